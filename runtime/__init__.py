@@ -1,0 +1,1 @@
+"""liganimate.runtime: motions, figures, scenes and the rasterizer."""
