@@ -1,0 +1,982 @@
+"""Articulated figures (LIG ANIMATE's MODEL type): structure and model operations.
+
+A figure is a tree whose nodes are *links* (rigid segments, each drawn from an
+opaque host shape) and whose arcs are *joints*.  Everything here is an
+immutable value: every operation returns a new :class:`Figure` and shares the
+unchanged parts (links, read-only arrays) with its operand, so copying a
+submodel into a bigger model (the thesis' value semantics for ``:-``) costs
+no more than building a tuple.
+
+Conventions (see ``docs/semantics-figure.md``):
+
+* A joint joins a primary link P and a secondary link S at ``loc1`` (in P's
+  coordinates) and ``loc2`` (in S's).  With angles ``(ax, ay, az)`` in
+  degrees, a point ``p`` of S is ``loc1 + R (p - loc2)`` in P, where
+  ``R = Rz(az) Ry(ay) Rx(ax)`` (right-hand rule).  Neutral is ``(0, 0, 0)``.
+* ``extremes`` is a ``(3, 2)`` array of ``(min, max)`` degrees per axis.
+* The *original* main link (``root``) is never a secondary; it fixes the tree's
+  structure.  The *current* main link (``main``, changed by FIGURE) is where a
+  pose is evaluated from: it sits at the origin of the model frame.
+* ``placement`` is the host's 4x4 transform placing the current main link in
+  the world.
+
+Operations always produce figures whose links and joints are in pre-order
+(depth first from the root, children in joint order), so ``links[0]`` is the
+root and joint ``k`` introduces link ``k + 1``; the constructor accepts any
+valid tree, though, and nothing relies on that order.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import operator
+from dataclasses import dataclass
+from functools import cached_property
+from typing import NamedTuple, Sequence
+
+import numpy as np
+
+from .errors import FigureError
+
+__all__ = [
+    "AXES",
+    "Link",
+    "Joint",
+    "Figure",
+    "JointSpec",
+    "TraversalLevel",
+    "normalize_extremes",
+    "join",
+    "assemble",
+]
+
+AXES = ("X", "Y", "Z")
+
+
+# --------------------------------------------------------------------------
+# small helpers
+# --------------------------------------------------------------------------
+
+
+def _key(name: str | None) -> str | None:
+    # LIG ANIMATE translates identifiers to upper case, so FOOT and foot are
+    # the same segment name.
+    return None if name is None else name.upper()
+
+
+def _num(x: float) -> str:
+    """Short decimal form for PRINT output (``-0`` printed as ``0``)."""
+    x = float(x)
+    if x == 0.0:
+        return "0"
+    return f"{x:.6g}"
+
+
+def _vec(v) -> str:
+    return "(" + ", ".join(_num(x) for x in v) + ")"
+
+
+def _frozen(value, shape: tuple[int, ...], what: str) -> np.ndarray:
+    """A finite, read-only float array of ``shape`` (reused when it already is one)."""
+    if (
+        isinstance(value, np.ndarray)
+        and value.dtype == np.float64
+        and value.shape == shape
+        and not value.flags.writeable
+    ):
+        # Structural sharing: read-only arrays coming from another figure are
+        # never copied again.
+        return value
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise FigureError(f"{what} must be {len(shape)}-dimensional numbers of shape {shape}.") from exc
+    if arr.shape != shape:
+        raise FigureError(f"{what} must have shape {shape}, not {arr.shape}.")
+    if not np.all(np.isfinite(arr)):
+        raise FigureError(f"{what} must be finite numbers, not {value!r}.")
+    arr = arr + 0.0  # turns -0.0 into 0.0 so printing and comparisons stay tidy
+    arr.setflags(write=False)
+    return arr
+
+
+def _joint_id(value) -> int:
+    if isinstance(value, bool):
+        raise FigureError(f"a joint identifier must be an integer, not {value!r}.")
+    try:
+        return operator.index(value)
+    except TypeError as exc:
+        raise FigureError(f"a joint identifier must be an integer, not {value!r}.") from exc
+
+
+def normalize_extremes(extremes) -> np.ndarray:
+    """Turn the extremes written in a JOINT statement into a ``(3, 2)`` array.
+
+    Parameters
+    ----------
+    extremes : array_like, shape (k, 2) with k in 1..3, or (2,)
+        ``(min, max)`` degree pairs for the X, Y and Z axes in that order.  A
+        bare pair is the X pair.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 2)
+        Read-only.  Omitted trailing axes are *locked* at ``(0, 0)``: the
+        thesis' arm examples give only X and Y pairs for a joint that should
+        not turn about Z.
+
+    Raises
+    ------
+    FigureError
+        If there are no pairs or more than three, a value is not finite, or a
+        pair has its minimum above its maximum (the message names the axis).
+    """
+    if isinstance(extremes, np.ndarray) and extremes.shape == (3, 2) and not extremes.flags.writeable:
+        return extremes
+    try:
+        arr = np.array(extremes, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise FigureError(
+            "joint extremes must be one to three (min, max) pairs of degrees.",
+            hint="write them as (min, max), (min, max), (min, max) for X, Y and Z",
+        ) from exc
+    if arr.shape == (2,):
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 2 or not 1 <= arr.shape[0] <= 3:
+        raise FigureError(
+            f"joint extremes must be one to three (min, max) pairs of degrees, not an array of shape {arr.shape}.",
+            hint="write them as (min, max), (min, max), (min, max) for X, Y and Z",
+        )
+    if not np.all(np.isfinite(arr)):
+        raise FigureError("joint extremes must be finite numbers of degrees.")
+    out = np.zeros((3, 2))
+    out[: arr.shape[0]] = arr
+    for axis in range(3):
+        lo, hi = out[axis]
+        if lo > hi:
+            raise FigureError(
+                f"the {AXES[axis]} extremes ({_num(lo)}, {_num(hi)}) have their minimum above their maximum.",
+                hint=f"write the pair as ({_num(hi)}, {_num(lo)})",
+            )
+    out = out + 0.0
+    out.setflags(write=False)
+    return out
+
+
+# --------------------------------------------------------------------------
+# values
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class Link:
+    """A rigid segment of a figure.
+
+    Parameters
+    ----------
+    name : str or None
+        The host graphical variable the segment was drawn from, or ``None``
+        for an anonymous expression.  Compared case-insensitively.
+    shape : object
+        The host graphical object; opaque here, drawn by the renderer.
+    scale : float, default 1.0
+        Uniform factor the renderer applies to ``shape``'s coordinates before
+        the link's pose (SCALE MODEL accumulates here; negative mirrors).
+    """
+
+    name: str | None
+    shape: object
+    scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        if self.name is not None and not isinstance(self.name, str):
+            raise FigureError(f"a link name must be a string or None, not {self.name!r}.")
+        scale = float(self.scale)
+        if not np.isfinite(scale) or scale == 0.0:
+            raise FigureError(f"a link's scale must be a finite non-zero number, not {self.scale!r}.")
+        object.__setattr__(self, "scale", scale)
+
+    @property
+    def label(self) -> str:
+        """The name for messages and PRINT (``<anonymous>`` when unnamed)."""
+        return self.name if self.name is not None else "<anonymous>"
+
+
+@dataclass(frozen=True, eq=False)
+class Joint:
+    """A joint between two links of a figure.
+
+    Parameters
+    ----------
+    id : int
+        The joint identifier used by motions (unique within a figure).
+    primary, secondary : int
+        Indices into the figure's ``links``: the stationary and the moving link.
+    loc1 : array_like, shape (3,)
+        The joint's location in the primary link's coordinates.
+    loc2 : array_like, shape (3,)
+        The joint's location in the secondary link's coordinates.
+    extremes : array_like, shape (k, 2), k in 1..3
+        ``(min, max)`` degrees per axis; see :func:`normalize_extremes`.
+        Stored as a read-only ``(3, 2)`` array.
+    """
+
+    id: int
+    primary: int
+    secondary: int
+    loc1: np.ndarray
+    loc2: np.ndarray
+    extremes: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "id", _joint_id(self.id))
+        object.__setattr__(self, "primary", operator.index(self.primary))
+        object.__setattr__(self, "secondary", operator.index(self.secondary))
+        object.__setattr__(self, "loc1", _frozen(self.loc1, (3,), f"the primary location of joint {self.id}"))
+        object.__setattr__(self, "loc2", _frozen(self.loc2, (3,), f"the secondary location of joint {self.id}"))
+        try:
+            object.__setattr__(self, "extremes", normalize_extremes(self.extremes))
+        except FigureError as exc:
+            # Say which joint: a model block may hold dozens of JOINT statements.
+            raise FigureError(f"joint {self.id}: {exc.message}", exc.hint) from None
+
+
+class TraversalLevel(NamedTuple):
+    """One depth level of a figure walked from its current main link.
+
+    All arrays have shape ``(k,)``: the level's ``k`` joints (indices into
+    ``Figure.joints``), the already-placed link each starts from, the link it
+    reaches, and whether the joint is walked backwards (secondary to primary),
+    in which case its inverse transform applies.
+    """
+
+    joints: np.ndarray
+    parents: np.ndarray
+    children: np.ndarray
+    reversed: np.ndarray
+
+
+class JointSpec(NamedTuple):
+    """One JOINT statement inside STARTMODEL ... ENDMODEL (see :func:`assemble`)."""
+
+    joint_id: int
+    primary_name: str
+    loc1: object
+    secondary: object  # str (a graphical object's name) or Figure (a submodel)
+    secondary_shape: object
+    loc2: object
+    extremes: object
+    statement_index: int
+
+
+@dataclass(frozen=True, eq=False)
+class Figure:
+    """An articulated model: a tree of links joined by joints.
+
+    Parameters
+    ----------
+    links : sequence of Link, length n_links >= 1
+    joints : sequence of Joint, length n_links - 1
+        Their ``primary``/``secondary`` index ``links``.  The order is the
+        figure's *joint order*: angle arrays are ``(..., n_joints, 3)`` in it.
+    root : int, default 0
+        The original main link; never a secondary.
+    main : int, optional
+        The current main link (default ``root``).
+    placement : array_like, shape (4, 4), optional
+        Host transform placing the current main link in the world
+        (default identity).
+
+    Raises
+    ------
+    FigureError
+        If the links and joints do not form one tree rooted at ``root`` or two
+        joints share an identifier.
+    """
+
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...] = ()
+    root: int = 0
+    main: int | None = None
+    placement: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        links = tuple(self.links)
+        joints = tuple(self.joints)
+        object.__setattr__(self, "links", links)
+        object.__setattr__(self, "joints", joints)
+        if not links or not all(isinstance(l, Link) for l in links):
+            raise FigureError("a figure needs at least one link, and every link must be a Link.")
+        if not all(isinstance(j, Joint) for j in joints):
+            raise FigureError("every joint of a figure must be a Joint.")
+        n = len(links)
+        root = operator.index(self.root)
+        main = root if self.main is None else operator.index(self.main)
+        if not (0 <= root < n and 0 <= main < n):
+            raise FigureError(f"the main links ({root}, {main}) must index the figure's {n} links.")
+        object.__setattr__(self, "root", root)
+        object.__setattr__(self, "main", main)
+        placement = np.eye(4) if self.placement is None else self.placement
+        object.__setattr__(self, "placement", _frozen(placement, (4, 4), "a figure's placement"))
+        self._check_tree()
+
+    def _check_tree(self) -> None:
+        n = len(self.links)
+        if len(self.joints) != n - 1:
+            raise FigureError(f"a tree of {n} links needs {n - 1} joints, not {len(self.joints)}.")
+        seen_ids: dict[int, int] = {}
+        parent = [-1] * n
+        for k, j in enumerate(self.joints):
+            if j.id in seen_ids:
+                raise FigureError(
+                    f"joint identifier {j.id} is used twice in one model.",
+                    hint="translate one submodel's identifiers with <TRANS JOINTS BY n>",
+                )
+            seen_ids[j.id] = k
+            if not (0 <= j.primary < n and 0 <= j.secondary < n) or j.primary == j.secondary:
+                raise FigureError(f"joint {j.id} must join two different links of the figure.")
+            if j.secondary == self.root:
+                raise FigureError(f"joint {j.id} makes the main link a secondary segment.")
+            if parent[j.secondary] != -1:
+                raise FigureError(f"link {self.links[j.secondary].label} is the secondary of two joints.")
+            parent[j.secondary] = k
+        # Each non-root link has exactly one parent; reaching them all from the
+        # root rules out cycles and disconnected pieces.
+        if len(self.preorder) != n:
+            raise FigureError("the joints do not connect every link to the main link in one tree.")
+
+    # ----------------------------------------------------------------- structure
+
+    @classmethod
+    def from_link(cls, link: Link) -> "Figure":
+        """A one-link figure (a graphical object used where a model is expected)."""
+        return cls((link,))
+
+    @property
+    def n_links(self) -> int:
+        """Number of links."""
+        return len(self.links)
+
+    @property
+    def n_joints(self) -> int:
+        """Number of joints (``n_links - 1``)."""
+        return len(self.joints)
+
+    @cached_property
+    def joint_ids(self) -> tuple[int, ...]:
+        """Joint identifiers in the figure's joint order."""
+        return tuple(j.id for j in self.joints)
+
+    @cached_property
+    def _id_index(self) -> dict[int, int]:
+        return {jid: k for k, jid in enumerate(self.joint_ids)}
+
+    def joint_index(self, joint_id: int) -> int:
+        """Position of joint ``joint_id`` in the joint order.
+
+        Raises
+        ------
+        FigureError
+            If the figure has no such joint (the message lists the ids).
+        """
+        try:
+            return self._id_index[_joint_id(joint_id)]
+        except KeyError:
+            raise FigureError(
+                f"the model has no joint {joint_id}.",
+                hint=f"its joints are {', '.join(map(str, sorted(self.joint_ids))) or 'none'}",
+            ) from None
+
+    def joint(self, joint_id: int) -> Joint:
+        """The :class:`Joint` with identifier ``joint_id``."""
+        return self.joints[self.joint_index(joint_id)]
+
+    @cached_property
+    def _parent_joint(self) -> tuple[int, ...]:
+        parent = [-1] * len(self.links)
+        for k, j in enumerate(self.joints):
+            parent[j.secondary] = k
+        return tuple(parent)
+
+    @cached_property
+    def _child_joints(self) -> tuple[tuple[int, ...], ...]:
+        children: list[list[int]] = [[] for _ in self.links]
+        for k, j in enumerate(self.joints):
+            children[j.primary].append(k)
+        return tuple(tuple(c) for c in children)
+
+    def parent_joint_of(self, link: int) -> Joint | None:
+        """The joint whose secondary is ``link`` in the ORIGINAL structure (None for the root)."""
+        k = self._parent_joint[link]
+        return None if k < 0 else self.joints[k]
+
+    def child_joints_of(self, link: int) -> tuple[Joint, ...]:
+        """Joints in which ``link`` is the primary in the ORIGINAL structure, in joint order."""
+        return tuple(self.joints[k] for k in self._child_joints[link])
+
+    @cached_property
+    def preorder(self) -> tuple[int, ...]:
+        """Link indices depth first from the root, children in joint order."""
+        order: list[int] = []
+        stack = [self.root]
+        seen = set()
+        while stack:
+            link = stack.pop()
+            if link in seen:  # only possible in a malformed joint list
+                continue
+            seen.add(link)
+            order.append(link)
+            stack.extend(self.joints[k].secondary for k in reversed(self._child_joints[link]))
+        return tuple(order)
+
+    def links_named(self, name: str) -> tuple[int, ...]:
+        """Indices of the links called ``name`` (case-insensitive), in :attr:`preorder`."""
+        key = _key(name)
+        return tuple(i for i in self.preorder if _key(self.links[i].name) == key)
+
+    @cached_property
+    def extremes(self) -> np.ndarray:
+        """All joints' extremes, shape ``(n_joints, 3, 2)``, read-only."""
+        arr = np.array([j.extremes for j in self.joints]).reshape(len(self.joints), 3, 2)
+        arr.setflags(write=False)
+        return arr
+
+    @cached_property
+    def locations(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(loc1, loc2)`` of all joints, each shape ``(n_joints, 3)``, read-only."""
+        loc1 = np.array([j.loc1 for j in self.joints]).reshape(len(self.joints), 3)
+        loc2 = np.array([j.loc2 for j in self.joints]).reshape(len(self.joints), 3)
+        loc1.setflags(write=False)
+        loc2.setflags(write=False)
+        return loc1, loc2
+
+    @cached_property
+    def link_scales(self) -> np.ndarray:
+        """Per-link geometry scale factors, shape ``(n_links,)``."""
+        arr = np.array([l.scale for l in self.links])
+        arr.setflags(write=False)
+        return arr
+
+    @cached_property
+    def traversal(self) -> tuple[TraversalLevel, ...]:
+        """The tree walked breadth first from the CURRENT main link, level by level.
+
+        A joint met from its secondary side is marked ``reversed``: it is
+        walked from S to P and its inverse transform applies.  This is what
+        makes FIGURE ... MAIN work without any sign bookkeeping.
+        """
+        adjacency: list[list[tuple[int, int, bool]]] = [[] for _ in self.links]
+        for k, j in enumerate(self.joints):
+            adjacency[j.primary].append((k, j.secondary, False))
+            adjacency[j.secondary].append((k, j.primary, True))
+        levels = []
+        frontier = [self.main]
+        visited = {self.main}
+        while True:
+            rows = []
+            for link in frontier:
+                for k, other, rev in adjacency[link]:
+                    if other not in visited:
+                        visited.add(other)
+                        rows.append((k, link, other, rev))
+            if not rows:
+                break
+            k, parents, children, rev = (np.array(c) for c in zip(*rows))
+            levels.append(TraversalLevel(k.astype(np.intp), parents.astype(np.intp), children.astype(np.intp), rev.astype(bool)))
+            frontier = [r[2] for r in rows]
+        return tuple(levels)
+
+    @cached_property
+    def reversed_joints(self) -> np.ndarray:
+        """Per joint, whether it is walked secondary to primary from the current main link, shape ``(n_joints,)``."""
+        rev = np.zeros(len(self.joints), dtype=bool)
+        for level in self.traversal:
+            rev[level.joints] = level.reversed
+        rev.setflags(write=False)
+        return rev
+
+    # ----------------------------------------------------------------- placement
+
+    def with_placement(self, matrix) -> "Figure":
+        """The same figure with host placement ``matrix`` (shape (4, 4))."""
+        return dataclasses.replace(self, placement=_frozen(matrix, (4, 4), "a figure's placement"))
+
+    def placed(self, matrix) -> "Figure":
+        """Apply host transform ``matrix`` (shape (4, 4)) after the current placement.
+
+        ``HUMAN :- HUMAN <TRANS (v)>`` is ``human.placed(translation(v))``: the
+        new placement is ``matrix @ placement``.
+        """
+        m = _frozen(matrix, (4, 4), "a host transform")
+        return dataclasses.replace(self, placement=m @ self.placement)
+
+    # ----------------------------------------------------------------- transformations
+
+    def trans_joints(self, n: int) -> "Figure":
+        """TRANS JOINTS BY ``n``: add ``n`` to every joint identifier."""
+        n = _joint_id(n)
+        return dataclasses.replace(self, joints=tuple(dataclasses.replace(j, id=j.id + n) for j in self.joints))
+
+    def scale_model(self, r: float) -> "Figure":
+        """SCALE MODEL ``r``: scale every link's geometry and every joint location by ``r``.
+
+        The links' frames stay rigid: the factor is recorded on each
+        :class:`Link` for the renderer and the joint locations are scaled, so
+        the whole posed figure becomes ``r`` times itself.  A negative ``r``
+        gives a mirror image (a point reflection, i.e. a plane mirror followed
+        by a half turn).
+
+        Raises
+        ------
+        FigureError
+            If ``r`` is zero or not finite.
+        """
+        r = float(r)
+        if not np.isfinite(r) or r == 0.0:
+            raise FigureError(
+                f"SCALE MODEL needs a finite non-zero factor, not {_num(r) if np.isfinite(r) else r}.",
+                hint="a zero factor would shrink the model to a point",
+            )
+        links = tuple(dataclasses.replace(l, scale=l.scale * r) for l in self.links)
+        joints = tuple(dataclasses.replace(j, loc1=j.loc1 * r, loc2=j.loc2 * r) for j in self.joints)
+        return dataclasses.replace(self, links=links, joints=joints)
+
+    def scale_extremes(self, r: float) -> "Figure":
+        """SCALE EXTREMES ``r``: multiply every joint extreme by ``r``.
+
+        A negative ``r`` mirrors the ranges: ``(a, b) * -1 == (-b, -a)``.
+        Zero locks every joint at neutral.
+        """
+        r = float(r)
+        if not np.isfinite(r):
+            raise FigureError(f"SCALE EXTREMES needs a finite factor, not {r}.")
+
+        def scaled(ext: np.ndarray) -> np.ndarray:
+            out = ext * r
+            return out[:, ::-1] if r < 0 else out  # keep each pair (min, max)
+
+        return dataclasses.replace(
+            self, joints=tuple(dataclasses.replace(j, extremes=scaled(j.extremes)) for j in self.joints)
+        )
+
+    # ----------------------------------------------------------------- main link
+
+    def with_main(self, link: int) -> "Figure":
+        """The figure animated from link index ``link`` (the structure is unchanged)."""
+        link = operator.index(link)
+        if not 0 <= link < len(self.links):
+            raise FigureError(f"the model has no link number {link}.")
+        return dataclasses.replace(self, main=link)
+
+    def with_original_main(self) -> "Figure":
+        """FIGURE m MAIN: animate from the original main link again."""
+        return dataclasses.replace(self, main=self.root)
+
+    def with_main_joint(self, joint_id: int) -> "Figure":
+        """FIGURE m MAIN JOINT ``joint_id``: the joint's secondary link becomes main.
+
+        Raises
+        ------
+        FigureError
+            If the model has no such joint.
+        """
+        return self.with_main(self.joint(joint_id).secondary)
+
+    def with_main_link(self, name: str, *, model_name: str | None = None) -> tuple["Figure", str | None]:
+        """FIGURE m MAIN LINK ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A link name (case-insensitive).
+        model_name : str, optional
+            The model variable, used in the warning's suggestion.
+
+        Returns
+        -------
+        figure : Figure
+            The figure animated from the chosen link.
+        warning : str or None
+            When several links bear ``name``: which one was chosen and how to
+            choose another.  The first one met depth first from the original
+            main link, children in joint order, is chosen.
+
+        Raises
+        ------
+        FigureError
+            If no link is called ``name`` (the message lists the closest names).
+        """
+        found = self.links_named(name)
+        if not found:
+            names = sorted({l.name.upper() for l in self.links if l.name is not None})
+            close = difflib.get_close_matches(name.upper(), names, n=3, cutoff=0.5)
+            raise FigureError(
+                f"the model has no link named {name}.",
+                hint=f"did you mean {' or '.join(close)}?" if close else f"its links are named {', '.join(names) or 'nothing'}",
+            )
+        chosen = found[0]
+        warning = None
+        if len(found) > 1:
+            m = model_name or "m"
+            parent = self.parent_joint_of(chosen)
+            which = (
+                f"the original main link itself"
+                if parent is None
+                else f"the one attached by joint {parent.id}"
+            )
+            others = ", ".join(str(self.parent_joint_of(i).id) for i in found[1:])
+            warning = (
+                f"{len(found)} links are named {name}; FIGURE {m} MAIN LINK {name} uses {which} "
+                f"(the first met depth first from the original main link {self.links[self.root].label}); "
+                f"write FIGURE {m} MAIN JOINT id with joint {others} to choose another."
+            )
+        return self.with_main(chosen), warning
+
+    # ----------------------------------------------------------------- PRINT
+
+    def describe_tree(self, name: str | None = None) -> str:
+        """The model's internal node relationships, as PRINT m shows them (thesis Figure 6).
+
+        One block per link in :attr:`preorder`: the link's graphical object,
+        scale and number of subjoints, then its arcs: row 0 is the joint in
+        which it is the secondary (the upward arc), rows 1..n the joints in
+        which it is the primary, each with the joint id, the node at the other
+        end and the joint's location on THIS link.
+        """
+        head = f"MODEL {name}: " if name else "MODEL: "
+        lines = [
+            f"{head}{self.n_links} links, {self.n_joints} joints; "
+            f"original main link {self.links[self.root].label} (node {self.root}); "
+            f"current main link {self.links[self.main].label} (node {self.main})"
+        ]
+        for i in self.preorder:
+            link = self.links[i]
+            tags = []
+            if i == self.root:
+                tags.append("original main link")
+            if i == self.main:
+                tags.append("current main link")
+            children = self.child_joints_of(i)
+            lines.append(
+                f"Node {i}: {link.label}  scale {_num(link.scale)}  subjoints {len(children)}"
+                + (f"  [{', '.join(tags)}]" if tags else "")
+            )
+            rows = [("No.", "Joint #", "Node", "Joint location")]
+            up = self.parent_joint_of(i)
+            if up is None:
+                rows.append(("0", "-", "-", "-"))
+            else:
+                rows.append(("0", str(up.id), f"{up.primary} {self.links[up.primary].label}", _vec(up.loc2)))
+            for n, j in enumerate(children, start=1):
+                rows.append((str(n), str(j.id), f"{j.secondary} {self.links[j.secondary].label}", _vec(j.loc1)))
+            lines.extend(_table(rows, indent="    "))
+        return "\n".join(lines)
+
+    def describe_table(self, angles=None, velocity=None, acceleration=None) -> str:
+        """The model's symbol table, as PRINT $m shows it (thesis Figure 8).
+
+        Parameters
+        ----------
+        angles, velocity, acceleration : array_like, shape (n_joints, 3), optional
+            Current values per joint (in joint order) and axis; zeros when
+            omitted.  Anything broadcastable to ``(n_joints, 3)`` is accepted.
+
+        Returns
+        -------
+        str
+            One row per joint: id, current orientation, X/Y/Z extremes,
+            velocity and acceleration.
+        """
+        shape = (self.n_joints, 3)
+        cols = [np.broadcast_to(np.asarray(0.0 if a is None else a, dtype=float), shape) for a in (angles, velocity, acceleration)]
+        rows = [("Joint #", "Current orientation", "X extremes", "Y extremes", "Z extremes", "Current velocity", "Current acceleration")]
+        for k, j in enumerate(self.joints):
+            rows.append(
+                (
+                    f"No. {j.id}",
+                    _vec(cols[0][k]),
+                    _vec(j.extremes[0]),
+                    _vec(j.extremes[1]),
+                    _vec(j.extremes[2]),
+                    _vec(cols[1][k]),
+                    _vec(cols[2][k]),
+                )
+            )
+        return "\n".join(_table(rows))
+
+
+def _table(rows: list[tuple[str, ...]], indent: str = "") -> list[str]:
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    return [indent + "  ".join(cell.ljust(w) for cell, w in zip(r, widths)).rstrip() for r in rows]
+
+
+# --------------------------------------------------------------------------
+# building figures
+# --------------------------------------------------------------------------
+
+
+def _as_figure(operand, role: str) -> Figure:
+    if isinstance(operand, Figure):
+        return operand
+    if isinstance(operand, Link):
+        return Figure.from_link(operand)
+    raise FigureError(f"the {role} of a JOINT must be a graphical object or a model, not {type(operand).__name__}.")
+
+
+def _graft(base: Figure, at: int, joint_id, loc1, sub: Figure, loc2, extremes) -> Figure:
+    """Attach ``sub`` by its ORIGINAL main link to link ``at`` of ``base``.
+
+    Keeps ``base``'s root, current main and placement.  If ``at`` is the root
+    (as in :func:`join`) and both operands are in pre-order, so is the result:
+    the new joint is the root's last child and ``sub``'s links follow.
+    """
+    new = Joint(joint_id, at, len(base.links) + sub.root, loc1, loc2, extremes)
+    taken = set(base.joint_ids)
+    for jid in (new.id, *sub.joint_ids):
+        if jid in taken:
+            raise FigureError(
+                f"joint identifier {jid} is used twice in one model.",
+                hint="translate one submodel's identifiers with <TRANS JOINTS BY n>",
+            )
+        taken.add(jid)
+    off = len(base.links)
+    shifted = tuple(dataclasses.replace(j, primary=j.primary + off, secondary=j.secondary + off) for j in sub.joints)
+    return Figure(
+        base.links + sub.links,
+        base.joints + (new,) + shifted,
+        root=base.root,
+        main=base.main,
+        placement=base.placement,
+    )
+
+
+def join(joint_id: int, primary, loc1, secondary, loc2, extremes) -> Figure:
+    """``m :- JOINT id, primary, loc1, secondary, loc2, extremes``.
+
+    Parameters
+    ----------
+    joint_id : int
+        The new joint's identifier.
+    primary, secondary : Link or Figure
+        A Figure is attached by its ORIGINAL main link (FIGURE changes how a
+        model is animated, not how it joins) and copied (value semantics).
+    loc1, loc2 : array_like, shape (3,)
+        The joint's location on the primary's and the secondary's main link.
+    extremes : array_like, shape (k, 2), k in 1..3
+        ``(min, max)`` degrees; omitted trailing axes are locked at ``(0, 0)``.
+
+    Returns
+    -------
+    Figure
+        Its original main link is the primary's original main link, its
+        current main link and placement are the primary's; the secondary's
+        placement and FIGURE choice are dropped.
+
+    Raises
+    ------
+    FigureError
+        On a repeated joint identifier (named) or malformed extremes.
+    """
+    p = _as_figure(primary, "primary segment")
+    s = _as_figure(secondary, "secondary segment")
+    return _graft(p, p.root, joint_id, loc1, s, loc2, extremes)
+
+
+def _canonical(links: list[Link], joints: list[Joint], root: int) -> Figure:
+    """A figure with links and joints renumbered into pre-order (children in list order)."""
+    children: list[list[int]] = [[] for _ in links]
+    for k, j in enumerate(joints):
+        children[j.primary].append(k)
+    order: list[int] = []
+    joint_order: list[int] = []
+    stack: list[tuple[int, int]] = [(root, -1)]
+    while stack:
+        link, via = stack.pop()
+        order.append(link)
+        if via >= 0:
+            joint_order.append(via)
+        stack.extend((joints[k].secondary, k) for k in reversed(children[link]))
+    where = {old: new for new, old in enumerate(order)}
+    new_joints = tuple(
+        dataclasses.replace(joints[k], primary=where[joints[k].primary], secondary=where[joints[k].secondary])
+        for k in joint_order
+    )
+    return Figure(tuple(links[i] for i in order), new_joints, root=0)
+
+
+def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str]]]:
+    """Build the model of a STARTMODEL ... ENDMODEL block.
+
+    Parameters
+    ----------
+    specs : sequence of JointSpec or 8-tuples
+        ``(joint_id, primary_name, loc1, secondary, secondary_shape, loc2,
+        extremes, statement_index)`` in textual order.  ``secondary`` is a
+        graphical object's name (its shape in ``secondary_shape``; when that
+        is None, ``shapes[secondary]``) or a :class:`Figure` submodel, attached
+        by its original main link and copied.
+    shapes : dict of str to object
+        Shapes of the graphical objects named as primaries (only the main
+        link's is needed: every other primary is a link some statement made).
+
+    Returns
+    -------
+    figure : Figure
+        In pre-order from the main link, siblings in textual order (a
+        submodel's own joints before those attached to it in the block).
+    warnings : list of (int, str)
+        ``(statement_index, sentence)`` for each ambiguous primary reference.
+
+    Raises
+    ------
+    FigureError
+        No main link (every segment is a secondary somewhere), several
+        candidate main links, a cycle, a repeated joint id, an ambiguous
+        primary with no candidate created before its statement, or a missing
+        shape.
+
+    Notes
+    -----
+    Statements may come in any order.  The main link is the one name used as
+    a primary but never as a secondary (nor inside a secondary submodel).
+    Each statement creates a new link or a copy of its submodel.  A primary
+    name resolves to the unique link bearing it; if several do, to the latest
+    one created by a statement textually BEFORE this one (the main link counts
+    as created first; within one submodel, the first in its pre-order), with
+    a warning -- the thesis asks that such statements follow the structure's
+    order.
+    """
+    specs = [JointSpec(*s) for s in specs]
+    if not specs:
+        raise FigureError("STARTMODEL ... ENDMODEL needs at least one JOINT statement.")
+
+    # 1. Each statement's piece: a new link, or a copy of a submodel.
+    pieces: list[Figure] = []
+    for s in specs:
+        if isinstance(s.secondary, Figure):
+            sub = s.secondary
+            # FIGURE and placement choices of a submodel do not travel with it.
+            pieces.append(Figure(sub.links, sub.joints, root=sub.root))
+        elif isinstance(s.secondary, str):
+            shape = s.secondary_shape if s.secondary_shape is not None else _lookup_shape(shapes, s.secondary)
+            pieces.append(Figure.from_link(Link(s.secondary, shape)))
+        elif isinstance(s.secondary, Link):
+            pieces.append(Figure.from_link(s.secondary))
+        else:
+            raise FigureError(f"the secondary of JOINT {s.joint_id} must be a graphical object or a model.")
+
+    # 2. The main link: a primary name never used as a secondary.
+    secondary_names = {_key(l.name) for p in pieces for l in p.links if l.name is not None}
+    roots: dict[str, str] = {}  # key -> name as first written, in textual order
+    for s in specs:
+        if _key(s.primary_name) not in secondary_names:
+            roots.setdefault(_key(s.primary_name), s.primary_name)
+    roots = list(roots.values())
+    if not roots:
+        raise FigureError(
+            "no segment can be the main link: every segment is a secondary somewhere, so the model has a cycle.",
+            hint="the main link must appear only as a primary segment",
+        )
+    if len(roots) > 1:
+        raise FigureError(
+            f"the model is not one tree: {', '.join(roots)} are each used only as primary segments, "
+            "so each would be a main link.",
+            hint="join the pieces together, or check the spelling of the segment names",
+        )
+    root_link = Link(roots[0], _lookup_shape(shapes, roots[0]))
+
+    # 3. Candidate links per name: (textual position of creator, link in piece);
+    #    the root's creator is position -1 ("created first").
+    candidates: dict[str, list[tuple[int, int]]] = {_key(root_link.name): [(-1, 0)]}
+    for pos, piece in enumerate(pieces):
+        for local in piece.preorder:
+            name = piece.links[local].name
+            if name is not None:
+                candidates.setdefault(_key(name), []).append((pos, local))
+
+    warnings: list[tuple[int, str]] = []
+    attach: list[tuple[int, int]] = []  # per statement: (creator position, local link)
+    for pos, s in enumerate(specs):
+        cands = candidates.get(_key(s.primary_name), [])
+        if len(cands) == 1:
+            attach.append(cands[0])
+            continue
+        before = [c for c in cands if c[0] < pos]
+        if not before:
+            raise FigureError(
+                f"JOINT {s.joint_id} names primary segment {s.primary_name}, which {len(cands)} links bear, "
+                "and none of them is made by an earlier statement.",
+                hint="with repeated segment names, place the JOINT statements in the order of the model's structure",
+            )
+        latest = max(c[0] for c in before)
+        chosen = next(c for c in before if c[0] == latest)  # first in that piece's pre-order
+        attach.append(chosen)
+        made_by = "the main link" if latest < 0 else f"the one made by JOINT {specs[latest].joint_id}"
+        warnings.append(
+            (
+                s.statement_index,
+                f"JOINT {s.joint_id}: {len(cands)} segments are named {s.primary_name}, so the reference is "
+                f"ambiguous; using {made_by}, the latest made before this statement.",
+            )
+        )
+
+    # 4. Cycles: follow each statement up through the statements that made
+    #    its primary; it must reach the main link without meeting itself.
+    for pos in range(len(specs)):
+        chain = [pos]
+        cur = attach[pos][0]
+        while cur >= 0:
+            if cur in chain:
+                loop = chain[chain.index(cur):]
+                ids = ", ".join(f"JOINT {specs[c].joint_id}" for c in loop)
+                raise FigureError(
+                    f"the model has a cycle: {ids} each hang from a segment made by the next"
+                    if len(loop) > 1
+                    else f"the model has a cycle: JOINT {specs[cur].joint_id} hangs its primary segment "
+                    f"{specs[cur].primary_name} from its own secondary.",
+                    hint="a segment cannot be both above and below itself",
+                )
+            chain.append(cur)
+            cur = attach[cur][0]
+
+    # 5. Repeated ids, named with their statements.
+    owner: dict[int, int] = {}
+    for pos, (s, piece) in enumerate(zip(specs, pieces)):
+        for jid in (_joint_id(s.joint_id), *piece.joint_ids):
+            if jid in owner:
+                raise FigureError(
+                    f"joint identifier {jid} is used twice in model (by JOINT {specs[owner[jid]].joint_id}"
+                    f"{' or its submodel' if owner[jid] != pos else ''} and by JOINT {s.joint_id}"
+                    f"{' or its submodel' if isinstance(s.secondary, Figure) else ''}).",
+                    hint="translate a submodel's identifiers with <TRANS JOINTS BY n>",
+                )
+            owner[jid] = pos
+
+    # 6. Flatten: root, then each piece's links; pieces' own joints first, then
+    #    the statements' joints in textual order, so siblings keep that order.
+    offsets = []
+    links: list[Link] = [root_link]
+    for piece in pieces:
+        offsets.append(len(links))
+        links.extend(piece.links)
+    joints: list[Joint] = []
+    for off, piece in zip(offsets, pieces):
+        joints.extend(
+            dataclasses.replace(j, primary=j.primary + off, secondary=j.secondary + off) for j in piece.joints
+        )
+    for pos, s in enumerate(specs):
+        creator, local = attach[pos]
+        primary = 0 if creator < 0 else offsets[creator] + local
+        joints.append(Joint(s.joint_id, primary, offsets[pos] + pieces[pos].root, s.loc1, s.loc2, s.extremes))
+    return _canonical(links, joints, 0), warnings
+
+
+def _lookup_shape(shapes: dict, name: str):
+    if name in shapes:
+        return shapes[name]
+    key = _key(name)
+    for k, v in shapes.items():
+        if isinstance(k, str) and _key(k) == key:
+            return v
+    raise FigureError(f"there is no graphical object named {name} to use as a segment.")
