@@ -91,7 +91,7 @@ def _frozen(value, shape: tuple[int, ...], what: str) -> np.ndarray:
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise FigureError(f"{what} must be {len(shape)}-dimensional numbers of shape {shape}.") from exc
+        raise FigureError(f"{what} must be numbers of shape {shape}.") from exc
     if arr.shape != shape:
         raise FigureError(f"{what} must have shape {shape}, not {arr.shape}.")
     if not np.all(np.isfinite(arr)):
@@ -287,6 +287,8 @@ class Figure:
     placement : array_like, shape (4, 4), optional
         Host transform placing the current main link in the world
         (default identity).
+
+    Figures are compared by identity; all array attributes are read-only.
 
     Raises
     ------
@@ -814,8 +816,8 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
         ``(joint_id, primary_name, loc1, secondary, secondary_shape, loc2,
         extremes, statement_index)`` in textual order.  ``secondary`` is a
         graphical object's name (its shape in ``secondary_shape``; when that
-        is None, ``shapes[secondary]``) or a :class:`Figure` submodel, attached
-        by its original main link and copied.
+        is None, ``shapes[secondary]``), a :class:`Figure` submodel, attached
+        by its original main link and copied, or a ready :class:`Link`.
     shapes : dict of str to object
         Shapes of the graphical objects named as primaries (only the main
         link's is needed: every other primary is a link some statement made).
