@@ -622,16 +622,14 @@ class Figure:
         if len(found) > 1:
             m = model_name or "m"
             parent = self.parent_joint_of(chosen)
-            which = (
-                f"the original main link itself"
-                if parent is None
-                else f"the one attached by joint {parent.id}"
-            )
-            others = ", ".join(str(self.parent_joint_of(i).id) for i in found[1:])
+            which = "the original main link itself" if parent is None else f"the one attached by joint {parent.id}"
+            # found[1:] are never the root (it comes first in pre-order), so each has a joint.
+            alts = [str(self.parent_joint_of(i).id) for i in found[1:]]
+            more = f" (or {', '.join(alts[1:])})" if len(alts) > 1 else ""
             warning = (
                 f"{len(found)} links are named {name}; FIGURE {m} MAIN LINK {name} uses {which} "
                 f"(the first met depth first from the original main link {self.links[self.root].label}); "
-                f"write FIGURE {m} MAIN JOINT id with joint {others} to choose another."
+                f"write FIGURE {m} MAIN JOINT {alts[0]}{more} to choose another."
             )
         return self.with_main(chosen), warning
 

@@ -94,7 +94,7 @@ def test_figure_human_main_link_foot_warns_and_picks_the_first_foot():
     human, _ = build_human()
     on_foot, warning = human.with_main_link("FOOT", model_name="HUMAN")
     assert on_foot.parent_joint_of(on_foot.main).id == 4
-    assert "joint 4" in warning and "FIGURE HUMAN MAIN JOINT" in warning and "6" in warning
+    assert "joint 4" in warning and "FIGURE HUMAN MAIN JOINT 6 to choose another" in warning
     # The structure is untouched: only the current main link moved.
     assert on_foot.root == human.root and signature(on_foot)[:2] == signature(human)[:2]
     assert on_foot.with_main_joint(6).parent_joint_of(on_foot.with_main_joint(6).main).id == 6
@@ -376,7 +376,11 @@ def test_with_main_link_repeated_root_name():
     f = join(3, Link("seg", 0), (0, 0, 0), Link("seg", 1), (0, 0, 0), FREE)
     g, warning = f.with_main_link("seg", model_name="chain")
     assert g.main == g.root
-    assert "original main link itself" in warning and "FIGURE chain MAIN JOINT id with joint 3" in warning
+    assert "original main link itself" in warning and "FIGURE chain MAIN JOINT 3 to choose another" in warning
+    three = join(4, f, (0, 1, 0), Link("seg", 2), (0, 0, 0), FREE)  # seg -3-> seg, seg -4-> seg
+    g, warning = three.with_main_link("SEG")
+    assert g.main == g.root and "3 links are named SEG" in warning
+    assert "MAIN JOINT 3 (or 4) to choose another" in warning
 
 
 def test_with_main_joint_unknown():
