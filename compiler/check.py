@@ -1,0 +1,746 @@
+"""Static checks: names, kinds and types, statement placement.
+
+:func:`check` takes a parsed :class:`~liganimate.lang.ast.Program` and returns
+a :class:`Checked` program (the symbol tables and the type of every
+expression) or raises :class:`~liganimate.lang.diagnostics.LigDiagnostics`
+with every error it found. Checks that depend on values (a FIGURE naming a
+link the model lacks, overlapping SYNCHRONIZE...) happen when the program
+runs, still before anything is rendered.
+
+Variables need no declaration: the first assignment declares them with the
+type of its value, and an implicit number assigned a REAL anywhere is REAL.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from liganimate.lang import ast as A
+from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+from liganimate.runtime import interpolation
+
+from . import types as T
+from .primitives import Signature, builtin_signatures, signature_from_pattern
+
+MAX_ERRORS = 20
+
+
+@dataclass
+class Scope:
+    """The variables of the main program or of one PRIMITIVE."""
+
+    name: str
+    types: dict = field(default_factory=dict)  # NAME -> type
+    declared: dict = field(default_factory=dict)  # NAME -> Pos of declaration (explicit)
+    implicit: set = field(default_factory=set)
+    params: list = field(default_factory=list)
+
+
+@dataclass
+class SceneInfo:
+    """What a scene uses: models to snapshot, models it animates, names it assigns."""
+
+    animated: list = field(default_factory=list)
+    models: list = field(default_factory=list)
+    assigned: set = field(default_factory=set)
+
+
+@dataclass
+class Checked:
+    """A program that passed the static checks, with what lowering needs."""
+
+    program: A.Program
+    main: Scope
+    primitives: dict  # NAME -> (PrimitiveDef | None, Signature, Scope | None)
+    types: dict  # id(expr node) -> type
+    scenes: dict  # id(Scene node) -> SceneInfo
+    warnings: list
+
+
+class _Stop(Exception):
+    pass
+
+
+class Checker:
+    """Walks the tree once per scope, twice to settle implicit number types."""
+
+    def __init__(self, program: A.Program):
+        self.program = program
+        self.errors: list = []
+        self.warnings: list = []
+        self.types: dict = {}
+        self.scenes: dict = {}
+        self.primitives: dict = {}
+        self.final = False
+
+    # ------------------------------------------------------------- errors
+    def err(self, node_or_pos, message: str, hint: str | None = None) -> None:
+        if not self.final:
+            return
+        pos = node_or_pos if isinstance(node_or_pos, A.Pos) else node_or_pos.pos
+        self.errors.append(Diagnostic(self.program.filename, pos, message, hint, source=self.program.source))
+        if len(self.errors) >= MAX_ERRORS:
+            raise _Stop()
+
+    def warn(self, node, message: str, hint: str | None = None) -> None:
+        if self.final:
+            self.warnings.append(Diagnostic(self.program.filename, node.pos, message, hint, "warning", self.program.source))
+
+    # ---------------------------------------------------------------- run
+    def run(self) -> Checked:
+        prog = self.program
+        sigs = builtin_signatures()
+        for p in prog.primitives:
+            if p.pattern is None:
+                self.final = True
+                self.err(p.name, f"PRIMITIVE {p.name.name} has no invocation pattern",
+                         f"add a line such as  {p.name.name} ::= '{p.name.name}' 'SIZE' S ;")
+                self.final = False
+                continue
+            sig, problems = signature_from_pattern(p.name.name, p.pattern)
+            for node, message in problems:
+                self.final = True
+                self.err(node, message, "a pattern is a series of 'KEYWORD' VALUE pairs separated by ',' (optional parts in [ ])")
+                self.final = False
+            sigs[p.name.name] = sig
+            self.primitives[p.name.name] = (p, sig, None)
+        for name, sig in sigs.items():
+            if name not in self.primitives:
+                self.primitives[name] = (None, sig, None)
+        self.signatures = sigs
+        main = Scope("main program")
+        try:
+            # First passes settle implicit types; the final pass reports.
+            for p in prog.primitives:
+                scope = self._primitive_scope(p)
+                for _ in range(3):
+                    self._check_scope(p.body, scope, primitive=p)
+                self.final = True
+                self._check_scope(p.body, scope, primitive=p)
+                self.final = False
+                prim, sig, _ = self.primitives[p.name.name]
+                for slot in sig.slots:
+                    sig.param_types[slot.keyword] = scope.types.get(slot.param, T.REAL)
+                self.primitives[p.name.name] = (prim, sig, scope)
+            for _ in range(3):
+                self._check_scope(prog.body, main, primitive=None)
+            self.final = True
+            self._check_scope(prog.body, main, primitive=None)
+        except _Stop:
+            pass
+        if self.errors:
+            raise LigDiagnostics(self.errors)
+        return Checked(prog, main, self.primitives, self.types, self.scenes, self.warnings)
+
+    def _primitive_scope(self, p: A.PrimitiveDef) -> Scope:
+        scope = Scope(f"PRIMITIVE {p.name.name}")
+        _, sig, _ = self.primitives.get(p.name.name, (None, None, None))
+        # Parameter types come from the declarations inside the primitive.
+        for stmt in p.body:
+            if isinstance(stmt, A.Decl):
+                for n in stmt.names:
+                    scope.types[n.name] = stmt.type
+                    scope.declared[n.name] = n.pos
+        if sig is not None:
+            for param in sig.params:
+                scope.params.append(param)
+                if param not in scope.types:
+                    scope.types[param] = T.REAL
+                    scope.implicit.add(param)
+        return scope
+
+    # --------------------------------------------------------- statements
+    def _check_scope(self, body: list, scope: Scope, primitive) -> None:
+        self.scope = scope
+        self.primitive = primitive
+        self.scene = None
+        self._stmts(body, context="top")
+
+    def _stmts(self, stmts: list, context: str) -> None:
+        for s in stmts:
+            self._stmt(s, context)
+
+    def _stmt(self, s, context: str) -> None:
+        method = getattr(self, "_s_" + type(s).__name__)
+        method(s, context)
+
+    def _s_PrimitiveDef(self, s, context):
+        pass  # checked in its own scope
+
+    def _s_ProgramEnd(self, s, context):
+        pass
+
+    def _s_PatternDef(self, s, context):
+        pass
+
+    def _s_Decl(self, s, context):
+        for n in s.names:
+            prev = self.scope.types.get(n.name)
+            if n.name in self.signatures and self.primitive is None:
+                self.err(n, f"{n.name} is a primitive, so it cannot be declared as a variable")
+            if n.name in self.scope.declared and self.scope.declared[n.name] != n.pos and prev != s.type:
+                where = self.scope.declared[n.name]
+                self.err(n, f"{n.name} is already declared as {prev} at line {where.line}")
+                continue
+            self.scope.types[n.name] = s.type
+            self.scope.declared[n.name] = n.pos
+            self.scope.implicit.discard(n.name)
+
+    def _assign_type(self, target: A.Name, value_type, value_node) -> None:
+        if value_type is None:
+            return
+        name = target.name
+        if value_type == T.PAIR:
+            self.err(value_node, "a pair (min, max) can only be a joint's extremes",
+                     "a vector has three components: (x, y, z)")
+            return
+        if value_type == T.BOOL:
+            return
+        current = self.scope.types.get(name)
+        if current is None:
+            self.scope.types[name] = value_type
+            self.scope.implicit.add(name)
+            return
+        if name in self.scope.implicit and current == T.INTEGER and value_type == T.REAL:
+            self.scope.types[name] = T.REAL
+            return
+        if not T.fits(current, value_type):
+            hint = "use INT(...) or NINT(...) to make an INTEGER" if current == T.INTEGER and value_type == T.REAL else None
+            self.err(value_node, f"{name} is {T.NOUN[current]}, so it cannot hold {T.NOUN[value_type]}", hint)
+
+    def _s_Assign(self, s, context):
+        if s.target.name in self.signatures:
+            self.err(s.target, f"{s.target.name} is a primitive, so it cannot be assigned")
+            return
+        if isinstance(s.value, A.JointExpr):
+            self._check_self_cycle(s.target.name, s.value)
+        t = self.expr(s.value)
+        self._assign_type(s.target, t, s.value)
+        if self.scene is not None:
+            self.scene.assigned.add(s.target.name)
+
+    def _check_self_cycle(self, target: str, joint: A.JointExpr) -> None:
+        args = joint.args
+        if len(args) >= 4:
+            p, sec = _plain_name(args[1]), _plain_name(args[3])
+            if p == target and sec == target:
+                self.err(args[3], f"{target} cannot be joined to itself: the model would contain a cycle",
+                         f"join a copy: make another model from {target} first")
+
+    def _s_KeyframeAssign(self, s, context):
+        t = self.scope.types.get(s.target.name)
+        if t is None:
+            self.scope.types[s.target.name] = T.MOTION
+            self.scope.implicit.add(s.target.name)
+        elif t != T.MOTION:
+            self.err(s.target, f"{s.target.name} is {T.NOUN[t]}; keyframes belong to a MOTION")
+        self._want(s.joint, T.INTEGER, "a joint identifier")
+        self._want(s.index, T.INTEGER, "a keyframe number")
+        self._keyframe(s.keyframe)
+        if self.scene is not None:
+            self.scene.assigned.add(s.target.name)
+
+    def _keyframe(self, k: A.Keyframe) -> None:
+        self._want_number(k.frame, "a frame number")
+        self._position(k.position, k)
+        if k.method is not None:
+            self._method(k.method)
+
+    def _method(self, name: A.Name) -> None:
+        try:
+            interpolation.get(name.name)
+        except KeyError:
+            hint = did_you_mean(name.name, interpolation.names())
+            self.err(name, f"{name.name} is not an interpolation method",
+                     hint or "the methods are " + ", ".join(interpolation.names()))
+
+    def _position(self, items: list, node) -> None:
+        if len(items) == 1:
+            self._want(items[0], T.VECTOR, "a position (ax, ay, az)")
+        elif len(items) == 3:
+            for it in items:
+                self._want_number(it, "an angle")
+        else:
+            self.err(items[1] if len(items) > 1 else node,
+                     f"a position is three angles or one vector, not {len(items)} values")
+
+    def _s_DoHeader(self, s, context):  # pragma: no cover - grouped away by the parser
+        pass
+
+    def _s_Do(self, s, context):
+        types = [self.expr(e) for e in (s.start, s.stop, s.step) if e is not None]
+        for e, t in zip([e for e in (s.start, s.stop, s.step) if e is not None], types):
+            if t is not None and not T.is_numeric(t):
+                self.err(e, f"a DO loop bound must be a number, not {T.NOUN[t]}")
+        loop_type = T.INTEGER if all(t == T.INTEGER for t in types) else T.REAL
+        self._assign_type(s.var, loop_type, s.start)
+        if self.scene is not None:
+            self.scene.assigned.add(s.var.name)
+        self._stmts(s.body, context)
+
+    def _s_If(self, s, context):
+        self.cond(s.cond)
+        self._stmts(s.then, context)
+        if s.orelse:
+            self._stmts(s.orelse, context)
+
+    def _s_ModelBlock(self, s, context):
+        self._model_target(s.name)
+        ids = {}
+        for j in s.joints:
+            args = j.args
+            self._joint_args(args, j, in_block=True)
+            if args and isinstance(args[0], A.Num) and isinstance(args[0].value, int):
+                if args[0].value in ids:
+                    self.err(args[0], f"joint {args[0].value} appears twice in model {s.name.name}",
+                             f"the first is at line {ids[args[0].value].line}; joint identifiers must be unique")
+                else:
+                    ids[args[0].value] = args[0].pos
+        if self.scene is not None:
+            self.scene.assigned.add(s.name.name)
+
+    def _model_target(self, name: A.Name) -> None:
+        t = self.scope.types.get(name.name)
+        if t is None:
+            self.scope.types[name.name] = T.MODEL
+            self.scope.implicit.add(name.name)
+        elif t != T.MODEL:
+            self.err(name, f"{name.name} is {T.NOUN[t]}, not a MODEL")
+
+    def _joint_args(self, args: list, node, in_block: bool) -> None:
+        if len(args) < 6 or len(args) > 8:
+            self.err(node, f"JOINT takes an identifier, a primary segment and its location, a secondary segment "
+                           f"and its location, and one to three extreme pairs: {len(args)} values given",
+                     "JOINT id, primary, (x, y, z), secondary, (x, y, z), (min, max), (min, max), (min, max)")
+            for a in args:
+                self.expr(a)
+            return
+        self._want(args[0], T.INTEGER, "a joint identifier")
+        if in_block and not isinstance(args[1], A.Var):
+            self.err(args[1], "inside STARTMODEL the primary segment must be the name of a GRAPHICAL object")
+        self._segment(args[1], "primary", in_block)
+        self._want(args[2], T.VECTOR, "a location (x, y, z)")
+        self._segment(args[3], "secondary", False)
+        self._want(args[4], T.VECTOR, "a location (x, y, z)")
+        for ext in args[5:]:
+            t = self.expr(ext)
+            if t is not None and t != T.PAIR:
+                self.err(ext, f"joint extremes are pairs (min, max), not {T.NOUN[t]}")
+            elif isinstance(ext, A.Tuple) and all(isinstance(i, (A.Num, A.Neg)) for i in ext.items):
+                lo, hi = (_const(i) for i in ext.items)
+                if lo is not None and hi is not None and lo > hi:
+                    self.err(ext, f"these extremes have a minimum ({_fmt(lo)}) above the maximum ({_fmt(hi)})",
+                             f"write ({_fmt(hi)}, {_fmt(lo)})")
+
+    def _segment(self, e, role: str, in_block: bool) -> None:
+        if in_block and role == "primary" and isinstance(e, A.Var):
+            t = self.scope.types.get(e.name)
+            if t is None:
+                self._unknown(e)
+            elif t != T.GRAPHICAL:
+                self.err(e, f"inside STARTMODEL the primary segment must be a GRAPHICAL object; {e.name} is {T.NOUN[t]}")
+            self.types[id(e)] = t
+            return
+        t = self.expr(e)
+        if t is not None and t not in (T.GRAPHICAL, T.MODEL):
+            self.err(e, f"a {role} segment is a GRAPHICAL object or a MODEL, not {T.NOUN[t]}")
+
+    def _s_MotionBlock(self, s, context):
+        t = self.scope.types.get(s.name.name)
+        if t is None:
+            self.scope.types[s.name.name] = T.MOTION
+            self.scope.implicit.add(s.name.name)
+        elif t != T.MOTION:
+            self.err(s.name, f"{s.name.name} is {T.NOUN[t]}, not a MOTION")
+        seen = {}
+        for j in s.joints:
+            self._want(j.joint, T.INTEGER, "a joint identifier")
+            if isinstance(j.joint, A.Num):
+                if j.joint.value in seen:
+                    self.err(j.joint, f"joint {j.joint.value} appears twice in motion {s.name.name}",
+                             f"the first is at line {seen[j.joint.value].line}; put all its keyframes under one JOINT")
+                seen[j.joint.value] = j.joint.pos
+            if j.start is not None:
+                self._position(j.start, j)
+            last = None
+            for k in j.keyframes:
+                self._keyframe(k)
+                c = _const(k.frame)
+                if c is not None and last is not None and c < last:
+                    self.err(k.frame, f"keyframes must be in ascending frame order: frame {_fmt(c)} comes after frame {_fmt(last)}")
+                last = c if c is not None else last
+        if self.scene is not None:
+            self.scene.assigned.add(s.name.name)
+
+    def _s_FigureStmt(self, s, context):
+        self._want_var(s.model, T.MODEL)
+        if s.kind == "JOINT":
+            self._want(s.joint, T.INTEGER, "a joint identifier")
+        if self.scene is not None:
+            self.scene.assigned.add(s.model.name)
+
+    def _s_Scene(self, s, context):
+        if self.primitive is not None or context != "top":
+            self.err(s.start_pos, "a scene cannot be defined inside a PRIMITIVE or another scene"
+                     if self.primitive is not None or context == "scene" else
+                     "a scene definition belongs at the program's top level, not inside a loop or IF")
+        info = SceneInfo()
+        self.scenes[id(s)] = info
+        outer = self.scene
+        self.scene = info
+        self._want(s.scene_id, T.INTEGER, "a scene identifier")
+        self._stmts(s.init, "scene")
+        self._want(s.length, T.INTEGER, "a scene length (a number of ticks)")
+        if s.sameframe is not None:
+            self._want(s.sameframe, T.INTEGER, "a number of ticks per image")
+        self._in_body = True
+        self._stmts(s.body, "scene-body")
+        self._in_body = False
+        self.scene = outer
+        info.models = sorted(n for n in _names_used(s) if self.scope.types.get(n) == T.MODEL)
+
+    def _s_Animate(self, s, context):
+        if context != "scene-body":
+            self.err(s, "ANIMATE belongs between STARTSCENE and ENDSCENE",
+                     "a scene is INITIALIZE SCENE n ... STARTSCENE LENGTH n ... ENDSCENE")
+        self._want_var(s.model, T.MODEL)
+        self._want(s.start, T.INTEGER, "a tick number")
+        self._want(s.end, T.INTEGER, "a tick number")
+        t = self.expr(s.motion)
+        if t is not None and t != T.MOTION:
+            self.err(s.motion, f"ANIMATE ... USING needs a MOTION, not {T.NOUN[t]}")
+        if self.scene is not None and s.model.name not in self.scene.animated:
+            self.scene.animated.append(s.model.name)
+
+    def _s_Background(self, s, context):
+        if self.primitive is not None:
+            self.err(s, "BACKGROUND belongs in a scene, not in a PRIMITIVE")
+        for item in s.items:
+            t = self.expr(item)
+            if t is not None and t not in (T.GRAPHICAL, T.MODEL):
+                self.err(item, f"a background is made of GRAPHICAL objects, not {T.NOUN[t]}")
+        if context not in ("scene", "scene-body"):
+            self.warn(s, "BACKGROUND outside a scene has no effect",
+                      "put it between INITIALIZE SCENE and ENDSCENE")
+
+    def _s_Print(self, s, context):
+        for item in s.items:
+            if item.kind == "value":
+                t = self.expr(item.value)
+                if t == T.PAIR:
+                    self.err(item.value, "a pair can only be a joint's extremes")
+            elif item.kind == "table":
+                self._want_var(item.value, T.MODEL, what="PRINT $ needs a MODEL")
+
+    def _s_View(self, s, context):
+        if s.what == "POINT":
+            self._want(s.value, T.VECTOR, "a view point (x, y, z)")
+        else:
+            self._want_number(s.value, "a view width")
+
+    def _s_Shoot(self, s, context):
+        if self.primitive is not None or context.startswith("scene"):
+            self.err(s, "SHOOTSCENES belongs outside scenes and primitives")
+
+    def _s_Stop(self, s, context):
+        pass
+
+    def _s_Return(self, s, context):
+        if self.primitive is None:
+            self.err(s, "RETURN belongs in a PRIMITIVE")
+
+    def _s_DrawWith(self, s, context):
+        if self.primitive is None:
+            self.err(s, "DRAW belongs in a PRIMITIVE")
+        for m in s.modifiers:
+            if m.kind != "lightness":
+                self.err(m, "DRAW WITH takes <LIGHTNESS l>")
+            self._want_number(m.arg, "a lightness")
+
+    def _s_DrawPoly(self, s, context):
+        if self.primitive is None:
+            self.err(s, "DRAW belongs in a PRIMITIVE")
+        for p in s.points:
+            self._want(p, T.VECTOR, "a point (x, y, z)")
+
+    def _s_Continue(self, s, context):  # pragma: no cover - grouped away
+        pass
+
+    # -------------------------------------------------------- expressions
+    def _want(self, e, t: str, what: str) -> None:
+        got = self.expr(e)
+        if got is None:
+            return
+        if not T.fits(t, got):
+            if t == T.INTEGER and got == T.REAL:
+                self.err(e, f"{what} must be an INTEGER; this is a REAL", "use INT(...) or NINT(...)")
+            else:
+                self.err(e, f"{what} must be {T.NOUN[t]}, not {T.NOUN[got]}")
+
+    def _want_number(self, e, what: str) -> None:
+        got = self.expr(e)
+        if got is not None and not T.is_numeric(got):
+            self.err(e, f"{what} must be a number, not {T.NOUN[got]}")
+
+    def _want_var(self, name: A.Name, t: str, what: str | None = None) -> None:
+        got = self.scope.types.get(name.name)
+        if got is None:
+            self._unknown(name)
+        elif got != t:
+            self.err(name, what + f"; {name.name} is {T.NOUN[got]}" if what else
+                     f"{name.name} is {T.NOUN[got]}, but {T.NOUN[t]} is needed here")
+
+    def _unknown(self, node) -> None:
+        name = node.name
+        hint = did_you_mean(name, list(self.scope.types) + list(self.signatures))
+        self.err(node, f"{name} is not defined", hint or "assign it or declare it (REAL, VECTOR, MODEL, ...) first")
+
+    def expr(self, e):
+        t = getattr(self, "_e_" + type(e).__name__)(e)
+        self.types[id(e)] = t
+        return t
+
+    def _e_Num(self, e):
+        return T.INTEGER if isinstance(e.value, int) else T.REAL
+
+    def _e_Var(self, e):
+        t = self.scope.types.get(e.name)
+        if t is None:
+            if e.name in self.signatures:
+                self.err(e, f"{e.name} is a primitive: call it with its keywords",
+                         self.signatures[e.name].usage())
+            else:
+                self._unknown(e)
+        return t
+
+    def _e_Tuple(self, e):
+        ts = [self.expr(i) for i in e.items]
+        for i, t in zip(e.items, ts):
+            if t is not None and not T.is_numeric(t):
+                self.err(i, f"a vector's components are numbers, not {T.NOUN[t]}")
+        if len(e.items) == 3:
+            return T.VECTOR
+        if len(e.items) == 2:
+            return T.PAIR
+        self.err(e, f"a vector has three components, not {len(e.items)}")
+        return None
+
+    def _e_Neg(self, e):
+        t = self.expr(e.operand)
+        if t is None:
+            return None
+        if t in (T.INTEGER, T.REAL, T.VECTOR):
+            return t
+        self.err(e, f"cannot negate {T.NOUN[t]}")
+        return None
+
+    def _e_BinOp(self, e):
+        lt, rt = self.expr(e.left), self.expr(e.right)
+        if lt is None or rt is None:
+            return None
+        op = e.op
+        if op in ("+", "-"):
+            if T.is_numeric(lt) and T.is_numeric(rt):
+                return T.numeric_join(lt, rt)
+            if lt == rt == T.VECTOR:
+                return T.VECTOR
+            if op == "+" and lt == rt == T.GRAPHICAL:
+                return T.GRAPHICAL
+            if op == "+" and lt == rt == T.MOTION:
+                return T.MOTION
+            if op == "+" and lt == rt == T.MODEL:
+                self.err(e, "models are combined with JOINT, not +",
+                         "a :- JOINT id, a, (x, y, z), b, (x, y, z), (min, max), ...")
+                return None
+            self.err(e, f"cannot {'add' if op == '+' else 'subtract'} {T.NOUN[rt]} {'to' if op == '+' else 'from'} {T.NOUN[lt]}")
+            return None
+        if op == "*":
+            if T.is_numeric(lt) and T.is_numeric(rt):
+                return T.numeric_join(lt, rt)
+            if (T.is_numeric(lt) and rt == T.VECTOR) or (lt == T.VECTOR and T.is_numeric(rt)):
+                return T.VECTOR
+            if rt == T.MOTION:
+                if lt == T.INTEGER:
+                    return T.MOTION
+                if lt == T.REAL:
+                    self.err(e.left, "a repetition count must be an INTEGER, not a REAL",
+                             "write a whole number such as 3 * walk, or use NINT(...)")
+                    return None
+            if lt == T.MOTION and T.is_numeric(rt):
+                self.err(e, "the repetition count comes first: write n * motion")
+                return None
+            self.err(e, f"cannot multiply {T.NOUN[lt]} by {T.NOUN[rt]}")
+            return None
+        if op == "/":
+            if T.is_numeric(lt) and T.is_numeric(rt):
+                return T.REAL
+            if lt == T.VECTOR and T.is_numeric(rt):
+                return T.VECTOR
+            self.err(e, f"cannot divide {T.NOUN[lt]} by {T.NOUN[rt]}")
+            return None
+        if op == "MOD":
+            if T.is_numeric(lt) and T.is_numeric(rt):
+                return T.numeric_join(lt, rt)
+            self.err(e, "MOD works on numbers")
+            return None
+        raise AssertionError(op)
+
+    def _e_Call(self, e):
+        spec = T.BUILTINS.get(e.name)
+        ts = [self.expr(a) for a in e.args]
+        if spec is None:
+            hint = did_you_mean(e.name, T.BUILTINS)
+            self.err(e, f"{e.name} is not a function", hint or "the functions are " + ", ".join(sorted(T.BUILTINS)))
+            return None
+        params, result = spec
+        if len(params) != len(e.args):
+            self.err(e, f"{e.name} takes {len(params)} argument{'s' if len(params) != 1 else ''}, not {len(e.args)}")
+            return None
+        for a, t, p in zip(e.args, ts, params):
+            if t is None:
+                return None
+            if p == "N" and not T.is_numeric(t):
+                self.err(a, f"{e.name} needs a number here, not {T.NOUN[t]}")
+                return None
+            if p not in ("N",) and t != p:
+                self.err(a, f"{e.name} needs {T.NOUN[p]} here, not {T.NOUN[t]}")
+                return None
+        if result is None:
+            return T.numeric_join(*ts) if len(ts) == 2 else ts[0]
+        return result
+
+    def _e_Modified(self, e):
+        t = self.expr(e.target)
+        if t is None:
+            for m in e.modifiers:
+                self.expr(m.arg)
+            return None
+        allowed = {
+            T.GRAPHICAL: {"trans", "rot", "scale", "lightness"},
+            T.MODEL: {"trans", "rot", "scale", "trans_joints", "scale_model", "scale_extremes"},
+            T.MOTION: {"scale_frames", "scale_extremes"},
+        }.get(t, set())
+        for m in e.modifiers:
+            at = self.expr(m.arg)
+            label = _MOD_LABEL[m.kind]
+            if m.kind not in allowed:
+                target = {"trans_joints": "models", "scale_model": "models", "scale_frames": "motions",
+                          "scale_extremes": "models and motions", "lightness": "graphical objects"}.get(
+                    m.kind, "graphical objects and models")
+                self.err(m, f"{label} applies to {target}; this is {T.NOUN[t]}")
+                continue
+            if at is None:
+                continue
+            if m.kind == "trans":
+                if at != T.VECTOR:
+                    self.err(m.arg, f"TRANS needs a vector (x, y, z), not {T.NOUN[at]}")
+            elif m.kind == "trans_joints":
+                if at != T.INTEGER:
+                    self.err(m.arg, f"TRANS JOINTS needs an INTEGER, not {T.NOUN[at]}")
+            elif m.kind == "scale":
+                if at != T.VECTOR and not T.is_numeric(at):
+                    self.err(m.arg, f"SCALE needs a number or a vector, not {T.NOUN[at]}")
+            elif not T.is_numeric(at):
+                self.err(m.arg, f"{label} needs a number, not {T.NOUN[at]}")
+            c = _const(m.arg)
+            if c == 0 and m.kind in ("scale_frames", "scale_model", "scale"):
+                self.err(m.arg, f"{label} 0 would collapse it to nothing")
+        return t
+
+    def _e_PrimCall(self, e):
+        sig = self.signatures.get(e.name)
+        for c in e.clauses:
+            self.expr(c.value)
+        if sig is None:  # pragma: no cover - the lexer only makes PRIM_NAME for known names
+            self.err(e, f"{e.name} is not a primitive")
+            return None
+        for node, message, hint in sig.match(e):
+            self.err(node, message, hint)
+        for c in e.clauses:
+            ptype = sig.param_types.get(c.keyword)
+            t = self.types.get(id(c.value))
+            if t is None or ptype is None:
+                continue
+            if not T.fits(ptype, t):
+                self.err(c.value, f"{e.name} {c.keyword} needs {T.NOUN.get(ptype, ptype)}, not {T.NOUN[t]}",
+                         f"put the {e.name} call in parentheses to apply <...> or + to the whole object"
+                         if t == T.GRAPHICAL else None)
+        return T.GRAPHICAL
+
+    def _e_JointExpr(self, e):
+        self._joint_args(e.args, e, in_block=False)
+        return T.MODEL
+
+    def _e_Strip(self, e):
+        t = self.expr(e.motion)
+        if t is not None and t != T.MOTION:
+            self.err(e.motion, f"STRIP takes a MOTION first, not {T.NOUN[t]}")
+        for j in e.joints:
+            self._want(j, T.INTEGER, "a joint identifier")
+        return T.MOTION
+
+    def _e_Sync(self, e):
+        for m in e.motions:
+            t = self.expr(m)
+            if t is not None and t != T.MOTION:
+                self.err(m, f"SYNCHRONIZE takes MOTIONs, not {T.NOUN[t]}")
+        return T.MOTION
+
+    # --------------------------------------------------------- conditions
+    def cond(self, c):
+        if isinstance(c, A.BoolOp):
+            self.cond(c.left)
+            self.cond(c.right)
+        elif isinstance(c, A.Not):
+            self.cond(c.operand)
+        else:
+            lt, rt = self.expr(c.left), self.expr(c.right)
+            if lt is None or rt is None:
+                return
+            if c.op in ("=", "<>", "/=") and lt == rt == T.VECTOR:
+                return
+            if not (T.is_numeric(lt) and T.is_numeric(rt)):
+                self.err(c, f"cannot compare {T.NOUN[lt]} with {T.NOUN[rt]}",
+                         "comparisons work on numbers (and = or <> on vectors)")
+
+
+_MOD_LABEL = {
+    "trans_joints": "TRANS JOINTS", "trans": "TRANS", "rot": "ROT", "scale_model": "SCALE MODEL",
+    "scale_extremes": "SCALE EXTREMES", "scale_frames": "SCALE FRAMES", "scale": "SCALE", "lightness": "LIGHTNESS",
+}
+
+
+def _plain_name(e):
+    while isinstance(e, A.Modified):
+        e = e.target
+    return e.name if isinstance(e, A.Var) else None
+
+
+def _const(e):
+    if isinstance(e, A.Num):
+        return e.value
+    if isinstance(e, A.Neg) and isinstance(e.operand, A.Num):
+        return -e.operand.value
+    return None
+
+
+def _fmt(x) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def _names_used(node) -> set:
+    from liganimate.lang.structure import children
+
+    out = set()
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, (A.Var, A.Name)):
+            out.add(n.name)
+        stack.extend(children(n))
+    return out
+
+
+def check(program: A.Program) -> Checked:
+    """Check a parsed program; raise LigDiagnostics listing every error found."""
+    return Checker(program).run()

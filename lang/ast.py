@@ -1,0 +1,353 @@
+"""The typed syntax tree of a LIG ANIMATE program.
+
+Every node is a small dataclass with a :class:`Pos`; names are upper-cased
+(the language is case-insensitive) and numbers are already converted. The
+tree is produced by :mod:`liganimate.lang.transform` while the LALR parser
+runs, so building it never recurses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional, Union
+
+
+@dataclass(frozen=True, slots=True)
+class Pos:
+    """A source span: 1-based lines and columns, end exclusive."""
+
+    line: int
+    column: int
+    end_line: int
+    end_column: int
+
+    def to(self, other: "Pos") -> "Pos":
+        """The span from the start of ``self`` to the end of ``other``."""
+        return Pos(self.line, self.column, other.end_line, other.end_column)
+
+
+NOWHERE = Pos(0, 0, 0, 0)
+
+
+@dataclass(slots=True)
+class Node:
+    pos: Pos
+
+
+# --------------------------------------------------------------- expressions
+
+
+@dataclass(slots=True)
+class Num(Node):
+    value: Union[int, float]
+    text: str
+
+
+@dataclass(slots=True)
+class Var(Node):
+    name: str
+
+
+@dataclass(slots=True)
+class Call(Node):
+    name: str
+    args: list
+
+
+@dataclass(slots=True)
+class Tuple(Node):
+    items: list
+
+
+@dataclass(slots=True)
+class BinOp(Node):
+    op: str  # one of + - * / MOD
+    left: Node
+    right: Node
+    op_pos: Pos = NOWHERE
+
+
+@dataclass(slots=True)
+class Neg(Node):
+    operand: Node
+
+
+@dataclass(slots=True)
+class Modifier(Node):
+    """One entry of a ``< ... >`` list."""
+
+    kind: str  # trans_joints trans rot scale_model scale_extremes scale_frames scale lightness
+    arg: Node
+    axis: Optional[str] = None
+
+
+@dataclass(slots=True)
+class Modified(Node):
+    target: Node
+    modifiers: list
+
+
+@dataclass(slots=True)
+class Clause(Node):
+    keyword: str
+    value: Node
+
+
+@dataclass(slots=True)
+class PrimCall(Node):
+    name: str
+    clauses: list
+
+
+@dataclass(slots=True)
+class JointExpr(Node):
+    args: list
+
+
+@dataclass(slots=True)
+class Strip(Node):
+    motion: Node
+    joints: list
+
+
+@dataclass(slots=True)
+class Sync(Node):
+    motions: list
+
+
+@dataclass(slots=True)
+class Compare(Node):
+    op: str
+    left: Node
+    right: Node
+
+
+@dataclass(slots=True)
+class BoolOp(Node):
+    op: str  # AND / OR
+    left: Node
+    right: Node
+
+
+@dataclass(slots=True)
+class Not(Node):
+    operand: Node
+
+
+# ----------------------------------------------------------------- statements
+
+
+@dataclass(slots=True)
+class Name(Node):
+    """A name written in a statement (declared, assigned, animated...)."""
+
+    name: str
+
+
+@dataclass(slots=True)
+class Decl(Node):
+    type: str
+    names: list  # of Name
+
+
+@dataclass(slots=True)
+class Assign(Node):
+    target: Name
+    op: str  # = := :-
+    value: Node
+
+
+@dataclass(slots=True)
+class Keyframe(Node):
+    frame: Node
+    position: list  # 1 vector expression or 3 numbers
+    method: Optional[Name]
+
+
+@dataclass(slots=True)
+class KeyframeAssign(Node):
+    target: Name
+    joint: Node
+    index: Node
+    op: str
+    keyframe: Keyframe
+
+
+@dataclass(slots=True)
+class DoHeader(Node):
+    """``DO label var = a, b[, step]`` before loops are grouped."""
+
+    label: int
+    var: Name
+    start: Node
+    stop: Node
+    step: Optional[Node]
+
+
+@dataclass(slots=True)
+class Continue(Node):
+    label: int
+
+
+@dataclass(slots=True)
+class Do(Node):
+    label: int
+    var: Name
+    start: Node
+    stop: Node
+    step: Optional[Node]
+    body: list
+    end_pos: Pos = NOWHERE
+
+
+@dataclass(slots=True)
+class If(Node):
+    cond: Node
+    then: list
+    orelse: Optional[list]
+
+
+@dataclass(slots=True)
+class JointStmt(Node):
+    args: list
+
+
+@dataclass(slots=True)
+class ModelBlock(Node):
+    name: Name
+    joints: list  # of JointStmt
+
+
+@dataclass(slots=True)
+class MotionJoint(Node):
+    joint: Node
+    start: Optional[list]
+    keyframes: list
+
+
+@dataclass(slots=True)
+class MotionBlock(Node):
+    name: Name
+    joints: list  # of MotionJoint
+
+
+@dataclass(slots=True)
+class FigureStmt(Node):
+    model: Name
+    kind: Optional[str]  # None, LINK or JOINT
+    link: Optional[Name] = None
+    joint: Optional[Node] = None
+
+
+@dataclass(slots=True)
+class Scene(Node):
+    scene_id: Node
+    init: list
+    length: Node
+    sameframe: Optional[Node]
+    body: list
+    start_pos: Pos = NOWHERE
+
+
+@dataclass(slots=True)
+class Animate(Node):
+    model: Name
+    start: Node
+    end: Node
+    motion: Node
+    repeat: bool
+
+
+@dataclass(slots=True)
+class Background(Node):
+    items: list
+
+
+@dataclass(slots=True)
+class PrintItem(Node):
+    kind: str  # value, table, text
+    value: object  # Node for value, Name for table, str for text
+
+
+@dataclass(slots=True)
+class Print(Node):
+    items: list
+
+
+@dataclass(slots=True)
+class View(Node):
+    what: str  # POINT or WIDTH
+    value: Node
+
+
+@dataclass(slots=True)
+class Shoot(Node):
+    pass
+
+
+@dataclass(slots=True)
+class Stop(Node):
+    pass
+
+
+@dataclass(slots=True)
+class Return(Node):
+    pass
+
+
+@dataclass(slots=True)
+class ProgramEnd(Node):
+    pass
+
+
+@dataclass(slots=True)
+class DrawWith(Node):
+    modifiers: list
+
+
+@dataclass(slots=True)
+class DrawPoly(Node):
+    points: list
+
+
+@dataclass(slots=True)
+class Load(Node):
+    source: str
+    names: list  # of Name; empty means everything
+
+
+@dataclass(slots=True)
+class PatWord(Node):
+    word: str
+
+
+@dataclass(slots=True)
+class PatParam(Node):
+    name: str
+
+
+@dataclass(slots=True)
+class PatOptional(Node):
+    items: list
+    defaults: list  # of (Name, expr)
+
+
+@dataclass(slots=True)
+class PatternDef(Node):
+    name: str
+    items: list
+
+
+@dataclass(slots=True)
+class PrimitiveDef(Node):
+    name: Name
+    body: list
+    pattern: Optional[PatternDef] = None
+
+
+@dataclass(slots=True)
+class Program(Node):
+    filename: str
+    source: str
+    body: list
+    primitives: list = field(default_factory=list)

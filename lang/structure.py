@@ -1,0 +1,117 @@
+"""Block structure the grammar cannot express: DO loops closed by labels.
+
+``DO 10 I = 1, 5 ... 10 CONTINUE`` is FORTRAN's loop; the label ties the two
+together, which a context-free grammar cannot check, so the parser yields a
+flat :class:`~liganimate.lang.ast.DoHeader` and :class:`~liganimate.lang.ast.Continue`
+and :func:`group_blocks` nests them. It also refuses absurdly deep nesting
+before any recursive pass could overflow Python's stack.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from . import ast as A
+from .diagnostics import Diagnostic, LigDiagnostics
+
+#: Deeper syntax trees are refused with a diagnostic (no RecursionError may escape).
+MAX_DEPTH = 100
+
+_FIELDS: dict = {}
+
+
+def children(node):
+    """Child nodes of ``node`` (through lists and tuples), in source order."""
+    names = _FIELDS.get(type(node))
+    if names is None:
+        names = _FIELDS[type(node)] = [f.name for f in dataclasses.fields(node) if f.name != "pos"]
+    out = []
+    for name in names:
+        _collect(getattr(node, name), out)
+    return out
+
+
+def _collect(value, out):
+    if isinstance(value, A.Node):
+        out.append(value)
+    elif isinstance(value, (list, tuple)):
+        for item in value:
+            _collect(item, out)
+
+
+def check_depth(roots: list, source) -> None:
+    """Refuse trees deeper than MAX_DEPTH, iteratively, pointing at the deepest place."""
+    stack = [(node, 1) for node in roots]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise LigDiagnostics([Diagnostic(
+                source.filename, node.pos,
+                f"this is nested more than {MAX_DEPTH} levels deep",
+                "split it into several statements with variables in between",
+                source=source.text,
+            )])
+        for child in children(node):
+            stack.append((child, depth + 1))
+
+
+def group_blocks(body: list, source) -> list:
+    """Check nesting depth, then nest DO loops in every statement list."""
+    check_depth(body, source)
+    return _group_list(body, source)
+
+
+def _group_list(stmts: list, source) -> list:
+    out: list = []
+    open_dos: list = []  # (header, index in out where its body starts)
+    for stmt in stmts:
+        _group_inner(stmt, source)
+        if isinstance(stmt, A.DoHeader):
+            open_dos.append((stmt, len(out)))
+            continue
+        if isinstance(stmt, A.Continue):
+            if not any(h.label == stmt.label for h, _ in open_dos):
+                raise LigDiagnostics([Diagnostic(
+                    source.filename, stmt.pos,
+                    f"{stmt.label} CONTINUE closes no DO loop",
+                    f"a loop is opened with DO {stmt.label} var = first, last in the same block",
+                    source=source.text,
+                )])
+            # FORTRAN lets nested loops share one terminal label: close them all.
+            while open_dos and open_dos[-1][0].label == stmt.label:
+                header, start = open_dos.pop()
+                loop = A.Do(header.pos, header.label, header.var, header.start, header.stop, header.step,
+                            out[start:], stmt.pos)
+                del out[start:]
+                out.append(loop)
+            if open_dos and any(h.label == stmt.label for h, _ in open_dos):
+                inner = open_dos[-1][0]
+                raise LigDiagnostics([Diagnostic(
+                    source.filename, stmt.pos,
+                    f"{stmt.label} CONTINUE closes a DO loop while the inner DO {inner.label} is still open",
+                    f"close DO {inner.label} (line {inner.pos.line}) with {inner.label} CONTINUE first",
+                    source=source.text,
+                )])
+            continue
+        out.append(stmt)
+    if open_dos:
+        header = open_dos[0][0]
+        raise LigDiagnostics([Diagnostic(
+            source.filename, header.pos,
+            f"DO {header.label} is never closed by {header.label} CONTINUE",
+            f"add '{header.label} CONTINUE' after the last statement of the loop",
+            source=source.text,
+        )])
+    return out
+
+
+def _group_inner(stmt, source) -> None:
+    if isinstance(stmt, A.If):
+        stmt.then = _group_list(stmt.then, source)
+        if stmt.orelse is not None:
+            stmt.orelse = _group_list(stmt.orelse, source)
+    elif isinstance(stmt, A.Scene):
+        stmt.init = _group_list(stmt.init, source)
+        stmt.body = _group_list(stmt.body, source)
+    elif isinstance(stmt, A.PrimitiveDef):
+        stmt.body = _group_list(stmt.body, source)

@@ -1,0 +1,367 @@
+"""The Lark transformer: one method per grammar rule, producing :mod:`.ast` nodes.
+
+It runs inside the LALR parser (Lark's ``transformer=`` option), so the tree
+is built bottom-up in the parser's own loop, without recursion and without
+an intermediate parse tree.
+"""
+
+from __future__ import annotations
+
+from lark import Token, Transformer
+
+from . import ast as A
+
+_KEYWORDS_KEPT = frozenset()
+
+
+def _tpos(tok: Token) -> A.Pos:
+    return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column)
+
+
+def _pos_of(x) -> A.Pos | None:
+    if isinstance(x, Token):
+        return _tpos(x)
+    if isinstance(x, A.Node):
+        return x.pos
+    if isinstance(x, list):
+        for item in x:
+            p = _pos_of(item)
+            if p is not None:
+                return p
+    return None
+
+
+def _last_pos_of(x) -> A.Pos | None:
+    if isinstance(x, list):
+        for item in reversed(x):
+            p = _last_pos_of(item)
+            if p is not None:
+                return p
+        return None
+    return _pos_of(x)
+
+
+def span(children) -> A.Pos:
+    """The span covering all positioned children."""
+    first = _pos_of(children)
+    last = _last_pos_of(children)
+    if first is None:
+        return A.NOWHERE
+    return first.to(last)
+
+
+def _nodes(children):
+    """Children that are values (nodes or lists), dropping keyword tokens."""
+    return [c for c in children if not isinstance(c, Token)]
+
+
+def _name(tok: Token) -> A.Name:
+    return A.Name(_tpos(tok), tok.value.upper())
+
+
+def _number(tok: Token) -> A.Num:
+    text = tok.value.rstrip("°")
+    if any(ch in text for ch in ".eE"):
+        value = float(text)
+    else:
+        value = int(text)
+    return A.Num(_tpos(tok), value, tok.value)
+
+
+class ToAst(Transformer):
+    """Builds the syntax tree; method names are the grammar's rule names and aliases."""
+
+    # ------------------------------------------------------------ program
+    def start(self, children):
+        return [c for c in children if not isinstance(c, Token)]
+
+    def program_end(self, children):
+        return A.ProgramEnd(span(children))
+
+    # --------------------------------------------------------- statements
+    def declaration(self, children):
+        kw = children[0]
+        return A.Decl(span(children), kw.value.upper(), _nodes(children))
+
+    def decl_name(self, children):
+        return _name(children[0])
+
+    def assignment(self, children):
+        target, op, value = children
+        return A.Assign(span(children), _name(target), op.value, value)
+
+    def keyframe_assign(self, children):
+        target, joint, index, op, keyframe = children
+        return A.KeyframeAssign(span(children), _name(target), joint, index, op.value, keyframe)
+
+    def keyframe(self, children):
+        rest = _nodes(children)
+        frame, position = rest[0], rest[1]
+        method = rest[2] if len(rest) > 2 else None
+        return A.Keyframe(span(children), frame, position, method)
+
+    def position(self, children):
+        return list(children)
+
+    def interpolate(self, children):
+        return _name(children[1])
+
+    def do_stmt(self, children):
+        label = _number(children[1])
+        var = _name(children[2])
+        exprs = children[3:]
+        step = exprs[2] if len(exprs) > 2 else None
+        return A.DoHeader(span(children), label.value, var, exprs[0], exprs[1], step)
+
+    def continue_stmt(self, children):
+        label = _number(children[0])
+        return A.Continue(span(children), label.value)
+
+    def if_stmt(self, children):
+        cond = children[1]
+        branches = [c for c in children[3:] if not isinstance(c, Token)]
+        then = branches[0] if isinstance(branches[0], list) else [branches[0]]
+        orelse = None
+        if len(branches) > 1:
+            orelse = branches[1] if isinstance(branches[1], list) else [branches[1]]
+        return A.If(span(children), cond, then, orelse)
+
+    def block(self, children):
+        return _nodes(children)
+
+    def model_block(self, children):
+        return A.ModelBlock(span(children), _name(children[1]), _nodes(children[2:]))
+
+    def joint_stmt(self, children):
+        return A.JointStmt(span(children), children[1])
+
+    def motion_block(self, children):
+        return A.MotionBlock(span(children), _name(children[1]), _nodes(children[2:]))
+
+    def motion_joint(self, children):
+        joint = children[1]
+        start = None
+        keyframes = []
+        i = 2
+        while i < len(children):
+            c = children[i]
+            if isinstance(c, Token) and c.type == "POSITION":
+                start = children[i + 1]
+                i += 2
+                continue
+            if isinstance(c, A.Keyframe):
+                keyframes.append(c)
+            i += 1
+        return A.MotionJoint(span(children), joint, start, keyframes)
+
+    def figure_stmt(self, children):
+        model = _name(children[1])
+        if len(children) <= 3:
+            return A.FigureStmt(span(children), model, None)
+        kind = children[3].type
+        if kind == "LINK":
+            return A.FigureStmt(span(children), model, "LINK", link=_name(children[4]))
+        return A.FigureStmt(span(children), model, "JOINT", joint=children[4])
+
+    def scene_block(self, children):
+        at = next(i for i, c in enumerate(children) if isinstance(c, Token) and c.type == "STARTSCENE")
+        init = _nodes(children[3:at])
+        length = children[at + 2]
+        rest = at + 3
+        sameframe = None
+        if rest < len(children) and isinstance(children[rest], Token) and children[rest].type == "SAMEFRAME":
+            sameframe = children[rest + 1]
+            rest += 2
+        body = _nodes(children[rest:])
+        return A.Scene(span(children), children[2], init, length, sameframe, body, span(children[:3]))
+
+    def animate_stmt(self, children):
+        repeat = isinstance(children[-1], Token) and children[-1].type == "REPEAT"
+        return A.Animate(span(children), _name(children[1]), children[3], children[5], children[7], repeat)
+
+    def background_stmt(self, children):
+        return A.Background(span(children), _nodes(children))
+
+    def print_stmt(self, children):
+        items = []
+        for c in children[1:]:
+            if isinstance(c, A.PrintItem):
+                items.append(c)
+            else:
+                items.append(A.PrintItem(c.pos, "value", c))
+        return A.Print(span(children), items)
+
+    def print_table(self, children):
+        tok = children[0]
+        pos = _tpos(tok)
+        return A.PrintItem(pos, "table", A.Name(A.Pos(pos.line, pos.column + 1, pos.end_line, pos.end_column), tok.value[1:].upper()))
+
+    def print_text(self, children):
+        tok = children[0]
+        return A.PrintItem(_tpos(tok), "text", tok.value[1:-1])
+
+    def view_stmt(self, children):
+        return A.View(span(children), children[1].type.replace("_KW", ""), children[2])
+
+    def shoot_stmt(self, children):
+        return A.Shoot(span(children))
+
+    def stop_stmt(self, children):
+        return A.Stop(span(children))
+
+    def return_stmt(self, children):
+        return A.Return(span(children))
+
+    def load_stmt(self, children):
+        src = children[1]
+        text = src.value[1:-1] if src.type == "STRING" else src.value
+        return A.Load(span(children), text, _nodes(children[2:]))
+
+    def draw_with(self, children):
+        return A.DrawWith(span(children), children[2])
+
+    def draw_poly(self, children):
+        return A.DrawPoly(span(children), _nodes(children))
+
+    # --------------------------------------------------------- primitives
+    def primitive_def(self, children):
+        name = _name(children[1])
+        body, pattern = [], None
+        for c in children[2:]:
+            if isinstance(c, Token):
+                continue
+            if isinstance(c, A.PatternDef):
+                pattern = c if pattern is None else pattern
+                body.append(c)
+            else:
+                body.append(c)
+        return A.PrimitiveDef(span(children), name, body, pattern)
+
+    def pattern_def(self, children):
+        return A.PatternDef(span(children), children[0].value.upper(), children[1])
+
+    def pattern(self, children):
+        return list(children)
+
+    def pat_word(self, children):
+        tok = children[0]
+        return A.PatWord(_tpos(tok), tok.value[1:-1].strip().upper())
+
+    def pat_param(self, children):
+        tok = children[0]
+        return A.PatParam(_tpos(tok), tok.value.upper())
+
+    def pat_optional(self, children):
+        return A.PatOptional(span(children), children[0], list(children[1:]))
+
+    def pat_default(self, children):
+        return (_name(children[0]), children[1])
+
+    # -------------------------------------------------------- expressions
+    def joint_expr(self, children):
+        return A.JointExpr(span(children), children[1])
+
+    def joint_args(self, children):
+        return list(children)
+
+    def strip_expr(self, children):
+        return A.Strip(span(children), children[1], list(children[2:]))
+
+    def sync_expr(self, children):
+        return A.Sync(span(children), list(children[1:]))
+
+    def add(self, children):
+        left, right = children
+        return A.BinOp(span(children), "+", left, right)
+
+    def sub(self, children):
+        left, right = children
+        return A.BinOp(span(children), "-", left, right)
+
+    def mul(self, children):
+        left, right = children
+        return A.BinOp(span(children), "*", left, right)
+
+    def div(self, children):
+        left, op, right = children
+        return A.BinOp(span(children), "/", left, right, _tpos(op))
+
+    def mod(self, children):
+        left, op, right = children
+        return A.BinOp(span(children), "MOD", left, right, _tpos(op))
+
+    def neg(self, children):
+        (operand,) = children
+        return A.Neg(operand.pos, operand)
+
+    def modified(self, children):
+        target, mods = children
+        if isinstance(target, A.Modified):
+            return A.Modified(span(children), target.target, target.modifiers + mods)
+        return A.Modified(span(children), target, mods)
+
+    def number(self, children):
+        return _number(children[0])
+
+    def var(self, children):
+        tok = children[0]
+        return A.Var(_tpos(tok), tok.value.upper())
+
+    def call(self, children):
+        tok = children[0]
+        return A.Call(span(children), tok.value.upper(), list(children[1:]))
+
+    def tuple(self, children):
+        return A.Tuple(span(children), list(children))
+
+    def prim_call(self, children):
+        tok = children[0]
+        return A.PrimCall(span(children), tok.value.upper(), list(children[1:]))
+
+    def prim_clause(self, children):
+        tok, value = children
+        return A.Clause(span(children), tok.value.upper(), value)
+
+    def modlist(self, children):
+        return list(children)
+
+    def mod_trans_joints(self, children):
+        return A.Modifier(span(children), "trans_joints", children[-1])
+
+    def mod_trans(self, children):
+        return A.Modifier(span(children), "trans", children[1])
+
+    def mod_rot(self, children):
+        return A.Modifier(span(children), "rot", children[2], children[1].value.upper())
+
+    def mod_scale_model(self, children):
+        return A.Modifier(span(children), "scale_model", children[2])
+
+    def mod_scale_extremes(self, children):
+        return A.Modifier(span(children), "scale_extremes", children[2])
+
+    def mod_scale_frames(self, children):
+        return A.Modifier(span(children), "scale_frames", children[2])
+
+    def mod_scale(self, children):
+        return A.Modifier(span(children), "scale", children[1])
+
+    def mod_lightness(self, children):
+        return A.Modifier(span(children), "lightness", children[1])
+
+    # --------------------------------------------------------- conditions
+    def cond_or(self, children):
+        return A.BoolOp(span(children), "OR", children[0], children[2])
+
+    def cond_and(self, children):
+        return A.BoolOp(span(children), "AND", children[0], children[2])
+
+    def cond_not(self, children):
+        return A.Not(span(children), children[1])
+
+    def compare(self, children):
+        left, op, right = children
+        return A.Compare(span(children), op.value, left, right)
+
+    def cond_group(self, children):
+        return children[0]

@@ -1,0 +1,626 @@
+"""The runtime a compiled program calls: host operations, models, motions, scenes.
+
+A lowered module defines ``_main(rt)`` and hands it to :class:`Program`.
+Every operation that can fail takes ``at``, an index into the module's table
+of source positions, so a failure is reported at the statement that caused
+it. A program runs twice when rendered: once in *check* mode, which runs
+every statement and every scene tick without drawing, so that nothing is
+written unless the whole program is sound; then in *render* mode.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import sys
+from typing import Iterable
+
+import numpy as np
+
+from liganimate.lang.ast import Pos
+from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+
+from . import figure as F
+from . import motion as M
+from .errors import LigError
+from .values import EMPTY, ZERO, Canvas, Graphical, Vec, box
+
+_StopProgram = type("_StopProgram", (Exception,), {})
+
+
+class Posed:
+    """A model as ANIMATE hands it to the host for one tick: a figure, a motion and a frame."""
+
+    __slots__ = ("figure", "motion", "frame", "statement")
+
+    def __init__(self, figure: F.Figure, motion: M.Motion, frame: float, statement: int):
+        self.figure = figure
+        self.motion = motion
+        self.frame = frame
+        self.statement = statement
+
+    def with_figure(self, figure: F.Figure) -> "Posed":
+        """The same pose on a changed figure (placement, main link...)."""
+        return Posed(figure, self.motion, self.frame, self.statement)
+
+
+class KeyframeEdits:
+    """A motion being written keyframe by keyframe (``m[j, k] := FRAME ...``).
+
+    Edits are chained in O(1) and applied once, when the motion is first used,
+    so a DO loop writing n keyframes costs O(n), not O(n^2).
+    """
+
+    __slots__ = ("base", "edit", "parent", "_cache")
+
+    def __init__(self, base, edit, parent):
+        self.base = base
+        self.edit = edit
+        self.parent = parent
+        self._cache = None
+
+
+class Program:
+    """A compiled LIG ANIMATE program, ready to check, execute or render.
+
+    Parameters
+    ----------
+    name : str
+        The source file's name, used in diagnostics.
+    positions : tuple of (line, col, end_line, end_col)
+        Source positions referred to by the ``at`` arguments of the runtime.
+    main : callable
+        ``main(rt) -> dict`` runs the program and returns its variables.
+    source : str
+        The program text, for the source line shown under a diagnostic.
+    """
+
+    def __init__(self, name: str, positions, main, source: str = ""):
+        self.name = name
+        self.positions = positions
+        self.main = main
+        self.source = source
+
+    def execute(self, mode: str = "check", renderer=None, stdout=None) -> "Runtime":
+        """Run the program; return the runtime, whose ``variables`` hold its final values."""
+        rt = Runtime(self, mode, renderer, stdout)
+        try:
+            rt.variables = self.main(rt) or {}
+        except _StopProgram:
+            pass
+        return rt
+
+    def check(self) -> list:
+        """Run every statement and every scene tick without drawing; return the warnings."""
+        return self.execute("check", stdout=io.StringIO()).warnings
+
+    def render(self, out_dir: str, **options) -> "Runtime":
+        """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`)."""
+        from .render import Renderer
+
+        self.check()
+        renderer = Renderer(out_dir, **options)
+        try:
+            rt = self.execute("render", renderer=renderer, stdout=options.get("stdout"))
+            renderer.finish()
+        finally:
+            renderer.close()
+        return rt
+
+
+def main(program: Program, argv=None) -> int:
+    """``python compiled.py -o DIR``: render a compiled module (same options as ``liganimate run``)."""
+    from liganimate.cli import run_program_cli
+
+    return run_program_cli(program, argv)
+
+
+class Runtime:
+    """The ``rt`` object generated code calls."""
+
+    ZERO = ZERO
+    EMPTY = EMPTY
+    NO_MOTION = M.Motion.empty()
+
+    def __init__(self, program: Program, mode: str, renderer=None, stdout=None):
+        self.program = program
+        self.mode = mode
+        self.renderer = renderer
+        self.out = stdout if stdout is not None else sys.stdout
+        self.warnings: list = []
+        self._warned: set = set()
+        self.scenes: dict = {}
+        self.scene = None
+        self.view_point = Vec(0.0, 0.0, 10.0)
+        self.view_width = 10.0
+        self.variables: dict = {}
+        self._bind_cache: dict = {}
+
+    # ---------------------------------------------------------- diagnostics
+    def pos(self, at: int) -> Pos:
+        return Pos(*self.program.positions[at])
+
+    def fail(self, at: int, message: str, hint: str | None = None):
+        """Raise a diagnostic at the statement ``at``."""
+        raise LigDiagnostics([Diagnostic(self.program.name, self.pos(at), message, hint, source=self.program.source)])
+
+    def warn(self, at: int, message: str, hint: str | None = None) -> None:
+        key = (at, message)
+        if key in self._warned:
+            return
+        self._warned.add(key)
+        self.warnings.append(Diagnostic(self.program.name, self.pos(at), message, hint, "warning", self.program.source))
+
+    def _guard(self, at, fn, *args):
+        try:
+            return fn(*args)
+        except LigError as exc:
+            self.fail(at, _sentence(exc.message), exc.hint)
+
+    # ------------------------------------------------------------- numbers
+    @staticmethod
+    def vec(x, y, z) -> Vec:
+        return Vec(x, y, z)
+
+    def div(self, a, b, at):
+        if isinstance(b, Vec):
+            self.fail(at, "cannot divide by a vector")
+        if b == 0:
+            self.fail(at, "division by zero", "check the divisor's value before dividing")
+        if isinstance(a, Vec):
+            return Vec(a[0] / b, a[1] / b, a[2] / b)
+        return a / b
+
+    def mod(self, a, b, at):
+        if b == 0:
+            self.fail(at, "MOD by zero")
+        # Floored, so angles wrap into [0, 360) even when negative.
+        r = a - b * math.floor(a / b)
+        return int(r) if isinstance(a, int) and isinstance(b, int) else r
+
+    def do_range(self, start, stop, step, at):
+        if step == 0:
+            self.fail(at, "a DO loop's step cannot be 0")
+        if all(isinstance(v, int) for v in (start, stop, step)):
+            return range(start, stop + (1 if step > 0 else -1), step)
+        count = max(0, int(math.floor((stop - start + step) / step + 1e-9)))
+        return [start + i * step for i in range(count)]
+
+    def _math(self, at, name, fn, x):
+        try:
+            return fn(x)
+        except (ValueError, OverflowError):
+            self.fail(at, f"{name} of {x:g} is not defined")
+
+    def f_SIN(self, x, at):
+        return math.sin(math.radians(x))
+
+    def f_COS(self, x, at):
+        return math.cos(math.radians(x))
+
+    def f_TAN(self, x, at):
+        return math.tan(math.radians(x))
+
+    def f_ASIN(self, x, at):
+        return math.degrees(self._math(at, "ASIN", math.asin, x))
+
+    def f_ACOS(self, x, at):
+        return math.degrees(self._math(at, "ACOS", math.acos, x))
+
+    def f_ATAN(self, x, at):
+        return math.degrees(math.atan(x))
+
+    def f_ATAN2(self, y, x, at):
+        return math.degrees(math.atan2(y, x))
+
+    def f_SQRT(self, x, at):
+        return self._math(at, "SQRT", math.sqrt, x)
+
+    def f_EXP(self, x, at):
+        return self._math(at, "EXP", math.exp, x)
+
+    def f_LOG(self, x, at):
+        return self._math(at, "LOG", math.log, x)
+
+    def f_ABS(self, x, at):
+        return abs(x)
+
+    def f_INT(self, x, at):
+        return int(x)
+
+    def f_NINT(self, x, at):
+        return int(math.floor(x + 0.5))
+
+    def f_REAL(self, x, at):
+        return float(x)
+
+    f_FLOAT = f_REAL
+
+    def f_MIN(self, a, b, at):
+        return min(a, b)
+
+    def f_MAX(self, a, b, at):
+        return max(a, b)
+
+    def f_MOD(self, a, b, at):
+        return self.mod(a, b, at)
+
+    def f_DOT(self, a, b, at):
+        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+    def f_CROSS(self, a, b, at):
+        return Vec(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+    def f_NORM(self, a, at):
+        return a.norm()
+
+    def f_X(self, a, at):
+        return a[0]
+
+    def f_Y(self, a, at):
+        return a[1]
+
+    def f_Z(self, a, at):
+        return a[2]
+
+    def f_LEN(self, m, at):
+        return float(self._motion(m, at).length)
+
+    # ----------------------------------------------------------- graphics
+    @staticmethod
+    def canvas() -> Canvas:
+        return Canvas()
+
+    @staticmethod
+    def prim_BOX(rt, CENTRE=None, WIDTH=None, HEIGHT=None, DEPTH=None, LIGHT=None) -> Graphical:
+        return box(CENTRE if CENTRE is not None else ZERO, WIDTH or 0.0, HEIGHT or 0.0, DEPTH or 0.0,
+                   40.0 if LIGHT is None else LIGHT)
+
+    @staticmethod
+    def superpose(a: Graphical, b: Graphical) -> Graphical:
+        return a + b
+
+    def modify_graphical(self, g: Graphical, mods, at) -> Graphical:
+        for kind, arg, axis in mods:
+            if kind == "lightness":
+                g = g.with_lightness(arg)
+            else:
+                g = g.transformed(self._host_matrix(kind, arg, axis, at))
+        return g
+
+    def _host_matrix(self, kind, arg, axis, at) -> np.ndarray:
+        m = np.eye(4)
+        if kind == "trans":
+            m[:3, 3] = arg
+        elif kind == "rot":
+            c, s = math.cos(math.radians(arg)), math.sin(math.radians(arg))
+            i, j = {"X": (1, 2), "Y": (2, 0), "Z": (0, 1)}[axis]
+            m[i, i] = c
+            m[i, j] = -s
+            m[j, i] = s
+            m[j, j] = c
+        elif kind == "scale":
+            k = np.asarray(arg, dtype=np.float64) * np.ones(3)
+            if np.any(k == 0):
+                self.fail(at, "SCALE by 0 would collapse the object to nothing")
+            m[:3, :3] = np.diag(k)
+        return m
+
+    # -------------------------------------------------------------- models
+    def _model(self, m, at, what="a model"):
+        if m is None:
+            self.fail(at, f"{what} is used before it has a value", "assign it with :- JOINT or STARTMODEL first")
+        return m.figure if isinstance(m, Posed) else m
+
+    def _segment(self, value, name, at):
+        if isinstance(value, Posed):
+            return value.figure
+        if isinstance(value, F.Figure):
+            return value
+        if value is None:
+            self.fail(at, f"{name or 'a model'} is used before it has a value")
+        return F.Link(name, value)
+
+    def joint(self, jid, primary, loc1, secondary, loc2, extremes, names, at):
+        p = self._segment(primary, names[0], at)
+        s = self._segment(secondary, names[1], at)
+        return self._guard(at, F.join, jid, p, loc1, s, loc2, extremes)
+
+    def model_block(self, name, specs, at):
+        shapes = {}
+        out = []
+        for index, (jid, pname, pshape, loc1, sec, sname, loc2, exts, jat) in enumerate(specs):
+            shapes[pname] = pshape
+            if isinstance(sec, (F.Figure, Posed)):
+                secondary, sshape = self._segment(sec, sname, jat), None
+            else:
+                if sec is None:
+                    self.fail(jat, f"{sname or 'a segment'} is used before it has a value")
+                secondary, sshape = (sname if sname is not None else f"<segment of joint {jid}>"), sec
+            out.append(F.JointSpec(jid, pname, loc1, secondary, sshape, loc2, exts, index))
+        try:
+            figure, warnings = F.assemble(out, shapes)
+        except LigError as exc:
+            self.fail(at, _sentence(exc.message), exc.hint)
+        for index, sentence in warnings:
+            self.warn(specs[index][-1], _sentence(sentence))
+        return figure
+
+    def modify_model(self, m, mods, at):
+        posed = m if isinstance(m, Posed) else None
+        fig = self._model(m, at)
+        for kind, arg, axis in mods:
+            if kind == "trans_joints":
+                fig = self._guard(at, fig.trans_joints, arg)
+            elif kind == "scale_model":
+                fig = self._guard(at, fig.scale_model, arg)
+            elif kind == "scale_extremes":
+                fig = self._guard(at, fig.scale_extremes, arg)
+            else:
+                fig = fig.placed(self._host_matrix(kind, arg, axis, at))
+        return posed.with_figure(fig) if posed is not None else fig
+
+    def figure(self, m, kind, arg, at):
+        posed = m if isinstance(m, Posed) else None
+        fig = self._model(m, at)
+        if kind is None:
+            fig = fig.with_original_main()
+        elif kind == "JOINT":
+            fig = self._guard(at, fig.with_main_joint, arg)
+        else:
+            try:
+                fig, warning = fig.with_main_link(arg)
+            except LigError as exc:
+                self.fail(at, _sentence(exc.message), exc.hint)
+            if warning:
+                self.warn(at, _sentence(warning))
+        return posed.with_figure(fig) if posed is not None else fig
+
+    # ------------------------------------------------------------- motions
+    def _motion(self, m, at) -> M.Motion:
+        if isinstance(m, KeyframeEdits):
+            return self._apply_edits(m, at)
+        return m
+
+    def set_keyframe(self, m, joint, k, frame, position, method, at):
+        if k < 0:
+            self.fail(at, f"keyframe numbers start at 0 (the starting position), not {k}")
+        if frame < 0:
+            self.fail(at, f"frame {frame:g} is before the motion starts")
+        base = m.base if isinstance(m, KeyframeEdits) else m
+        return KeyframeEdits(base, (joint, k, frame, tuple(position), method, at), m if isinstance(m, KeyframeEdits) else None)
+
+    def _apply_edits(self, m: KeyframeEdits, at) -> M.Motion:
+        if m._cache is not None:
+            return m._cache
+        edits = []
+        node = m
+        while node is not None:
+            edits.append(node.edit)
+            node = node.parent
+        edits.reverse()
+        base = m.base
+        tracks: dict = {}
+        for j in base.joints:
+            start, kfs = self._guard(at, base.keyframes, j)
+            tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None) for i, kf in enumerate(kfs)}]
+        for joint, k, frame, position, method, eat in edits:
+            entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
+            if k == 0:
+                entry[0] = position
+            else:
+                entry[1][k] = (frame, position, method or "LINEAR", eat)
+        spec = {}
+        for joint, (start, kfs) in tracks.items():
+            n = max(kfs) if kfs else 0
+            missing = [i for i in range(1, n + 1) if i not in kfs]
+            if missing:
+                eat = kfs[n][3] if kfs[n][3] is not None else at
+                self.fail(eat, f"keyframe {n} of joint {joint} is set, but keyframe {missing[0]} never is",
+                          "number the keyframes of each joint 1, 2, 3, ... without gaps")
+            seq = [kfs[i] for i in range(1, n + 1)]
+            for i in range(1, len(seq)):
+                if seq[i][0] < seq[i - 1][0]:
+                    eat = seq[i][3] if seq[i][3] is not None else at
+                    self.fail(eat, f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
+                                   f"before keyframe {i} at frame {seq[i - 1][0]:g}")
+            spec[joint] = (start, [(f, p, meth) for f, p, meth, _ in seq])
+        motion = self._guard(at, M.Motion.from_tracks, spec)
+        m._cache = motion
+        return motion
+
+    def motion_block(self, joints, at):
+        spec = {}
+        for joint, start, kfs, jat in joints:
+            if joint in spec:
+                self.fail(jat, f"joint {joint} appears twice in this motion")
+            last = None
+            for frame, pos, method, kat in kfs:
+                if frame < 0:
+                    self.fail(kat, f"frame {frame:g} is before the motion starts")
+                if last is not None and frame < last:
+                    self.fail(kat, f"keyframes must be in ascending frame order: frame {frame:g} comes after frame {last:g}")
+                last = frame
+            spec[joint] = (tuple(start) if start is not None else (0.0, 0.0, 0.0),
+                           [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs])
+        return self._guard(at, M.Motion.from_tracks, spec)
+
+    def concat(self, a, b, at):
+        return self._guard(at, M.concat, self._motion(a, at), self._motion(b, at))
+
+    def repeat(self, n, m, at):
+        if n < 0:
+            self.fail(at, f"a repetition count cannot be negative ({n})")
+        return self._guard(at, M.repeat, n, self._motion(m, at))
+
+    def strip(self, m, joints, at):
+        return self._guard(at, M.strip, self._motion(m, at), joints)
+
+    def synchronize(self, motions, at):
+        return self._guard(at, M.synchronize, *[self._motion(m, at) for m in motions])
+
+    def modify_motion(self, m, mods, at):
+        m = self._motion(m, at)
+        for kind, arg, _ in mods:
+            if kind == "scale_frames":
+                m = self._guard(at, M.scale_frames, m, arg)
+            else:
+                m = self._guard(at, M.scale_extremes, m, arg)
+        return m
+
+    # -------------------------------------------------------------- scenes
+    def view(self, what, value, at):
+        if what == "POINT":
+            if Vec(*value).norm() == 0:
+                self.fail(at, "the VIEW POINT cannot be the origin: the camera looks at the origin")
+            target = "view_point"
+        else:
+            if not value > 0:
+                self.fail(at, f"the VIEW WIDTH must be positive, not {value:g}")
+            target = "view_width"
+            value = float(value)
+        if self.scene is not None:
+            setattr(self.scene, target, value)
+        else:
+            setattr(self, target, value)
+
+    def define_scene(self, scene_id, fn, snapshot, at):
+        if scene_id in self.scenes:
+            self.fail(at, f"scene {scene_id} is already defined at line {self.pos(self.scenes[scene_id][2]).line}")
+        self.scenes[scene_id] = (fn, snapshot, at)
+
+    def shoot(self, at):
+        for scene_id in sorted(self.scenes):
+            fn, snapshot, sat = self.scenes[scene_id]
+            self.scene = SceneState(scene_id, self.view_point, self.view_width, sat)
+            if self.renderer is not None:
+                self.renderer.begin_scene(scene_id)
+            try:
+                fn(snapshot)
+            finally:
+                if self.renderer is not None:
+                    self.renderer.end_scene()
+                self.scene = None
+        self.scenes = {}
+
+    def ticks(self, length, sameframe, at):
+        if length < 0:
+            self.fail(at, f"a scene's LENGTH cannot be negative ({length})")
+        if sameframe < 1:
+            self.fail(at, f"SAMEFRAME must be at least 1, not {sameframe}")
+        state = self.scene
+        state.length, state.sameframe = length, sameframe
+        for t in range(length):
+            state.tick = t
+            yield t
+
+    def animate(self, m, name, start, end, motion, repeat, at):
+        fig = self._model(m, at, name)
+        motion = self._motion(motion, at)
+        t = self.scene.tick
+        if t < start or t > end:
+            return fig
+        frame = float(t - start)
+        if repeat:
+            length = motion.length
+            frame = math.fmod(frame, length) if length > 0 else 0.0
+        if self.mode == "check":
+            self._bind(fig, motion, at)
+        return Posed(fig, motion, frame, at)
+
+    def _bind(self, fig: F.Figure, motion: M.Motion, at):
+        """Check (once per pair) that a motion suits a model; warn about joints it lacks."""
+        key = (id(fig.joints), id(motion))
+        if key in self._bind_cache:
+            return
+        self._bind_cache[key] = (fig, motion)
+        missing = [j for j in motion.joints if j not in set(fig.joint_ids)]
+        if missing:
+            self.warn(at, f"the motion drives joint{'s' if len(missing) > 1 else ''} "
+                          f"{', '.join(map(str, missing))}, which the model does not have")
+
+    def background(self, items, at):
+        out = []
+        for item in items:
+            if item is None:
+                self.fail(at, "a background object is used before it has a value")
+            out.append(item.figure if isinstance(item, Posed) else item)
+        if self.scene is not None:
+            self.scene.background = out
+
+    def end_tick(self, pairs):
+        state = self.scene
+        for name, value in pairs:
+            if isinstance(value, Posed):
+                state.drawn.append((name, value))
+        if self.renderer is not None:
+            self.renderer.add_tick(state, self)
+        state.drawn = []
+
+    def stop(self):
+        raise _StopProgram()
+
+    # --------------------------------------------------------------- PRINT
+    def print_items(self, items, at):
+        if self.mode == "check":
+            return
+        for kind, value, label in items:
+            self.out.write(self._print_one(kind, value, label, at) + "\n")
+
+    def _print_one(self, kind, value, label, at) -> str:
+        if kind == "text":
+            return value
+        if kind == "MODEL":
+            return self._model(value, at, label).describe_tree(label)
+        if kind == "table":
+            fig = self._model(value, at, label)
+            if isinstance(value, Posed):
+                from .pose import joint_angles
+
+                angles, vel, acc = joint_angles(fig, value.motion, np.array([value.frame]), full=True)
+                return f"MODEL {label} at frame {value.frame:g}\n" + fig.describe_table(angles[0], vel[0], acc[0])
+            return f"MODEL {label}\n" + fig.describe_table()
+        if kind == "MOTION":
+            motion = self._motion(value, at)
+            lines = [f"MOTION {label}: length {motion.length:g} frames, joints {', '.join(map(str, motion.joints)) or 'none'}"]
+            try:
+                for j in motion.joints:
+                    start, kfs = motion.keyframes(j, limit=1000)
+                    lines.append(f"  JOINT {j} POSITION {_fmt_vec(start)}")
+                    for frame, val, method in kfs:
+                        lines.append(f"    FRAME {frame:g} POSITION {_fmt_vec(val)} INTERPOLATE {method}")
+            except LigError:
+                lines.append("  " + motion.describe())
+            return "\n".join(lines)
+        if kind == "GRAPHICAL":
+            return f"{label} = GRAPHICAL object of {len(value)} triangles"
+        if isinstance(value, float):
+            return f"{label} = {value:.6g}"
+        return f"{label} = {value!r}"
+
+
+class SceneState:
+    """One scene while it is being shot: its camera, background and this tick's drawings."""
+
+    def __init__(self, scene_id, view_point, view_width, at):
+        self.id = scene_id
+        self.view_point = view_point
+        self.view_width = view_width
+        self.background: list = []
+        self.drawn: list = []
+        self.tick = 0
+        self.length = 0
+        self.sameframe = 1
+        self.at = at
+
+
+def _fmt_vec(v) -> str:
+    return ", ".join(f"{float(x):g}" for x in v)
+
+
+def _sentence(message: str) -> str:
+    """Runtime libraries write sentences; diagnostics print them without the final period."""
+    message = message.strip()
+    if message.endswith(".") and not message.endswith(".."):
+        message = message[:-1]
+    return message[:1].lower() + message[1:] if message[:2] != message[:2].upper() else message

@@ -1,0 +1,178 @@
+"""Applying motions to models: joint angles, link transforms and world triangles, batched.
+
+Everything here works on whole batches of frames at once (numpy over the
+frame axis); the only Python loops are over joints or tree levels, never
+over frames.
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from . import figure as F
+from . import kinematics as K
+from .motion import Motion
+from .values import Graphical, grey_levels
+
+# (id(motion), id(joints)) -> (motion, joints, bound); the stored objects keep
+# the ids valid. Bounded so a long program cannot grow it without limit.
+_bound: dict = {}
+_BOUND_MAX = 512
+
+
+def _bound_motion(fig: F.Figure, motion: Motion) -> Motion:
+    """The motion with free (full-turn) axes unwrapped, cached per (model, motion)."""
+    key = (id(motion), id(fig.joints))
+    hit = _bound.get(key)
+    if hit is not None:
+        return hit[2]
+    free = {j: axes for j, axes in K.free_axes(fig).items() if any(axes) and j in set(motion.joints)}
+    bound = motion.unwrapped(free) if free else motion
+    if len(_bound) >= _BOUND_MAX:
+        _bound.clear()
+    _bound[key] = (motion, fig.joints, bound)
+    return bound
+
+
+def joint_angles(fig: F.Figure, motion: Motion, frames: np.ndarray, full: bool = False):
+    """Clamped joint angles of ``fig`` driven by ``motion``.
+
+    Parameters
+    ----------
+    fig : Figure
+    motion : Motion
+    frames : ndarray, shape (T,)
+        Motion frames (may be fractional).
+    full : bool
+        Also return velocity and acceleration (deg/frame, deg/frame^2).
+
+    Returns
+    -------
+    ndarray, shape (T, J, 3)
+        In the figure's joint order; joints the motion does not drive sit at
+        neutral (0, 0, 0), clamped into their extremes like every other angle.
+        With ``full``, a tuple (angles, velocity, acceleration).
+    """
+    frames = np.asarray(frames, dtype=np.float64).reshape(-1)
+    ids = fig.joint_ids
+    driven = [j for j in ids if j in set(motion.joints)]
+    angles = np.zeros((len(frames), len(ids), 3))
+    vel = np.zeros_like(angles)
+    acc = np.zeros_like(angles)
+    if driven:
+        bound = _bound_motion(fig, motion)
+        cols = [fig.joint_index(j) for j in driven]
+        if full:
+            a, v, c = bound.evaluate_full(frames, driven)
+            angles[:, cols], vel[:, cols], acc[:, cols] = a, v, c
+        else:
+            angles[:, cols] = bound.evaluate(frames, driven)
+    clamped = K.clamp(fig, angles)
+    if full:
+        # A clamped axis is held by its stop: it neither moves nor accelerates.
+        held = clamped != angles
+        held &= ~np.isclose(clamped, angles)
+        vel[held] = 0.0
+        acc[held] = 0.0
+        return clamped, vel, acc
+    return clamped
+
+
+class MeshTable:
+    """A model's link shapes concatenated once: triangles in link coordinates.
+
+    Attributes
+    ----------
+    triangles : ndarray, shape (M, 3, 3)
+    link : ndarray of int, shape (M,)
+    grey : ndarray of uint8, shape (M,)
+    closed : ndarray of bool, shape (M,)
+    """
+
+    def __init__(self, fig: F.Figure):
+        tris, link, light, closed = [], [], [], []
+        for i, l in enumerate(fig.links):
+            g = l.shape
+            if not isinstance(g, Graphical) or len(g) == 0:
+                continue
+            t = g.triangles
+            c = g.closed
+            if l.scale < 0:
+                # A mirrored link flips its triangles' winding.
+                t = t[:, ::-1, :]
+            tris.append(t)
+            link.append(np.full(len(g), i))
+            light.append(g.lightness)
+            closed.append(c)
+        if tris:
+            self.triangles = np.concatenate(tris)
+            self.link = np.concatenate(link)
+            self.grey = grey_levels(np.concatenate(light))
+            self.closed = np.concatenate(closed)
+        else:
+            self.triangles = np.zeros((0, 3, 3))
+            self.link = np.zeros(0, dtype=int)
+            self.grey = np.zeros(0, dtype=np.uint8)
+            self.closed = np.zeros(0, dtype=bool)
+
+
+_meshes: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def mesh_table(fig: F.Figure) -> MeshTable:
+    """The cached :class:`MeshTable` of a figure's links (shared by figures with the same links)."""
+    key = fig.links[0]
+    entry = _meshes.get(key)
+    if entry is not None and entry[0] is fig.links:
+        return entry[1]
+    table = MeshTable(fig)
+    _meshes[key] = (fig.links, table)
+    return table
+
+
+def world_transforms(fig: F.Figure, angles: np.ndarray, placements: np.ndarray) -> np.ndarray:
+    """Each link's shape-to-world transform.
+
+    Parameters
+    ----------
+    fig : Figure
+    angles : ndarray, shape (T, J, 3)
+        Clamped angles.
+    placements : ndarray, shape (T, 4, 4)
+        Per-frame host placement of the current main link.
+
+    Returns
+    -------
+    ndarray, shape (T, n_links, 4, 4)
+        ``placement @ pose @ diag(s, s, s, 1)``.
+    """
+    X = K.pose_transforms(fig, angles)
+    X = placements[:, None] @ X
+    s = fig.link_scales
+    X[..., :3, :3] *= s[None, :, None, None]
+    return X
+
+
+def world_triangles(table: MeshTable, X: np.ndarray) -> np.ndarray:
+    """Triangles in world coordinates, shape (T, M, 3, 3), from link transforms X (T, L, 4, 4)."""
+    if len(table.triangles) == 0:
+        return np.zeros((X.shape[0], 0, 3, 3))
+    R = X[:, table.link, :3, :3]  # (T, M, 3, 3)
+    t = X[:, table.link][..., :3, 3]  # (T, M, 3)
+    return np.einsum("tmij,mkj->tmki", R, table.triangles, optimize=True) + t[:, :, None, :]
+
+
+def static_triangles(fig: F.Figure):
+    """A model drawn as a background object: neutral pose at its placement.
+
+    Returns
+    -------
+    (triangles (M, 3, 3), grey (M,), closed (M,))
+    """
+    J = fig.n_joints
+    angles = K.clamp(fig, np.zeros((1, J, 3)))
+    X = world_transforms(fig, angles, np.asarray(fig.placement)[None])
+    table = mesh_table(fig)
+    return world_triangles(table, X)[0], table.grey, table.closed & (np.linalg.det(np.asarray(fig.placement)[:3, :3]) > 0)

@@ -1,0 +1,194 @@
+"""Host values: 3-vectors and graphical objects.
+
+A :class:`Graphical` is an immutable set of flat-shaded triangles in its own
+coordinates, each with a LIGHTNESS (0 black .. 100 white) and a flag saying
+whether it belongs to a closed, outward-wound solid (so the rasterizer may
+cull it when it faces away).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import LigError
+
+
+class Vec(tuple):
+    """An immutable 3-vector with the arithmetic LIG programs use."""
+
+    __slots__ = ()
+
+    def __new__(cls, x, y, z):
+        return tuple.__new__(cls, (float(x), float(y), float(z)))
+
+    def __add__(self, o):
+        return Vec(self[0] + o[0], self[1] + o[1], self[2] + o[2])
+
+    def __sub__(self, o):
+        return Vec(self[0] - o[0], self[1] - o[1], self[2] - o[2])
+
+    def __mul__(self, k):
+        return Vec(self[0] * k, self[1] * k, self[2] * k)
+
+    __rmul__ = __mul__
+
+    def __neg__(self):
+        return Vec(-self[0], -self[1], -self[2])
+
+    def __repr__(self):
+        return f"({_num(self[0])}, {_num(self[1])}, {_num(self[2])})"
+
+    def norm(self) -> float:
+        """Euclidean length."""
+        return math.sqrt(self[0] ** 2 + self[1] ** 2 + self[2] ** 2)
+
+
+def _num(x: float) -> str:
+    return f"{x:.6g}"
+
+
+ZERO = Vec(0.0, 0.0, 0.0)
+
+
+class Graphical:
+    """Triangles with lightness, in object coordinates.
+
+    Parameters
+    ----------
+    triangles : ndarray, shape (N, 3, 3)
+    lightness : ndarray, shape (N,)
+    closed : ndarray of bool, shape (N,)
+        True where the triangle is part of a closed solid wound
+        counter-clockwise seen from outside.
+    """
+
+    __slots__ = ("triangles", "lightness", "closed")
+
+    def __init__(self, triangles, lightness, closed):
+        self.triangles = np.ascontiguousarray(triangles, dtype=np.float64).reshape(-1, 3, 3)
+        self.lightness = np.asarray(lightness, dtype=np.float64).reshape(-1)
+        self.closed = np.asarray(closed, dtype=bool).reshape(-1)
+
+    def __len__(self):
+        return len(self.triangles)
+
+    def __add__(self, other: "Graphical") -> "Graphical":
+        return Graphical(
+            np.concatenate([self.triangles, other.triangles]),
+            np.concatenate([self.lightness, other.lightness]),
+            np.concatenate([self.closed, other.closed]),
+        )
+
+    def transformed(self, matrix) -> "Graphical":
+        """Apply a 4x4 affine transform; a mirror keeps the solids wound outward."""
+        m = np.asarray(matrix, dtype=np.float64)
+        tris = self.triangles @ m[:3, :3].T + m[:3, 3]
+        if np.linalg.det(m[:3, :3]) < 0:
+            tris = tris[:, ::-1, :]
+        return Graphical(tris, self.lightness, self.closed)
+
+    def with_lightness(self, lightness: float) -> "Graphical":
+        """Every triangle at one lightness."""
+        return Graphical(self.triangles, np.full(len(self), float(lightness)), self.closed)
+
+
+EMPTY = Graphical(np.zeros((0, 3, 3)), np.zeros(0), np.zeros(0, dtype=bool))
+
+
+def grey_levels(lightness) -> np.ndarray:
+    """LIGHTNESS (0..100, clipped) to 8-bit grey levels, rounding half up."""
+    l = np.clip(np.asarray(lightness, dtype=np.float64), 0.0, 100.0)
+    return np.floor(l * 2.55 + 0.5).astype(np.uint8)
+
+
+class Canvas:
+    """What a PRIMITIVE draws into: DRAW WITH <LIGHTNESS l> and DRAW POLY."""
+
+    def __init__(self):
+        self.polys: list = []
+        self.light = 40.0
+
+    def lightness(self, value) -> None:
+        """Set the lightness of the polygons drawn next."""
+        self.light = float(value)
+
+    def poly(self, points, at=None) -> None:
+        """Add a polygon; a closing point equal to the first is dropped."""
+        pts = [tuple(p) for p in points]
+        if len(pts) > 1 and pts[-1] == pts[0]:
+            pts = pts[:-1]
+        if len(pts) < 3:
+            raise LigError(f"a polygon needs at least three corners; this one has {len(pts)}")
+        self.polys.append((np.asarray(pts, dtype=np.float64), self.light))
+
+    def result(self) -> Graphical:
+        """The drawn polygons as one Graphical (fan-triangulated, solids detected)."""
+        return polygons_to_graphical(self.polys)
+
+
+def polygons_to_graphical(polys) -> Graphical:
+    """Fan-triangulate convex polygons; mark the set closed if it is a closed oriented surface."""
+    if not polys:
+        return EMPTY
+    tris, light = [], []
+    for pts, l in polys:
+        for k in range(1, len(pts) - 1):
+            tris.append((pts[0], pts[k], pts[k + 1]))
+            light.append(l)
+    tris = np.asarray(tris, dtype=np.float64)
+    closed = _closed_orientation(polys)
+    if closed == 0:
+        return Graphical(tris, light, np.zeros(len(tris), dtype=bool))
+    if closed < 0:
+        tris = tris[:, ::-1, :]
+    return Graphical(tris, light, np.ones(len(tris), dtype=bool))
+
+
+def _closed_orientation(polys) -> int:
+    """+1 if the polygons form a closed surface wound outward, -1 if inward, 0 if not closed/consistent."""
+    edges = {}
+    for pts, _ in polys:
+        keyed = [tuple(np.round(p, 9)) for p in pts]
+        for a, b in zip(keyed, keyed[1:] + keyed[:1]):
+            edges[(a, b)] = edges.get((a, b), 0) + 1
+    for (a, b), n in edges.items():
+        if n != 1 or edges.get((b, a), 0) != 1:
+            return 0
+    vol = 0.0
+    for pts, _ in polys:
+        for k in range(1, len(pts) - 1):
+            vol += float(np.dot(pts[0], np.cross(pts[k], pts[k + 1])))
+    if vol > 0:
+        return 1
+    if vol < 0:
+        return -1
+    return 0
+
+
+def box(centre, width, height, depth, light) -> Graphical:
+    """The built-in BOX: exactly the polygons of the thesis' Appendix A PRIMITIVE BOX."""
+    c = np.asarray(centre, dtype=np.float64)
+    w, h, d = float(width), float(height), float(depth)
+    l1, l2 = float(light), float(light) * 1.5
+    ftr = c + (w / 2, h / 2, d / 2)
+    ftl = ftr - (w, 0, 0)
+    fbl = ftl - (0, h, 0)
+    fbr = ftr - (0, h, 0)
+    btr = ftr - (0, 0, d)
+    btl = btr - (w, 0, 0)
+    bbl = btl - (0, h, 0)
+    bbr = btr - (0, h, 0)
+    # Appendix A's faces and lightnesses; three of its faces are listed
+    # inward, so they are reversed here to make a closed solid the rasterizer
+    # may back-face cull (the picture is the same either way).
+    polys = [
+        (np.array([bbr, bbl, btl, btr]), l1),  # back
+        (np.array([ftr, btr, btl, ftl]), l2),  # top
+        (np.array([fbl, bbl, bbr, fbr]), l2),  # bottom
+        (np.array([ftl, btl, bbl, fbl]), l2),  # left
+        (np.array([fbr, bbr, btr, ftr]), l2),  # right
+        (np.array([ftr, ftl, fbl, fbr]), l1),  # front
+    ]
+    return polygons_to_graphical(polys)

@@ -1,0 +1,7 @@
+"""``python -m liganimate``."""
+
+import sys
+
+from liganimate.cli import main
+
+sys.exit(main())

@@ -1,0 +1,189 @@
+"""The ``liganimate`` command: run, check, compile and plot LIG ANIMATE programs.
+
+Every user error is printed as a diagnostic (``file:line:col``, the line, a
+caret, a sentence, a hint) and the command exits with status 1; no Python
+traceback reaches the user, and nothing is written when a program is wrong.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from liganimate import __version__
+
+EXIT_USER_ERROR = 1
+EXIT_INTERNAL = 3
+
+
+def _print_diagnostics(diags, stream=None) -> None:
+    from liganimate.lang.diagnostics import format_diagnostic
+
+    stream = stream or sys.stderr
+    for d in diags:
+        stream.write(format_diagnostic(d) + "\n")
+
+
+def _size(text: str):
+    try:
+        w, h = text.lower().split("x")
+        w, h = int(w), int(h)
+        if w <= 0 or h <= 0 or w > 16384 or h > 16384:
+            raise ValueError
+        return w, h
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a size like 640x480") from None
+
+
+def load_program(path: str):
+    """Compile a .lig file in memory (the same lowering ``compile`` writes) and return (program, warnings)."""
+    from liganimate.compiler import compile_file
+
+    compiled = compile_file(path)
+    namespace = {"__name__": "liganimate_program", "__file__": path}
+    code = compile(compiled.python, f"<liganimate {path}>", "exec")
+    exec(code, namespace)
+    return namespace["program"], compiled.warnings
+
+
+def _add_render_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("-o", "--out", metavar="DIR", help="folder for the frames (default: <stem>_frames)")
+    p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="image size (default 640x480)")
+    p.add_argument("--gif", metavar="FILE", help="also write an animated GIF")
+    p.add_argument("--mp4", metavar="FILE", help="also write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)")
+    p.add_argument("--poses", metavar="FILE", help="write the pose record (JSON Lines, see docs/poses.md)")
+    p.add_argument("--fps", type=float, default=24.0, help="frame rate of the GIF and MP4 (default 24)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def _render(program, warnings, args, stem: str) -> int:
+    out = args.out or f"{stem}_frames"
+    _print_diagnostics(warnings)
+    warnings_run = program.check()
+    _print_diagnostics(warnings_run)
+    program.render(out, size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps,
+                   quiet=args.quiet)
+    if not args.quiet:
+        sys.stderr.write(f"frames written to {out}\n")
+    return 0
+
+
+def _guarded(fn):
+    """Run a command, turning diagnostics into exit status 1 and bugs into a short report."""
+    from liganimate.lang.diagnostics import LigDiagnostics
+    from liganimate.runtime.errors import LigError
+
+    try:
+        return fn()
+    except LigDiagnostics as exc:
+        _print_diagnostics(exc.diagnostics)
+        return EXIT_USER_ERROR
+    except LigError as exc:
+        sys.stderr.write(f"liganimate: error: {exc.message}\n")
+        if exc.hint:
+            sys.stderr.write(f"  hint: {exc.hint}\n")
+        return EXIT_USER_ERROR
+    except OSError as exc:
+        sys.stderr.write(f"liganimate: error: {exc.strerror or exc}: {exc.filename or ''}\n")
+        return EXIT_USER_ERROR
+    except KeyboardInterrupt:
+        sys.stderr.write("\nliganimate: interrupted; every file already written is complete\n")
+        return 130
+    except RecursionError:
+        sys.stderr.write("liganimate: error: the program is nested too deeply to compile\n")
+        return EXIT_USER_ERROR
+    except Exception as exc:  # noqa: BLE001 - the user must never see a traceback
+        sys.stderr.write(f"liganimate: internal error: {type(exc).__name__}: {exc}\n"
+                         "  please report this with the program that caused it\n")
+        if os.environ.get("LIGANIMATE_DEBUG"):
+            raise
+        return EXIT_INTERNAL
+
+
+def cmd_run(args) -> int:
+    def go():
+        program, warnings = load_program(args.file)
+        stem = os.path.splitext(os.path.basename(args.file))[0]
+        return _render(program, warnings, args, stem)
+
+    return _guarded(go)
+
+
+def cmd_check(args) -> int:
+    def go():
+        program, warnings = load_program(args.file)
+        _print_diagnostics(warnings)
+        _print_diagnostics(program.check())
+        return 0
+
+    return _guarded(go)
+
+
+def cmd_compile(args) -> int:
+    def go():
+        from liganimate.compiler import compile_file
+        from liganimate.runtime.imagefiles import _atomic
+
+        compiled = compile_file(args.file)
+        _print_diagnostics(compiled.warnings)
+        out = args.output or os.path.splitext(os.path.basename(args.file))[0] + ".py"
+        with _atomic(out, True) as fh:
+            fh.write(compiled.python.encode("utf-8"))
+        return 0
+
+    return _guarded(go)
+
+
+def cmd_plot(args) -> int:
+    def go():
+        from liganimate.runtime.plot import plot_motion
+
+        program, warnings = load_program(args.file)
+        _print_diagnostics(warnings)
+        rt = program.execute("check")
+        name = args.motion.upper()
+        out = args.output or f"{name.lower()}.png"
+        plot_motion(rt, name, out)
+        return 0
+
+    return _guarded(go)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``liganimate`` command."""
+    parser = argparse.ArgumentParser(prog="liganimate", description="LIG ANIMATE: model and animate articulated figures.")
+    parser.add_argument("--version", action="version", version=f"liganimate {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("run", help="compile a program and render its scenes")
+    p.add_argument("file")
+    _add_render_options(p)
+    p.set_defaults(func=cmd_run)
+    p = sub.add_parser("check", help="run every check without rendering")
+    p.add_argument("file")
+    p.set_defaults(func=cmd_check)
+    p = sub.add_parser("compile", help="write the program as a standalone Python module")
+    p.add_argument("file")
+    p.add_argument("-o", "--output", metavar="FILE.py")
+    p.set_defaults(func=cmd_compile)
+    p = sub.add_parser("plot", help="draw a motion's joint angle curves with matplotlib")
+    p.add_argument("file")
+    p.add_argument("motion")
+    p.add_argument("-o", "--output", metavar="FILE.png")
+    p.set_defaults(func=cmd_plot)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``liganimate`` command."""
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+def run_program_cli(program, argv=None) -> int:
+    """``python compiled.py [-o DIR] ...``: render a compiled module."""
+    parser = argparse.ArgumentParser(prog=os.path.basename(sys.argv[0]), description=f"Render {program.name}.")
+    _add_render_options(parser)
+    args = parser.parse_args(argv)
+    stem = os.path.splitext(os.path.basename(program.name))[0]
+    return _guarded(lambda: _render(program, [], args, stem))
