@@ -292,7 +292,8 @@ class Lowerer:
         self.emit(f"rt.shoot({self.at(s)})")
 
     def s_Stop(self, s, where):
-        self.emit("rt.stop()")
+        # In the main program, hand the variables over so Python users see them.
+        self.emit("rt.stop(locals())" if where == "main" and getattr(self, "scope_types", None) is None else "rt.stop(None)")
 
     def s_Return(self, s, where):
         self.emit("return _g.result()")

@@ -87,7 +87,8 @@ class Program:
         try:
             rt.variables = self.main(rt) or {}
         except _StopProgram:
-            pass
+            pass  # STOP handed over its variables
+
         return rt
 
     def check(self) -> list:
@@ -557,7 +558,9 @@ class Runtime:
             self.renderer.add_tick(state, self)
         state.drawn = []
 
-    def stop(self):
+    def stop(self, variables=None):
+        if variables is not None:
+            self.variables = variables
         raise _StopProgram()
 
     # --------------------------------------------------------------- PRINT

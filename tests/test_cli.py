@@ -1,0 +1,99 @@
+"""The command line as a user meets it: exit codes, files, no tracebacks."""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from liganimate.compiler import compile_file
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+EXAMPLES = ROOT / "examples"
+GOLDEN_COMPILE = ROOT / "tests" / "golden" / "compile"
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "liganimate", *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_run_appendix_a_writes_one_image_and_poses(tmp_path):
+    r = run("run", str(EXAMPLES / "appendix_a.lig"), "--size", "160x120", "--poses", "p.jsonl", "--quiet", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in (tmp_path / "appendix_a_frames" / "scene1").iterdir()) == ["00000.png"]
+    records = [json.loads(line) for line in (tmp_path / "p.jsonl").read_text().splitlines()]
+    assert [rec["tick"] for rec in records] == [0, 1, 2, 3, 4, 5]
+    assert {rec["image"] for rec in records} == {0}
+    # The main link is a FOOT: its matrix differs between ticks only by the host's TRANS.
+    feet = [next(s for s in rec["segments"] if s["link"] == "FOOT" and s["joint"] == 4) for rec in records]
+    xs = [f["matrix"][3] for f in feet]
+    assert xs == pytest.approx([-3.0 + 1.2 * t for t in range(6)])
+    assert all(f["matrix"][7] == pytest.approx(0.0) for f in feet)
+    torso_y = [next(s for s in rec["segments"] if s["link"] == "TORSO")["matrix"][7] for rec in records]
+    assert all(b < a for a, b in zip(torso_y, torso_y[1:])), "the torso sinks during the squat"
+
+
+def test_bad_program_exits_1_with_a_diagnostic_and_writes_nothing(tmp_path):
+    bad = tmp_path / "bad.lig"
+    bad.write_text("MODEL M\nMOTION W\nX = 1 / 0\nSHOOTSCENES\n")
+    r = run("run", str(bad), "--poses", "p.jsonl", cwd=tmp_path)
+    assert r.returncode == 1
+    assert "Traceback" not in r.stderr
+    assert f"{bad}:3:7: error: division by zero" in r.stderr
+    assert "    X = 1 / 0" in r.stderr and "      ^" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.lig"]
+
+
+def test_check_runs_scenes_without_rendering(tmp_path):
+    r = run("check", str(EXAMPLES / "appendix_a.lig"), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "warning: 2 links are named FOOT" in r.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_compiled_module_renders_like_run(tmp_path):
+    r = run("compile", str(EXAMPLES / "appendix_a.lig"), "-o", "appendix.py", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    p = subprocess.run([sys.executable, "appendix.py", "-o", "mod", "--size", "160x120", "--quiet"],
+                       capture_output=True, text=True, cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    r2 = run("run", str(EXAMPLES / "appendix_a.lig"), "-o", "cli", "--size", "160x120", "--quiet", cwd=tmp_path)
+    assert r2.returncode == 0
+    assert (tmp_path / "mod/scene1/00000.png").read_bytes() == (tmp_path / "cli/scene1/00000.png").read_bytes()
+    text = (tmp_path / "appendix.py").read_text()
+    imports = [line for line in text.splitlines() if line.startswith(("import ", "from "))]
+    assert imports == ["from liganimate.runtime import host as _host"]
+
+
+def test_imported_module_hands_the_program_to_python(tmp_path):
+    r = run("compile", str(EXAMPLES / "clock.lig"), "-o", "clockmod.py", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    sys.path.insert(0, str(tmp_path))
+    try:
+        import clockmod  # noqa: PLC0415
+
+        rt = clockmod.program.execute("check")
+        assert rt.variables["CLOCK"].joint_ids == (1, 2)
+        assert rt.variables["TIME"] is not None
+    finally:
+        sys.path.remove(str(tmp_path))
+        sys.modules.pop("clockmod", None)
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.lig")), ids=lambda p: p.stem)
+def test_compile_output_is_stable(path, regen_golden):
+    first = compile_file(str(path)).python
+    second = compile_file(str(path)).python
+    assert first == second
+    stored = GOLDEN_COMPILE / (path.stem + ".py.txt")
+    # Paths differ between machines; the stored text uses the example's relative name.
+    normalised = first.replace(str(path), f"examples/{path.name}")
+    if regen_golden:
+        stored.parent.mkdir(parents=True, exist_ok=True)
+        stored.write_text(normalised)
+        return
+    assert stored.exists(), "run with --regen-golden to store the compiled module"
+    assert normalised == stored.read_text()
