@@ -1,0 +1,271 @@
+"""Rasterizer benchmark: liganimate vs matplotlib mplot3d on the same polygons.
+
+The scene is five box humanoids (11 boxes of 12 triangles each) spread
+across a 640x480 frame, each about 170 px tall, posed differently every
+frame.  Reported, side by side:
+
+* images/second of liganimate's ``rasterize`` and of mplot3d
+  (``Poly3DCollection`` drawn by the Agg canvas and read back as an array),
+  and their ratio;
+* images/second of ``rasterize`` + ``write_png`` with one process and with
+  two workers (processes and threads, both reported; the faster is
+  ``png_ips_2proc``).
+
+The last line printed is one JSON object with the figures.
+
+Usage: ``python benchmarks/raster.py [--quick]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import os
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from liganimate.runtime.camera import Camera
+from liganimate.runtime.imagefiles import write_png
+from liganimate.runtime.raster import rasterize
+
+SIZE = (640, 480)
+VIEW_POINT = (3.0, 4.0, 14.0)
+VIEW_WIDTH = 6.8
+
+# Unit cube corners (+-1) and its faces as quads, counter-clockwise seen
+# from outside (outward right-hand normals), as the rasterizer's cull flag
+# expects.
+_CORNERS = np.array([[x, y, z] for z in (-1, 1) for y in (-1, 1) for x in (-1, 1)], dtype=float)
+_QUADS = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+_BOX_TRIS = np.array([[q[0], q[1], q[2]] for q in _QUADS] + [[q[0], q[2], q[3]] for q in _QUADS])
+
+
+def _rot(axis: int, angle: np.ndarray) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) about a coordinate axis."""
+    c, s = np.cos(angle), np.sin(angle)
+    m = np.zeros(np.shape(angle) + (3, 3))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    m[..., axis, axis] = 1.0
+    m[..., i, i] = c
+    m[..., j, j] = c
+    m[..., i, j] = -s
+    m[..., j, i] = s
+    return m
+
+
+def humanoid_boxes(t: float, seed: int):
+    """Boxes of one posed humanoid at time t: centres (11, 3), half sizes (11, 3), rotations (11, 3, 3)."""
+    rng = np.random.default_rng(seed)
+    phase = rng.uniform(0, 2 * np.pi)
+    swing = 0.6 * np.sin(2.0 * t + phase)
+    # (attachment point, length, half thickness x/z, swing sign) for limbs hanging down.
+    centres, halves, rots = [], [], []
+
+    def seg(top, length, hx, hz, angle):
+        r = _rot(0, np.asarray(angle))
+        centres.append(np.asarray(top) + r @ np.array([0.0, -length / 2, 0.0]))
+        halves.append([hx, length / 2, hz])
+        rots.append(r)
+        return np.asarray(top) + r @ np.array([0.0, -length, 0.0])
+
+    seg([0, 1.55, 0], 0.55, 0.2, 0.11, 0.0)  # torso
+    seg([0, 1.0, 0], 0.12, 0.17, 0.1, 0.0)  # pelvis
+    seg([0, 1.8, 0], 0.22, 0.1, 0.1, 0.1 * swing)  # head (top at 1.8)
+    for side in (-1, 1):
+        elbow = seg([0.27 * side, 1.52, 0], 0.3, 0.06, 0.06, side * swing)
+        seg(elbow, 0.28, 0.05, 0.05, side * swing - 0.4)
+        knee = seg([0.1 * side, 0.9, 0], 0.42, 0.08, 0.08, -side * swing)
+        seg(knee, 0.42, 0.065, 0.065, -side * swing + 0.3)
+    return np.array(centres), np.array(halves), np.array(rots)
+
+
+def boxes_to_triangles(centres, halves, rots) -> np.ndarray:
+    """Closed, outward-wound boxes (B, ...) to triangles (12 B, 3, 3)."""
+    corners = _CORNERS[None] * halves[:, None, :]  # (B, 8, 3)
+    corners = np.einsum("bij,bkj->bki", rots, corners) + centres[:, None, :]
+    return corners[:, _BOX_TRIS].reshape(-1, 3, 3)
+
+
+def scene(frame: int, fps: float = 25.0):
+    """Five humanoids at one frame: triangles (N, 3, 3) and grey levels (N,)."""
+    t = frame / fps
+    tris = []
+    for h, x in enumerate(np.linspace(-2.4, 2.4, 5)):
+        c, s, r = humanoid_boxes(t, seed=h)
+        yaw = _rot(1, np.asarray(0.5 * h - 1.0 + 0.3 * t))
+        c = c @ yaw.T + np.array([x, -0.9, 0.4 * (h % 2)])
+        tris.append(boxes_to_triangles(c, s, np.einsum("ij,bjk->bik", yaw, r)))
+    tris = np.concatenate(tris)
+    # Lambert-like grey from the face normal, as the runtime would do.
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    light = np.array([0.4, 0.8, 0.45]) / np.linalg.norm([0.4, 0.8, 0.45])
+    shade = (40 + 180 * np.clip(n @ light, 0, 1)).astype(np.uint8)
+    return tris, shade
+
+
+def _camera() -> Camera:
+    return Camera(VIEW_POINT, VIEW_WIDTH, SIZE)
+
+
+def bench_liganimate(frames, cull=True) -> float:
+    cam = _camera()
+    scenes = [scene(f) for f in range(frames)]
+    ones = np.ones(len(scenes[0][0]), dtype=bool) if cull else None
+    rasterize(*scenes[0], cam, cull=ones)
+    t0 = time.perf_counter()
+    for tris, shade in scenes:
+        rasterize(tris, shade, cam, cull=ones)
+    return frames / (time.perf_counter() - t0)
+
+
+_TO_MPL = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+
+
+def bench_mplot3d(frames, save=None) -> float:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    fig = Figure(figsize=(SIZE[0] / 100, SIZE[1] / 100), dpi=100)
+    canvas = FigureCanvasAgg(fig)
+    ax = fig.add_axes([0, 0, 1, 1], projection="3d")
+    # Same view as liganimate's camera: mplot3d is Z-up, so world (x, y, z)
+    # is drawn as (x, -z, y); the focal length matches VIEW WIDTH, and the
+    # zoom was fitted so the figures cover the same pixels (about 29000).
+    p = _TO_MPL @ np.array(VIEW_POINT)
+    d = np.linalg.norm(p)
+    ax.set_proj_type("persp", focal_length=d / (VIEW_WIDTH / 2))
+    ax.view_init(elev=np.degrees(np.arcsin(p[2] / d)), azim=np.degrees(np.arctan2(p[1], p[0])))
+    ax.set_axis_off()
+    for setlim in (ax.set_xlim, ax.set_ylim, ax.set_zlim):
+        setlim(-4.0, 4.0)
+    ax.set_box_aspect((1, 1, 1), zoom=2.61)
+    tris, shade = scene(0)
+    grey = np.repeat(shade[:, None] / 255.0, 3, axis=1)
+    coll = Poly3DCollection(tris @ _TO_MPL.T, facecolors=grey, edgecolors="none")
+    ax.add_collection3d(coll)
+    canvas.draw()
+    scenes = [scene(f) for f in range(frames)]
+    t0 = time.perf_counter()
+    for tris, shade in scenes:
+        coll.set_verts(tris @ _TO_MPL.T)
+        coll.set_facecolor(np.repeat(shade[:, None] / 255.0, 3, axis=1))
+        canvas.draw()
+        img = np.asarray(canvas.buffer_rgba())[:, :, 0].copy()
+    assert img.shape == (SIZE[1], SIZE[0])
+    if save:
+        write_png(save, img)
+    return frames / (time.perf_counter() - t0)
+
+
+def _render_and_write(args):
+    first, count, folder = args
+    cam = _camera()
+    for f in range(first, first + count):
+        tris, shade = scene(f)
+        img = rasterize(tris, shade, cam, cull=np.ones(len(tris), dtype=bool))
+        write_png(os.path.join(folder, f"frame{f:05d}.png"), img)
+    return count
+
+
+def _scene_cache(frames):
+    return [scene(f) for f in range(frames)]
+
+
+def bench_png(frames, workers: int, mode: str) -> float:
+    """Render + write PNG images/second; scenes are built outside the timing."""
+    with tempfile.TemporaryDirectory() as folder:
+        if mode == "process":
+            ctx = mp.get_context("fork")
+            with ctx.Pool(workers, initializer=_init_worker, initargs=(frames,)) as pool:
+                pool.map(_timed_chunk, [(0, 2, folder)] * workers)  # warm up
+                chunks = [(w, frames, folder) for w in range(workers)]
+                t0 = time.perf_counter()
+                done = sum(pool.map(_timed_chunk, chunks))
+                return done / (time.perf_counter() - t0)
+        _init_worker(frames)
+        _timed_chunk((0, 2, folder))
+        if workers == 1:
+            t0 = time.perf_counter()
+            done = _timed_chunk((0, frames, folder))
+            return done / (time.perf_counter() - t0)
+        with ThreadPoolExecutor(workers) as ex:
+            t0 = time.perf_counter()
+            done = sum(ex.map(_timed_chunk, [(w, frames, folder) for w in range(workers)]))
+            return done / (time.perf_counter() - t0)
+
+
+_SCENES: list = []
+
+
+def _init_worker(frames):
+    global _SCENES
+    _SCENES = _scene_cache(min(frames, 50))
+
+
+def _timed_chunk(args):
+    worker, count, folder = args
+    cam = _camera()
+    cull = np.ones(len(_SCENES[0][0]), dtype=bool)
+    for i in range(count):
+        tris, shade = _SCENES[i % len(_SCENES)]
+        img = rasterize(tris, shade, cam, cull=cull)
+        write_png(os.path.join(folder, f"w{worker}_{i % 50:03d}.png"), img)
+    return count
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="a short run (under a minute)")
+    args = ap.parse_args(argv)
+    n_lig, n_mpl, n_png = (100, 20, 200) if args.quick else (1000, 100, 2000)
+
+    tris, _ = scene(0)
+    img = rasterize(*scene(0), _camera())
+    ys, _ = np.nonzero(img != 255)
+    print(f"scene: {len(tris)} triangles, {SIZE[0]}x{SIZE[1]}, figures span rows {ys.min()}..{ys.max()}")
+
+    lig = bench_liganimate(n_lig)
+    lig_nocull = bench_liganimate(max(n_lig // 2, 10), cull=False)
+    mpl = bench_mplot3d(n_mpl)
+    print(f"liganimate rasterize (culling): {lig:8.1f} images/s")
+    print(f"liganimate rasterize (no cull): {lig_nocull:8.1f} images/s")
+    print(f"mplot3d Poly3DCollection/Agg:   {mpl:8.1f} images/s   (painter's sort, no z-buffer)")
+    print(f"ratio: {lig / mpl:.1f}x")
+
+    png1 = bench_png(n_png, 1, "thread")
+    png2p = bench_png(n_png // 2, 2, "process")
+    png2t = bench_png(n_png // 2, 2, "thread")
+    print(f"rasterize + write_png, 1 process:   {png1:8.1f} images/s")
+    print(f"rasterize + write_png, 2 processes: {png2p:8.1f} images/s")
+    print(f"rasterize + write_png, 2 threads:   {png2t:8.1f} images/s")
+    print(
+        json.dumps(
+            {
+                "liganimate_ips": round(lig, 1),
+                "liganimate_nocull_ips": round(lig_nocull, 1),
+                "mplot3d_ips": round(mpl, 1),
+                "ratio": round(lig / mpl, 2),
+                "png_ips_1proc": round(png1, 1),
+                "png_ips_2proc": round(max(png2p, png2t), 1),
+                "png_ips_2proc_processes": round(png2p, 1),
+                "png_ips_2proc_threads": round(png2t, 1),
+                "cores": os.cpu_count(),
+                "quick": args.quick,
+            }
+        )
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,218 @@
+"""PNG, GIF and MP4 writers: round trips, determinism, atomicity, errors."""
+
+from __future__ import annotations
+
+import os
+import struct
+import subprocess
+import zlib
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from liganimate.runtime import imagefiles
+from liganimate.runtime.errors import RenderError
+from liganimate.runtime.imagefiles import encode_png, read_png, write_gif, write_mp4, write_png
+
+
+def frames(n, shape=(48, 64), seed=0):
+    """n flat-shaded-looking frames: a moving dark square on grey, shape (H, W) each."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        f = np.full(shape, 200, np.uint8)
+        f[5 + i : 25 + i, 10 + 2 * i : 30 + 2 * i] = 40 + 10 * i
+        f[-3:, :] = rng.integers(0, 256, (3, shape[1]))
+        out.append(f)
+    return out
+
+
+def chunks(data: bytes):
+    """PNG chunk types in order."""
+    pos, kinds = 8, []
+    while pos < len(data):
+        (length,) = struct.unpack(">I", data[pos : pos + 4])
+        kind = data[pos + 4 : pos + 8]
+        body = data[pos + 8 : pos + 8 + length]
+        (crc,) = struct.unpack(">I", data[pos + 8 + length : pos + 12 + length])
+        assert crc == zlib.crc32(kind + body)
+        kinds.append(kind)
+        pos += 12 + length
+    return kinds
+
+
+def leftovers(folder):
+    return [n for n in os.listdir(folder) if n.endswith(".tmp")]
+
+
+# --------------------------------------------------------------------------
+# PNG
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (480, 640), (7, 13), (300, 1)])
+def test_png_round_trip(tmp_path, shape):
+    img = np.random.default_rng(1).integers(0, 256, shape).astype(np.uint8)
+    img[: shape[0] // 2] = 77  # some flat area as well as noise
+    path = tmp_path / "a.png"
+    write_png(path, img)
+    np.testing.assert_array_equal(read_png(path), img)
+    with Image.open(path) as im:
+        assert im.mode == "L" and im.size == (shape[1], shape[0])
+
+
+def test_png_is_minimal_and_deterministic(tmp_path):
+    img = frames(1, (480, 640))[0]
+    data = encode_png(img)
+    assert data.startswith(b"\x89PNG\r\n\x1a\n")
+    assert chunks(data) == [b"IHDR", b"IDAT", b"IEND"]  # no time or text chunks
+    assert encode_png(img.copy()) == data
+    write_png(tmp_path / "a.png", img)
+    write_png(tmp_path / "b.png", img)
+    assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes() == data
+    assert len(data) < 20_000  # flat images compress well
+
+
+def test_png_write_is_atomic(tmp_path, monkeypatch):
+    path = tmp_path / "frame.png"
+    write_png(path, np.zeros((4, 4), np.uint8))
+    old = path.read_bytes()
+
+    def fail(fd):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(imagefiles.os, "fsync", fail)
+    with pytest.raises(OSError):
+        write_png(path, np.full((4, 4), 255, np.uint8))
+    assert path.read_bytes() == old  # the old file is intact
+    assert leftovers(tmp_path) == []  # and no temporary file remains
+    monkeypatch.undo()
+    write_png(path, np.full((4, 4), 255, np.uint8))
+    assert (read_png(path) == 255).all()
+    umask = os.umask(0)
+    os.umask(umask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~umask  # not mkstemp's 0600
+
+
+def test_png_rejects_bad_images(tmp_path):
+    for bad in [np.zeros((4, 4), np.float64), np.zeros((4, 4, 3), np.uint8), np.zeros((0, 4), np.uint8)]:
+        with pytest.raises(RenderError):
+            write_png(tmp_path / "x.png", bad)
+    assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------
+# GIF
+
+
+def test_gif_round_trip_and_timing(tmp_path):
+    fr = frames(7)
+    path = tmp_path / "a.gif"
+    assert write_gif(path, iter(fr), fps=30) == 7
+    with Image.open(path) as im:
+        assert im.n_frames == 7 and im.size == (64, 48)
+        assert im.info.get("loop") == 0
+        durations = []
+        for i in range(7):
+            im.seek(i)
+            np.testing.assert_array_equal(np.asarray(im.convert("L")), fr[i])
+            durations.append(im.info["duration"])
+    # Hundredths of a second, spread so the total stays exact: 7 frames at 30 fps = 0.233 s.
+    assert durations == [30, 40, 30, 30, 40, 30, 30]
+
+
+def test_gif_is_deterministic_and_streams(tmp_path):
+    pulled = []
+
+    def gen():
+        for i, f in enumerate(frames(5)):
+            pulled.append(i)
+            yield f
+
+    write_gif(tmp_path / "a.gif", gen(), fps=10)
+    write_gif(tmp_path / "b.gif", frames(5), fps=10)
+    assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
+    assert pulled == list(range(5))
+
+
+def test_gif_errors_leave_nothing(tmp_path):
+    path = tmp_path / "a.gif"
+    with pytest.raises(RenderError, match="no frames"):
+        write_gif(path, [], fps=10)
+    with pytest.raises(RenderError, match="Frame 1"):
+        write_gif(path, [np.zeros((4, 4), np.uint8), np.zeros((5, 4), np.uint8)], fps=10)
+    with pytest.raises(RenderError):
+        write_gif(path, frames(2), fps=0)
+    assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------
+# MP4
+
+needs_ffmpeg = pytest.mark.skipif(
+    not any(
+        [
+            __import__("importlib").util.find_spec("imageio_ffmpeg"),
+            __import__("shutil").which("ffmpeg"),
+        ]
+    ),
+    reason="no ffmpeg",
+)
+
+
+def decode_mp4(path, shape):
+    exe = imagefiles.find_ffmpeg()
+    out = subprocess.run(
+        [exe, "-loglevel", "error", "-i", str(path), "-f", "rawvideo", "-pix_fmt", "gray", "pipe:1"],
+        capture_output=True,
+        check=True,
+    ).stdout
+    return np.frombuffer(out, np.uint8).reshape(-1, *shape)
+
+
+@needs_ffmpeg
+def test_mp4_round_trip_and_determinism(tmp_path):
+    fr = frames(12, (48, 64))
+    a, b = tmp_path / "a.mp4", tmp_path / "b.mp4"
+    assert write_mp4(a, (f for f in fr), fps=25) == 12
+    write_mp4(b, fr, fps=25)
+    data = a.read_bytes()
+    assert data[4:8] == b"ftyp"
+    assert data == b.read_bytes()
+    got = decode_mp4(a, (48, 64))
+    assert len(got) == 12
+    # Lossy, but close on flat areas.
+    assert np.abs(got[:, :40].astype(int) - np.array(fr)[:, :40]).mean() < 3
+    assert leftovers(tmp_path) == []
+
+
+@needs_ffmpeg
+def test_mp4_odd_size_is_padded(tmp_path):
+    path = tmp_path / "odd.mp4"
+    write_mp4(path, frames(3, (49, 65)), fps=10)
+    assert decode_mp4(path, (50, 66)).shape == (3, 50, 66)
+
+
+def test_mp4_without_ffmpeg_says_how_to_get_it(tmp_path, monkeypatch):
+    import imageio_ffmpeg
+
+    def missing():
+        raise RuntimeError("no ffmpeg")
+
+    monkeypatch.setattr(imageio_ffmpeg, "get_ffmpeg_exe", missing)
+    monkeypatch.setattr(imagefiles.shutil, "which", lambda name: None)
+    with pytest.raises(RenderError) as err:
+        write_mp4(tmp_path / "a.mp4", frames(2), fps=10)
+    assert "ffmpeg" in err.value.message
+    assert "pip install imageio-ffmpeg" in err.value.hint
+    assert os.listdir(tmp_path) == []
+
+
+def test_mp4_ffmpeg_failure_is_a_render_error(tmp_path, monkeypatch):
+    monkeypatch.setattr(imagefiles, "find_ffmpeg", lambda: "false")  # exits 1 at once
+    path = tmp_path / "a.mp4"
+    path.write_bytes(b"old")
+    with pytest.raises(RenderError, match="ffmpeg"):
+        write_mp4(path, frames(3), fps=10)
+    assert path.read_bytes() == b"old"
+    assert leftovers(tmp_path) == []
