@@ -242,6 +242,9 @@ class Lowerer:
         if assigned:
             self.emit(f"nonlocal {', '.join(sorted(assigned))}")
         if snap:
+            # The scene sees its models as they were where it was defined;
+            # the program's own variables get their values back afterwards.
+            self.emit(f"_saved = {_tuple_value(snap)}")
             self.emit(f"{_tuple_target(snap)} = _snap")
         self.block(s.init, "scene")
         sameframe = self.expr(s.sameframe) if s.sameframe is not None else "1"
@@ -256,7 +259,9 @@ class Lowerer:
         pairs = "".join(f"({n!r}, {n}), " for n in animated)
         self.emit(f"rt.end_tick(({pairs}))")
         self.indent -= 1
-        if animated:
+        if snap:
+            self.emit(f"{_tuple_target(snap)} = _saved")
+        elif animated:
             self.emit(f"{_tuple_target(animated)} = _base")
         self.indent -= 1
         self.emit(f"rt.define_scene({self.expr(s.scene_id)}, {fn}, {_tuple_value(snap)}, {self.at(s.start_pos)})")
@@ -335,6 +340,8 @@ class Lowerer:
             return f"rt.mod({left}, {right}, {self.at(e.op_pos)})"
         if e.op == "*" and self.type_of(e.right) == T.MOTION:
             return f"rt.repeat({left}, {right}, {self.at(e)})"
+        if e.op == "+" and self.type_of(e.left) == T.MOTION:
+            return f"rt.concat({left}, {right}, {self.at(e)})"
         return f"({left} {e.op} {right})"
 
     def e_Call(self, e):

@@ -212,11 +212,6 @@ class ToAst(Transformer):
     def return_stmt(self, children):
         return A.Return(span(children))
 
-    def load_stmt(self, children):
-        src = children[1]
-        text = src.value[1:-1] if src.type == "STRING" else src.value
-        return A.Load(span(children), text, _nodes(children[2:]))
-
     def draw_with(self, children):
         return A.DrawWith(span(children), children[2])
 

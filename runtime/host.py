@@ -88,6 +88,8 @@ class Program:
             rt.variables = self.main(rt) or {}
         except _StopProgram:
             pass  # STOP handed over its variables
+        for scene_id, (_, _, at) in sorted(rt.scenes.items()):
+            rt.warn(at, f"scene {scene_id} is defined but never shot", "add SHOOTSCENES after the scenes")
 
         return rt
 
@@ -520,7 +522,7 @@ class Runtime:
         motion = self._motion(motion, at)
         t = self.scene.tick
         if t < start or t > end:
-            return fig
+            return m  # another ANIMATE of this model may cover this tick
         frame = float(t - start)
         if repeat:
             length = motion.length
