@@ -1,0 +1,619 @@
+"""Motion values: per-joint tracks with the thesis' motion algebra.
+
+A :class:`Motion` maps joint ids to tracks (see :mod:`liganimate.runtime.track`).
+It is immutable, and every operation is lazy: ``a + b``, ``n * a``, STRIP,
+SYNCHRONIZE and the SCALE transforms build new node graphs of a size that
+does not depend on repetition counts, so ``10**9 * walk`` costs what ``walk``
+costs.  The semantics are written out in ``docs/semantics-motion.md``.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from typing import Iterable, Mapping, Sequence
+
+import numpy as np
+
+from liganimate.runtime import interpolation
+from liganimate.runtime import track as tr
+from liganimate.runtime.errors import MotionError
+
+__all__ = [
+    "Motion",
+    "concat",
+    "repeat",
+    "strip",
+    "synchronize",
+    "scale_frames",
+    "scale_extremes",
+    "DEFAULT_KEYFRAME_LIMIT",
+]
+
+DEFAULT_KEYFRAME_LIMIT = 100_000
+
+
+def _joint_id(joint) -> int:
+    if isinstance(joint, bool):
+        raise MotionError(f"joint id {joint!r} is not an integer")
+    try:
+        return operator.index(joint)
+    except TypeError:
+        raise MotionError(f"joint id {joint!r} is not an integer") from None
+
+
+def _vector(value, what: str) -> np.ndarray:
+    try:
+        v = np.asarray(value, dtype=float).reshape(3)
+    except (TypeError, ValueError):
+        raise MotionError(f"{what} must be three angles (x, y, z), got {value!r}") from None
+    if not np.all(np.isfinite(v)):
+        raise MotionError(f"{what} must be finite, got {tuple(v)}")
+    return v
+
+
+def _real(r, what: str) -> float:
+    try:
+        r = float(r)
+    except (TypeError, ValueError):
+        raise MotionError(f"{what} must be a number, got {r!r}") from None
+    if not math.isfinite(r):
+        raise MotionError(f"{what} must be finite, got {r}")
+    return r
+
+
+def _leaf(joint: int, spec) -> tr.Leaf:
+    """Validate one joint's ``(start, keyframes)`` and build its leaf."""
+    try:
+        start, keys = spec
+    except (TypeError, ValueError):
+        raise MotionError(f"joint {joint}: expected (start position, list of keyframes)") from None
+    start = np.zeros(3) if start is None else _vector(start, f"joint {joint}: start position")
+    frames, values, methods, ramps = [], [], [], []
+    previous = 0.0
+    for k, key in enumerate(keys, start=1):
+        where = f"joint {joint}, keyframe {k}"
+        if not isinstance(key, Sequence) or len(key) not in (3, 4):
+            raise MotionError(f"{where}: expected (frame, position, method)")
+        frame = _real(key[0], f"{where}: frame")
+        if frame < 0:
+            raise MotionError(
+                f"{where}: frame {frame:g} is negative",
+                hint="frames count ticks from the start of the motion, which is frame 0",
+            )
+        if frame < previous:
+            raise MotionError(
+                f"{where}: frame {frame:g} comes before the previous keyframe's frame {previous:g}",
+                hint="list keyframes in order of their frames; equal frames make an instantaneous step",
+            )
+        previous = frame
+        try:
+            method = interpolation.get(key[2])
+        except KeyError:
+            raise MotionError(
+                f"{where}: unknown interpolation method {key[2]!r}",
+                hint="known methods: " + ", ".join(interpolation.names()),
+            ) from None
+        ramp = tr.RAMP if len(key) == 3 else _real(key[3], f"{where}: ramp")
+        if ramp <= 0:
+            raise MotionError(f"{where}: ramp {ramp:g} must be positive")
+        frames.append(frame)
+        values.append(_vector(key[1], f"{where}: position"))
+        methods.append(method)
+        ramps.append(ramp)
+    return tr.Leaf(start, frames, np.reshape(values, (-1, 3)), methods, ramps)
+
+
+class Motion:
+    """An immutable motion: a track per joint, built lazily by the motion algebra.
+
+    Build one with :meth:`from_tracks` or :meth:`empty`; combine with ``+``,
+    ``n * m`` and the methods below.  All operations return new motions.
+    """
+
+    __slots__ = ("_tracks", "_length", "_expr")
+
+    def __init__(self, tracks: Mapping[int, tr.Track], expr: tuple, length: float | None = None):
+        self._tracks = dict(sorted(tracks.items()))
+        self._length = float(
+            length if length is not None else max((t.end for t in self._tracks.values()), default=0.0)
+        )
+        self._expr = expr
+
+    # -- construction -----------------------------------------------------
+
+    @classmethod
+    def from_tracks(cls, tracks: Mapping[int, tuple], name: str | None = None) -> "Motion":
+        """Build a motion from explicit keyframes.
+
+        Parameters
+        ----------
+        tracks : mapping of int to (start, keyframes)
+            ``start`` is array_like of shape (3,) (or None for the neutral
+            position); ``keyframes`` is a sequence of ``(frame, position,
+            method_name)`` with ``position`` of shape (3,), optionally with a
+            fourth element, the LINEAR ramp in frames (default 3).
+        name : str, optional
+            Shown by :meth:`describe`.
+
+        Returns
+        -------
+        Motion
+
+        Raises
+        ------
+        MotionError
+            For decreasing or negative frames, unknown methods, malformed
+            positions; the message names the joint and the keyframe.
+        """
+        leaves = {}
+        for joint, spec in tracks.items():
+            j = _joint_id(joint)
+            leaves[j] = _leaf(j, spec)
+        nkeys = sum(len(leaf.frames) for leaf in leaves.values())
+        return cls(leaves, ("keys", name, len(leaves), nkeys))
+
+    @classmethod
+    def empty(cls) -> "Motion":
+        """The motion with no joints and length 0.
+
+        Returns
+        -------
+        Motion
+        """
+        return cls({}, ("empty",))
+
+    # -- properties -------------------------------------------------------
+
+    @property
+    def length(self) -> float:
+        """Last frame at which any track changes (float)."""
+        return self._length
+
+    @property
+    def joints(self) -> tuple[int, ...]:
+        """Driven joint ids, sorted."""
+        return tuple(self._tracks)
+
+    def track(self, joint: int) -> tr.Track:
+        """The track node of one joint (for the runtime and tests).
+
+        Parameters
+        ----------
+        joint : int
+
+        Returns
+        -------
+        Track
+        """
+        return self._tracks[self._driven(joint, "this motion")]
+
+    def _driven(self, joint, where: str) -> int:
+        j = _joint_id(joint)
+        if j not in self._tracks:
+            raise MotionError(f"joint {j} is not driven by {where}", hint=f"it drives joints {list(self.joints)}")
+        return j
+
+    # -- algebra ----------------------------------------------------------
+
+    def __add__(self, other: "Motion") -> "Motion":
+        if not isinstance(other, Motion):
+            return NotImplemented
+        la, lb = self._length, other._length
+        tracks = {}
+        for j in self._tracks.keys() | other._tracks.keys():
+            ta, tb = self._tracks.get(j), other._tracks.get(j)
+            if tb is None:
+                tracks[j] = tr.pad(ta, la + lb, hold_from=la)  # a's end value is held through b
+            else:
+                if ta is None:
+                    ta = tr.Const(tb.start_value)  # b's start value is held through a
+                tracks[j] = tr.concat(ta, tb, la)
+        return Motion(tracks, ("+", self._expr, other._expr))
+
+    def repeat(self, n: int) -> "Motion":
+        """``n`` copies played back to back (the thesis' ``n * motion``).
+
+        Parameters
+        ----------
+        n : int
+            Non-negative.
+
+        Returns
+        -------
+        Motion
+            Of length ``n * self.length``; for ``n = 0``, length 0 and every
+            joint holding its start value.
+
+        Raises
+        ------
+        MotionError
+            If ``n`` is not a non-negative integer.
+        """
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+            raise MotionError(f"a motion can only be repeated a whole number of times, not {n!r}")
+        n = int(n)
+        if n < 0:
+            raise MotionError(f"a motion cannot be repeated a negative number of times ({n})")
+        expr = ("*", n, self._expr)
+        if n == 0:
+            return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr)
+        if n == 1 or self._length == 0:
+            return Motion(self._tracks, expr, self._length * n)
+        L = self._length
+        # A track that lasts the whole period ends exactly where the repeat does.
+        tracks = {j: tr.Repeat(t, n, L, end=n * L if t.end == L else None) for j, t in self._tracks.items()}
+        return Motion(tracks, expr, n * L)
+
+    def __mul__(self, n) -> "Motion":
+        return self.repeat(n)
+
+    __rmul__ = __mul__
+
+    def strip(self, joints: Iterable[int]) -> "Motion":
+        """Keep only some joints (STRIP).
+
+        Parameters
+        ----------
+        joints : iterable of int
+
+        Returns
+        -------
+        Motion
+            Its length is recomputed from the kept tracks.
+
+        Raises
+        ------
+        MotionError
+            If a listed joint is not driven by this motion.
+        """
+        kept = {}
+        for joint in joints:
+            j = self._driven(joint, "the motion being stripped")
+            kept[j] = self._tracks[j]
+        return Motion(kept, ("strip", tuple(kept), self._expr))
+
+    def scale_frames(self, r: float) -> "Motion":
+        """Stretch time by ``|r|``; a negative ``r`` also plays the motion backwards.
+
+        Parameters
+        ----------
+        r : float
+            Non-zero.
+
+        Returns
+        -------
+        Motion
+            Its pose at ``|r| * t`` is this motion's pose at ``t`` (for
+            ``r > 0``) or at ``length - t`` (for ``r < 0``).
+
+        Raises
+        ------
+        MotionError
+            If ``r`` is zero or not finite.
+        """
+        r = _real(r, "the SCALE FRAMES factor")
+        if r == 0:
+            raise MotionError("SCALE FRAMES 0 would squeeze the motion into no time", hint="use a non-zero factor")
+        s, L = abs(r), self._length * abs(r)
+        memo: dict = {}
+        tracks = {j: tr.scale_frames(t, s, memo) for j, t in self._tracks.items()}
+        if r < 0:
+            tracks = {j: tr.reverse(t, L, memo) for j, t in tracks.items()}
+        return Motion(tracks, ("frames", r, self._expr), L)
+
+    def scale_extremes(self, r: float) -> "Motion":
+        """Multiply every angle (start and keyframe positions) by ``r``.
+
+        Parameters
+        ----------
+        r : float
+
+        Returns
+        -------
+        Motion
+        """
+        r = _real(r, "the SCALE EXTREMES factor")
+        memo: dict = {}
+        tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
+        return Motion(tracks, ("extremes", r, self._expr), self._length)
+
+    def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> "Motion":
+        """Take the short way round on axes that can turn freely.
+
+        Parameters
+        ----------
+        free_axes : mapping of int to tuple of 3 bool
+            Joints (and their X, Y, Z axes) with no rotation limit; joints this
+            motion does not drive are ignored.
+
+        Returns
+        -------
+        Motion
+            In every leaf track, each keyframe value on a listed axis is moved
+            by a multiple of 360 to within 180 degrees of the previous one; the
+            start values are kept.
+        """
+        memo: dict = {}
+        tracks = dict(self._tracks)
+        for joint, axes in free_axes.items():
+            j = _joint_id(joint)
+            if j in tracks and any(axes):
+                tracks[j] = tr.unwrap(tracks[j], tuple(bool(a) for a in axes), memo)
+        return Motion(tracks, ("unwrap", self._expr), self._length)
+
+    # -- evaluation -------------------------------------------------------
+
+    def _times(self, times) -> np.ndarray:
+        t = np.asarray(times, dtype=float).reshape(-1)
+        if np.isnan(t).any():
+            raise MotionError("cannot evaluate a motion at a NaN time")
+        return np.ascontiguousarray(t)
+
+    def _joint_list(self, joints) -> list[int]:
+        if joints is None:
+            return list(self._tracks)
+        return [self._driven(j, "the motion being evaluated") for j in joints]
+
+    def evaluate(self, times, joints: Iterable[int] | None = None) -> np.ndarray:
+        """Joint angles at some times.
+
+        Parameters
+        ----------
+        times : array_like, shape (T,)
+            Frames (real numbers); before 0 the start values are shown,
+            after ``length`` the end values.
+        joints : iterable of int, optional
+            Defaults to :attr:`joints`.
+
+        Returns
+        -------
+        ndarray, shape (T, J, 3)
+            Degrees about X, Y, Z.
+        """
+        return self.evaluate_full(times, joints)[0]
+
+    def evaluate_full(self, times, joints: Iterable[int] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Joint angles with their analytic velocity and acceleration.
+
+        Parameters
+        ----------
+        times : array_like, shape (T,)
+        joints : iterable of int, optional
+
+        Returns
+        -------
+        angles : ndarray, shape (T, J, 3)
+            Degrees.
+        velocity : ndarray, shape (T, J, 3)
+            Degrees per frame (one-sided at keyframes, on the side the value is taken from).
+        acceleration : ndarray, shape (T, J, 3)
+            Degrees per frame squared.
+        """
+        t = self._times(times)
+        js = self._joint_list(joints)
+        out = np.zeros((3, len(t), len(js), 3))
+        for i, j in enumerate(js):
+            s = self._tracks[j].sample(t)
+            out[0, :, i], out[1, :, i], out[2, :, i] = s
+        return out[0], out[1], out[2]
+
+    # -- inspection -------------------------------------------------------
+
+    def keyframes(
+        self, joint: int, limit: int = DEFAULT_KEYFRAME_LIMIT, with_ramps: bool = False
+    ) -> tuple[tuple[float, float, float], list[tuple]]:
+        """One joint's track written out as a single keyframe list (for PRINT).
+
+        Junctions of ``+`` and ``*`` appear as a repeated keyframe (a
+        zero-length step), and holds as a constant LINEAR segment, so the
+        listing fed back to :meth:`from_tracks` (with ``with_ramps=True``)
+        gives the same angles except exactly at left-continuous steps.
+
+        Parameters
+        ----------
+        joint : int
+        limit : int
+            Most keyframes to produce.
+        with_ramps : bool
+            Append each keyframe's LINEAR ramp as a fourth element.
+
+        Returns
+        -------
+        start : tuple of 3 float
+        keys : list of (frame, (x, y, z), method_name[, ramp])
+
+        Raises
+        ------
+        MotionError
+            If the joint is not driven, or the listing would exceed ``limit``
+            (checked before anything big is built).
+        """
+        j = self._driven(joint, "this motion")
+        try:
+            start, keys = tr.materialize(self._tracks[j], limit)
+        except MotionError as exc:
+            raise MotionError(
+                f"joint {j}: {exc.message}", hint="use describe() to see how the motion is built"
+            ) from None
+        if not with_ramps:
+            keys = [k[:3] for k in keys]
+        return start, keys
+
+    def footprint(self) -> tr.Footprint:
+        """What this motion stores: distinct track nodes and leaf keyframes.
+
+        Returns
+        -------
+        Footprint
+        """
+        return tr.footprint(self._tracks.values())
+
+    def describe(self, max_chars: int = 2000) -> str:
+        """A compact text of the expression that built this motion.
+
+        Parameters
+        ----------
+        max_chars : int
+            The text is cut (ending in "...") beyond this, so a motion built
+            by doubling 60 times still describes quickly.
+
+        Returns
+        -------
+        str
+        """
+        parts: list[str] = []
+        budget = [max_chars]
+
+        def put(s: str) -> bool:
+            parts.append(s)
+            budget[0] -= len(s)
+            return budget[0] > 0
+
+        def render(e: tuple, prec: int) -> bool:
+            # prec: 0 inside + or a list, 1 as a * operand, 2 before a <transform>.
+            kind = e[0]
+            if kind == "keys":
+                _, name, nj, nk = e
+                return put(name or f"keyframes[{nj} joints, {nk} keyframes]")
+            if kind == "empty":
+                return put("EMPTY")
+            if kind in ("+", "*"):
+                paren = prec > (0 if kind == "+" else 1)
+                if paren and not put("("):
+                    return False
+                if kind == "+":
+                    ok = render(e[1], 0) and put(" + ") and render(e[2], 0)
+                else:
+                    ok = put(f"{e[1]} * ") and render(e[2], 2)
+                return ok and (not paren or put(")"))
+            if kind in ("frames", "extremes"):
+                label = "FRAMES" if kind == "frames" else "EXTREMES"
+                return render(e[2], 2) and put(f" <SCALE {label} {e[1]:g}>")
+            if kind == "strip":
+                return put("STRIP(") and render(e[2], 0) and put("".join(f", {j}" for j in e[1]) + ")")
+            if kind == "sync":
+                if not put("SYNCHRONIZE("):
+                    return False
+                for i, sub in enumerate(e[1]):
+                    if (i and not put(", ")) or not render(sub, 0):
+                        return False
+                return put(")")
+            if kind == "unwrap":
+                return put("UNWRAP(") and render(e[1], 0) and put(")")
+            return put(f"<{kind}>")
+
+        if not render(self._expr, 0):
+            return "".join(parts)[:max_chars] + "..."
+        return "".join(parts)
+
+    def __repr__(self) -> str:
+        return f"<Motion length={self._length:g} joints={list(self.joints)}: {self.describe(200)}>"
+
+
+def concat(a: Motion, b: Motion) -> Motion:
+    """``a + b``: ``b`` played after ``a``.
+
+    Parameters
+    ----------
+    a, b : Motion
+
+    Returns
+    -------
+    Motion
+    """
+    return a + b
+
+
+def repeat(n: int, a: Motion) -> Motion:
+    """``n * a``; see :meth:`Motion.repeat`.
+
+    Parameters
+    ----------
+    n : int
+    a : Motion
+
+    Returns
+    -------
+    Motion
+    """
+    return a.repeat(n)
+
+
+def strip(a: Motion, joints: Iterable[int]) -> Motion:
+    """STRIP: see :meth:`Motion.strip`.
+
+    Parameters
+    ----------
+    a : Motion
+    joints : iterable of int
+
+    Returns
+    -------
+    Motion
+    """
+    return a.strip(joints)
+
+
+def synchronize(*motions: Motion) -> Motion:
+    """SYNCHRONIZE: one motion driving the union of disjoint joint sets.
+
+    Parameters
+    ----------
+    *motions : Motion
+
+    Returns
+    -------
+    Motion
+        Its length is the longest operand's.
+
+    Raises
+    ------
+    MotionError
+        If two operands drive the same joint; the message names the joint
+        and the two operands (counted from 1).
+    """
+    tracks: dict[int, tr.Track] = {}
+    owner: dict[int, int] = {}
+    for i, m in enumerate(motions, start=1):
+        if not isinstance(m, Motion):
+            raise MotionError(f"operand {i} of SYNCHRONIZE is not a motion")
+        for j, t in m._tracks.items():
+            if j in owner:
+                raise MotionError(
+                    f"joint {j} is driven by both operand {owner[j]} and operand {i} of SYNCHRONIZE",
+                    hint="STRIP the joint from one of them first",
+                )
+            owner[j] = i
+            tracks[j] = t
+    return Motion(tracks, ("sync", tuple(m._expr for m in motions)))
+
+
+def scale_frames(a: Motion, r: float) -> Motion:
+    """SCALE FRAMES: see :meth:`Motion.scale_frames`.
+
+    Parameters
+    ----------
+    a : Motion
+    r : float
+
+    Returns
+    -------
+    Motion
+    """
+    return a.scale_frames(r)
+
+
+def scale_extremes(a: Motion, r: float) -> Motion:
+    """SCALE EXTREMES: see :meth:`Motion.scale_extremes`.
+
+    Parameters
+    ----------
+    a : Motion
+    r : float
+
+    Returns
+    -------
+    Motion
+    """
+    return a.scale_extremes(r)

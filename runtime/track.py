@@ -1,0 +1,838 @@
+"""Per-joint tracks: keyframe leaves and the lazy nodes that compose them.
+
+A track is a function of time ``t`` (frames, any real number) to a joint's
+three angles, with analytic velocity and acceleration.  Every track is
+defined on the whole real line: before frame 0 it shows its *start value*,
+after its *end* frame it shows its *end value*.  Composite tracks never copy
+keyframes: ``Concat`` switches between pieces at pivot frames, ``Repeat``
+maps time into one period, ``Pad`` only moves the end frame.  Transformations
+(reversal, scaling) rebuild the node graph once per distinct node, so a motion
+repeated a billion times is reversed as cheaply as the motion itself.
+
+The exact formulas are documented in ``docs/semantics-motion.md``.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from liganimate.runtime import interpolation
+from liganimate.runtime.errors import MotionError
+
+RAMP = 3.0
+"""Frames a LINEAR segment spends reaching its cruise speed (before SCALE FRAMES)."""
+
+MAX_PIECES = 64
+"""Pieces a flat Concat may hold; longer chains nest, which keeps appends cheap."""
+
+
+def _frozen(a) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.flags.writeable = False
+    return a
+
+
+class Samples(NamedTuple):
+    """Angles and their time derivatives at N times.
+
+    Attributes
+    ----------
+    x : ndarray, shape (N, 3)
+        Angles in degrees.
+    v : ndarray, shape (N, 3)
+        Angular velocity in degrees per frame.
+    a : ndarray, shape (N, 3)
+        Angular acceleration in degrees per frame squared.
+    """
+
+    x: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+
+
+def _empty(n: int) -> Samples:
+    return Samples(np.empty((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)))
+
+
+class Track:
+    """Base class of the immutable track nodes.
+
+    Attributes
+    ----------
+    end : float
+        Frame after which the track holds ``end_value``.
+    start_value, end_value : ndarray, shape (3,)
+        Value before frame 0 and after ``end``.
+    min_keys : int
+        Keyframes the materialized listing has at least (exact for leaves);
+        lets ``materialize`` refuse a billion-fold repeat before building it.
+    """
+
+    __slots__ = ("end", "start_value", "end_value", "min_keys")
+
+    def sample(self, t: np.ndarray) -> Samples:
+        """Evaluate the track.
+
+        Parameters
+        ----------
+        t : ndarray, shape (N,)
+            Times in frames (float, no NaN).
+
+        Returns
+        -------
+        Samples
+            Each field of shape (N, 3).
+        """
+        raise NotImplementedError
+
+    def children(self) -> tuple["Track", ...]:
+        return ()
+
+    # Transformations are written per node and reached through the memoized
+    # module functions below, so that shared subtrees are rebuilt only once.
+    def _reversed(self, length: float, memo: dict) -> "Track":
+        raise NotImplementedError
+
+    def _scaled_frames(self, r: float, memo: dict) -> "Track":
+        raise NotImplementedError
+
+    def _mapped(self, m: "LeafMap", memo: dict) -> "Track":
+        raise NotImplementedError
+
+    def _emit(self, out: "_Emitter", offset: float) -> None:
+        raise NotImplementedError
+
+
+# ---------------------------------------------------------------------------
+# Leaves
+
+
+def _harmonic(s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
+    """Harmonic mean where both slopes share a strict sign, else 0 (monotone, like PCHIP)."""
+    same = ((s1 > 0) & (s2 > 0)) | ((s1 < 0) & (s2 < 0))
+    out = np.zeros(np.broadcast(s1, s2).shape)
+    out[same] = 2.0 * s1[same] * s2[same] / (s1[same] + s2[same])
+    return out
+
+
+class _Prepared(NamedTuple):
+    F: np.ndarray  # (K+1,) knot frames, knot 0 is the start at frame 0
+    V: np.ndarray  # (K+1, 3) knot values
+    T: np.ndarray  # (K,) segment durations
+    D: np.ndarray  # (K, 3) segment displacements
+    code: np.ndarray  # (K,) index into kinds
+    kinds: tuple  # distinct method objects
+    Vs: np.ndarray  # (K, 3) LINEAR boundary velocity at segment start
+    Ve: np.ndarray  # (K, 3) LINEAR boundary velocity at segment end
+    c: np.ndarray  # (K, 3) LINEAR cruise speed
+    r: np.ndarray  # (K,) LINEAR ramp length actually used
+
+
+class Leaf(Track):
+    """A keyframe track: start value at frame 0, then keyframes.
+
+    Parameters
+    ----------
+    start : array_like, shape (3,)
+        Angles at frame 0.
+    frames : array_like, shape (K,)
+        Non-decreasing keyframe frames, all >= 0; equal frames form a step.
+    values : array_like, shape (K, 3)
+        Angles reached at each keyframe.
+    methods : sequence of InterpolationMethod, length K
+        Method of the segment arriving at each keyframe.
+    ramps : array_like, shape (K,)
+        LINEAR ramp length of the segment arriving at each keyframe (> 0).
+    right : bool
+        True if the track is right-continuous at its steps (as written by
+        users); reversed leaves are left-continuous.
+    """
+
+    __slots__ = ("start", "frames", "values", "methods", "ramps", "right", "_prep")
+
+    def __init__(self, start, frames, values, methods, ramps, right: bool = True):
+        self.start = _frozen(start).reshape(3)
+        self.frames = _frozen(frames).reshape(-1)
+        k = len(self.frames)
+        self.values = _frozen(values).reshape(k, 3)
+        self.methods = tuple(methods)
+        self.ramps = _frozen(ramps).reshape(k)
+        self.right = bool(right)
+        self.end = float(self.frames[-1]) if k else 0.0
+        self.start_value = self.start
+        self.end_value = self.values[-1] if k else self.start
+        self.min_keys = k
+        self._prep = None
+
+    def _prepare(self) -> _Prepared:
+        if self._prep is not None:
+            return self._prep
+        F = np.concatenate([[0.0], self.frames])
+        V = np.vstack([self.start[None, :], self.values])
+        T = np.diff(F)
+        D = np.diff(V, axis=0)
+        K = len(T)
+        pos = T > 0
+        slope = np.zeros((K, 3))
+        slope[pos] = D[pos] / T[pos, None]
+        kinds: list = []
+        code = np.empty(K, dtype=np.intp)
+        for i, m in enumerate(self.methods):
+            for j, known in enumerate(kinds):
+                if known is m:
+                    break
+            else:
+                j = len(kinds)
+                kinds.append(m)
+            code[i] = j
+        lin = np.array([m.name == "LINEAR" for m in self.methods], dtype=bool)
+        # Natural boundary velocities of fixed-shape segments: (D/T) e'(0), (D/T) e'(1).
+        nat0 = np.zeros((K, 3))
+        nat1 = np.zeros((K, 3))
+        for j, m in enumerate(kinds):
+            _, de, _ = m.ease(np.array([0.0, 1.0]))
+            sel = code == j
+            nat0[sel] = slope[sel] * de[0]
+            nat1[sel] = slope[sel] * de[1]
+        Vs = np.zeros((K, 3))
+        Ve = np.zeros((K, 3))
+        if K > 1:
+            # Knot i+1 joins segment i and i+1; a zero-length neighbour is a step (velocity 0).
+            inner = _harmonic(slope[:-1], slope[1:])
+            both = (pos[:-1] & pos[1:])[:, None]
+            Vs[1:] = np.where(both, np.where(lin[:-1, None], inner, nat1[:-1]), 0.0)
+            Ve[:-1] = np.where(both, np.where(lin[1:, None], inner, nat0[1:]), 0.0)
+        r = np.minimum(self.ramps, T / 2.0)
+        c = np.zeros((K, 3))
+        c[pos] = (D[pos] - r[pos, None] * (Vs[pos] + Ve[pos]) / 2.0) / (T[pos] - r[pos])[:, None]
+        self._prep = _Prepared(F, V, T, D, code, tuple(kinds), Vs, Ve, c, r)
+        return self._prep
+
+    def sample(self, t: np.ndarray) -> Samples:
+        p = self._prepare()
+        out = _empty(len(t))
+        K = len(p.T)
+        idx = np.searchsorted(p.F, t, side="right" if self.right else "left")
+        out.x[idx == 0] = self.start
+        out.x[idx > K] = p.V[K]
+        inside = np.nonzero((idx > 0) & (idx <= K))[0]
+        if len(inside) == 0:
+            return out
+        seg = idx[inside] - 1
+        for j, m in enumerate(p.kinds):
+            sel = p.code[seg] == j
+            if not sel.any():
+                continue
+            rows, s = inside[sel], seg[sel]
+            ts = t[rows]
+            if m.name == "LINEAR":
+                x, v, a = _trapezoid(p, s, ts)
+            else:
+                x, v, a = _fixed(p, m, s, ts)
+            out.x[rows], out.v[rows], out.a[rows] = x, v, a
+        return out
+
+    def _reversed(self, length, memo):
+        rev = _cached(memo, ("leaf-rev",), self, self._mirror)
+        if length > self.end:
+            # The hold after this leaf's end becomes a hold before the mirrored keyframes.  The
+            # frame `end` itself belongs to the hold if this leaf is right-continuous, else to
+            # its last segment; mirrored, that is the first piece or the second.
+            return concat(Const(self.end_value, 0.0), rev, length - self.end, right=not self.right, end=length)
+        return rev
+
+    def _mirror(self) -> "Leaf":
+        E = self.end
+        F = np.concatenate([[0.0], self.frames])
+        V = np.vstack([self.start[None, :], self.values])
+        methods = []
+        for m in reversed(self.methods):
+            try:
+                methods.append(interpolation.get(m.reverse))
+            except KeyError:
+                raise MotionError(
+                    f"interpolation method {m.name} cannot be reversed: its reverse {m.reverse} is not known"
+                ) from None
+        return Leaf(V[-1], E - F[::-1][1:], V[::-1][1:], methods, self.ramps[::-1], right=not self.right)
+
+    def _scaled_frames(self, r, memo):
+        return Leaf(self.start, self.frames * r, self.values, self.methods, self.ramps * r, self.right)
+
+    def _mapped(self, m, memo):
+        return m.leaf(self)
+
+    def _emit(self, out, offset):
+        for f, v, m, r in zip(self.frames, self.values, self.methods, self.ramps):
+            out.add(offset + f, v, m.name, r)
+
+
+def _gather(p: _Prepared, s: np.ndarray, ts: np.ndarray):
+    tau = (ts - p.F[s])[:, None]
+    sig = (p.F[s + 1] - ts)[:, None]
+    return tau, sig, p.V[s], p.V[s + 1]
+
+
+def _trapezoid(p: _Prepared, s: np.ndarray, ts: np.ndarray):
+    """LINEAR segments: ramp Vs -> c over r frames, cruise, ramp c -> Ve over r frames."""
+    tau, sig, v0, v1 = _gather(p, s, ts)
+    r = p.r[s][:, None]
+    Vs, Ve, c = p.Vs[s], p.Ve[s], p.c[s]
+    # Each half is measured from its own keyframe so that the mirrored segment
+    # performs the mirrored arithmetic and keyframes are reached exactly.
+    xs = np.where(tau < r, Vs * tau + (c - Vs) * tau * tau / (2.0 * r), r * (Vs + c) / 2.0 + c * (tau - r))
+    xe = np.where(sig < r, Ve * sig + (c - Ve) * sig * sig / (2.0 * r), r * (Ve + c) / 2.0 + c * (sig - r))
+    x = np.where(tau <= sig, v0 + xs, v1 - xe)
+    v = np.where(tau < r, Vs + (c - Vs) * tau / r, np.where(sig < r, Ve + (c - Ve) * sig / r, c))
+    a = np.where(tau < r, (c - Vs) / r, np.where(sig < r, -(c - Ve) / r, 0.0))
+    return x, v, a
+
+
+def _fixed(p: _Prepared, m, s: np.ndarray, ts: np.ndarray):
+    """Fixed-shape segments: v0 + D e(u)."""
+    tau, sig, v0, v1 = _gather(p, s, ts)
+    T = p.T[s][:, None]
+    D = p.D[s]
+    u = np.clip(tau / T, 0.0, 1.0)
+    e, de, d2e = m.ease(u[:, 0])
+    e, de, d2e = e[:, None], de[:, None], d2e[:, None]
+    x = np.where(u <= 0.5, v0 + D * e, v1 - D * (1.0 - e))
+    return x, D / T * de, D / (T * T) * d2e
+
+
+# ---------------------------------------------------------------------------
+# Composite nodes
+
+
+class Const(Track):
+    """A joint that never moves.
+
+    Parameters
+    ----------
+    value : array_like, shape (3,)
+    end : float
+        End frame (a constant track may still "last" for a while).
+    """
+
+    __slots__ = ("value",)
+
+    def __init__(self, value, end: float = 0.0):
+        self.value = _frozen(value).reshape(3)
+        self.end = float(end)
+        self.start_value = self.end_value = self.value
+        self.min_keys = 0
+
+    def sample(self, t):
+        out = _empty(len(t))
+        out.x[:] = self.value
+        return out
+
+    def _reversed(self, length, memo):
+        return Const(self.value, length)
+
+    def _scaled_frames(self, r, memo):
+        return Const(self.value, self.end * r)
+
+    def _mapped(self, m, memo):
+        return Const(m.value(self.value), self.end)
+
+    def _emit(self, out, offset):
+        pass
+
+
+class Pad(Track):
+    """A track whose end is moved later (the hold counts as part of it).
+
+    Parameters
+    ----------
+    inner : Track
+    end : float
+        New end frame, >= ``inner.end``.
+    hold_from : float, optional
+        From this frame on (inclusive) show ``inner.end_value``.  ``a + b``
+        uses it for joints only ``a`` drives, so that the junction stays
+        right-continuous even if ``a``'s track is left-continuous at its end;
+        being tied to ``inner``, the held value follows any change of angles.
+    """
+
+    __slots__ = ("inner", "hold_from")
+
+    def __init__(self, inner: Track, end: float, hold_from: float | None = None):
+        self.inner = inner
+        self.end = float(end)
+        self.hold_from = None if hold_from is None else float(hold_from)
+        self.start_value, self.end_value = inner.start_value, inner.end_value
+        self.min_keys = inner.min_keys
+
+    def sample(self, t):
+        if self.hold_from is None:
+            return self.inner.sample(t)
+        held = t >= self.hold_from
+        if not held.any():
+            return self.inner.sample(t)
+        out = _empty(len(t))
+        out.x[held] = self.end_value
+        if not held.all():
+            out.x[~held], out.v[~held], out.a[~held] = self.inner.sample(t[~held])
+        return out
+
+    def children(self):
+        return (self.inner,)
+
+    def _reversed(self, length, memo):
+        if self.hold_from is None:
+            return reverse(self.inner, length, memo)
+        split = length - self.hold_from
+        return concat(Const(self.end_value), reverse(self.inner, self.hold_from, memo), split, False, length)
+
+    def _scaled_frames(self, r, memo):
+        hold = None if self.hold_from is None else self.hold_from * r
+        return Pad(scale_frames(self.inner, r, memo), self.end * r, hold)
+
+    def _mapped(self, m, memo):
+        return Pad(map_leaves(self.inner, m, memo), self.end, self.hold_from)
+
+    def _emit(self, out, offset):
+        self.inner._emit(out, offset)
+
+
+class Concat(Track):
+    """Pieces played one after the other; piece j starts at ``pivots[j-1]``.
+
+    Parameters
+    ----------
+    pieces : tuple of Track, length J+1
+    pivots : array_like, shape (J,)
+        Strictly increasing frames where the next piece takes over.  Each
+        piece sees local time ``t - pivot``.
+    rights : array_like of bool, shape (J,)
+        True if, at exactly the pivot, the later piece is shown.
+    end : float
+    """
+
+    __slots__ = ("pieces", "pivots", "rights")
+
+    def __init__(self, pieces, pivots, rights, end: float):
+        self.pieces = tuple(pieces)
+        self.pivots = _frozen(pivots).reshape(-1)
+        self.rights = np.array(rights, dtype=bool).reshape(-1)
+        self.rights.flags.writeable = False
+        self.end = float(end)
+        self.start_value = self.pieces[0].start_value
+        self.end_value = self.pieces[-1].end_value
+        self.min_keys = sum(p.min_keys for p in self.pieces) + len(self.pivots)
+
+    def children(self):
+        return self.pieces
+
+    def sample(self, t):
+        idx = np.searchsorted(self.pivots, t, side="right")
+        # Pivots are strictly increasing, so at most the last passed pivot equals t.
+        at = idx > 0
+        at[at] = (t[at] == self.pivots[idx[at] - 1]) & ~self.rights[idx[at] - 1]
+        idx[at] -= 1
+        offsets = np.concatenate([[0.0], self.pivots])
+        out = _empty(len(t))
+        for j in np.unique(idx):
+            rows = idx == j
+            s = self.pieces[j].sample(t[rows] - offsets[j])
+            out.x[rows], out.v[rows], out.a[rows] = s
+        return out
+
+    def _reversed(self, length, memo):
+        bounds = np.concatenate([[0.0], self.pivots, [length]])
+        pieces = [reverse(p, bounds[j + 1] - bounds[j], memo) for j, p in enumerate(self.pieces)]
+        return Concat(pieces[::-1], (length - self.pivots)[::-1], ~self.rights[::-1], length)
+
+    def _scaled_frames(self, r, memo):
+        pieces = [scale_frames(p, r, memo) for p in self.pieces]
+        return Concat(pieces, self.pivots * r, self.rights, self.end * r)
+
+    def _mapped(self, m, memo):
+        return Concat([map_leaves(p, m, memo) for p in self.pieces], self.pivots, self.rights, self.end)
+
+    def _emit(self, out, offset):
+        self.pieces[0]._emit(out, offset)
+        for p, q in zip(self.pivots, self.pieces[1:]):
+            out.junction(offset + p, q.start_value)
+            q._emit(out, offset + p)
+
+
+class Repeat(Track):
+    """``n`` copies of a track, one every ``period`` frames, without copying it.
+
+    Parameters
+    ----------
+    inner : Track
+        ``inner.end <= period``.
+    n : int
+        Number of copies, >= 2.
+    period : float
+        Frames between copies, > 0.
+    right : bool
+        True if at a junction the later copy is shown.
+    end : float, optional
+        Defaults to ``(n - 1) * period + inner.end``.
+    """
+
+    __slots__ = ("inner", "n", "period", "right")
+
+    def __init__(self, inner: Track, n: int, period: float, right: bool = True, end: float | None = None):
+        self.inner, self.n, self.period, self.right = inner, int(n), float(period), bool(right)
+        self.end = float((self.n - 1) * self.period + inner.end if end is None else end)
+        self.start_value, self.end_value = inner.start_value, inner.end_value
+        self.min_keys = self.n * inner.min_keys + (self.n - 1)
+
+    def children(self):
+        return (self.inner,)
+
+    def sample(self, t):
+        P, last = self.period, self.n - 1
+        with np.errstate(invalid="ignore"):
+            k = np.floor(t / P) if self.right else np.ceil(t / P) - 1.0
+        k = np.clip(np.nan_to_num(k, nan=0.0), 0, last)
+        local = t - k * P
+        # t / P can round across an integer; settle the copy by exact comparisons.
+        if self.right:
+            down, up = (local < 0) & (k > 0), (local >= P) & (k < last)
+        else:
+            down, up = (local <= 0) & (k > 0), (local > P) & (k < last)
+        if down.any() or up.any():
+            k = k - down + up
+            local = t - k * P
+        return self.inner.sample(local)
+
+    def _reversed(self, length, memo):
+        # The last copy (it absorbs any hold after the repeat) comes first, then n-1 mirrored periods.
+        split = length - (self.n - 1) * self.period
+        first = reverse(self.inner, split, memo)
+        one = reverse(self.inner, self.period, memo)
+        rest = one if self.n == 2 else Repeat(one, self.n - 1, self.period, not self.right)
+        return concat(first, rest, split, right=not self.right, end=length)
+
+    def _scaled_frames(self, r, memo):
+        return Repeat(scale_frames(self.inner, r, memo), self.n, self.period * r, self.right, self.end * r)
+
+    def _mapped(self, m, memo):
+        return Repeat(map_leaves(self.inner, m, memo), self.n, self.period, self.right, self.end)
+
+    def _emit(self, out, offset):
+        for k in range(self.n):
+            if k:
+                out.junction(offset + k * self.period, self.inner.start_value)
+            self.inner._emit(out, offset + k * self.period)
+
+
+# ---------------------------------------------------------------------------
+# Constructors and memoized transformations
+
+
+def pad(track: Track, end: float, hold_from: float | None = None) -> Track:
+    """Give ``track`` a later end frame without changing its values.
+
+    Parameters
+    ----------
+    track : Track
+    end : float
+    hold_from : float, optional
+        See :class:`Pad`.
+
+    Returns
+    -------
+    Track
+    """
+    if isinstance(track, Const):
+        return Const(track.value, end)
+    if hold_from is None:
+        if end == track.end:
+            return track
+        if isinstance(track, Pad):
+            return Pad(track.inner, end, track.hold_from)
+    return Pad(track, end, hold_from)
+
+
+def concat(first: Track, second: Track, pivot: float, right: bool = True, end: float | None = None) -> Track:
+    """``first`` until ``pivot``, then ``second`` shifted to start at ``pivot``.
+
+    Parameters
+    ----------
+    first, second : Track
+        ``first.end <= pivot``.
+    pivot : float
+    right : bool
+        At exactly ``pivot``, show ``second`` (True) or ``first`` (False).
+    end : float, optional
+        Defaults to ``pivot + second.end``.
+
+    Returns
+    -------
+    Track
+    """
+    if end is None:
+        end = pivot + second.end
+    while isinstance(first, Pad) and first.hold_from is None:  # its end is invisible once something follows
+        first = first.inner
+    if isinstance(first, Concat) and len(first.pieces) < MAX_PIECES and first.pivots[-1] < pivot:
+        return Concat(first.pieces + (second,), np.append(first.pivots, pivot), np.append(first.rights, right), end)
+    return Concat((first, second), [pivot], [right], end)
+
+
+def _cached(memo: dict, key: tuple, node: Track, make: Callable[[], Track]) -> Track:
+    k = (id(node),) + key
+    hit = memo.get(k)
+    if hit is None:
+        hit = memo[k] = (node, make())  # keep node alive so its id stays unique
+    return hit[1]
+
+
+def reverse(track: Track, length: float, memo: dict | None = None) -> Track:
+    """Mirror a track about ``length / 2``: the result at t is ``track`` at ``length - t``.
+
+    Parameters
+    ----------
+    track : Track
+    length : float
+        Mirror length, >= ``track.end`` (the motion's length).
+    memo : dict, optional
+        Shared between calls so shared subtrees are mirrored once.
+
+    Returns
+    -------
+    Track
+        Ends at ``length``; left-continuous wherever ``track`` was right-continuous.
+    """
+    memo = {} if memo is None else memo
+    return _cached(memo, ("rev", length), track, lambda: pad(track._reversed(length, memo), length))
+
+
+def scale_frames(track: Track, r: float, memo: dict | None = None) -> Track:
+    """Stretch time by ``r > 0``: frames, pivots, periods and ramps times ``r``.
+
+    Parameters
+    ----------
+    track : Track
+    r : float
+    memo : dict, optional
+
+    Returns
+    -------
+    Track
+    """
+    memo = {} if memo is None else memo
+    return _cached(memo, ("frames", r), track, lambda: track._scaled_frames(r, memo))
+
+
+class LeafMap(NamedTuple):
+    """A change of angles that keeps the time structure of a track.
+
+    Attributes
+    ----------
+    key : hashable
+        Identifies the map in the memo.
+    leaf : callable
+        Leaf -> Leaf with the same frames.
+    value : callable
+        ndarray (3,) -> ndarray (3,), applied to the value of constant tracks.
+    """
+
+    key: object
+    leaf: Callable[[Leaf], Leaf]
+    value: Callable[[np.ndarray], np.ndarray]
+
+
+def map_leaves(track: Track, m: LeafMap, memo: dict | None = None) -> Track:
+    """Rebuild the graph with ``m`` applied to every leaf and constant.
+
+    Parameters
+    ----------
+    track : Track
+    m : LeafMap
+    memo : dict, optional
+
+    Returns
+    -------
+    Track
+    """
+    memo = {} if memo is None else memo
+    return _cached(memo, ("map", m.key), track, lambda: track._mapped(m, memo))
+
+
+def scale_extremes(track: Track, r: float, memo: dict | None = None) -> Track:
+    """Multiply every angle of the track by ``r``.
+
+    Parameters
+    ----------
+    track : Track
+    r : float
+    memo : dict, optional
+
+    Returns
+    -------
+    Track
+    """
+
+    def leaf(lf: Leaf) -> Leaf:
+        return Leaf(lf.start * r, lf.frames, lf.values * r, lf.methods, lf.ramps, lf.right)
+
+    return map_leaves(track, LeafMap(("extremes", r), leaf, lambda v: v * r), memo)
+
+
+def unwrap_angles(start: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Shift each value by a multiple of 360 to lie within 180 degrees of its predecessor.
+
+    Parameters
+    ----------
+    start : ndarray, shape (A,)
+        Anchor, left unchanged.
+    values : ndarray, shape (K, A)
+
+    Returns
+    -------
+    ndarray, shape (K, A)
+        A difference of exactly +-180 is kept, so a written half turn keeps its direction.
+    """
+    diffs = np.diff(np.vstack([start[None, :], values]), axis=0)
+    turns = np.where(np.abs(diffs) > 180.0, np.sign(diffs) * np.ceil((np.abs(diffs) - 180.0) / 360.0), 0.0)
+    return values - 360.0 * np.cumsum(turns, axis=0)
+
+
+def unwrap(track: Track, axes: tuple[bool, bool, bool], memo: dict | None = None) -> Track:
+    """Unwrap the listed axes inside every leaf (see :func:`unwrap_angles`).
+
+    Parameters
+    ----------
+    track : Track
+    axes : tuple of 3 bool
+    memo : dict, optional
+
+    Returns
+    -------
+    Track
+    """
+    ax = np.array(axes, dtype=bool)
+
+    def leaf(lf: Leaf) -> Leaf:
+        values = np.array(lf.values)
+        values[:, ax] = unwrap_angles(lf.start[ax], values[:, ax])
+        return Leaf(lf.start, lf.frames, values, lf.methods, lf.ramps, lf.right)
+
+    # Start values are anchors, and a constant track is nothing but a start value.
+    return map_leaves(track, LeafMap(("unwrap", tuple(ax)), leaf, lambda v: v), memo)
+
+
+# ---------------------------------------------------------------------------
+# Materialization and inspection
+
+
+class _Emitter:
+    """Collects a flat keyframe listing, refusing to grow past ``limit``."""
+
+    def __init__(self, start: np.ndarray, limit: int):
+        self.keys: list = []
+        self.limit = limit
+        self.cur = start
+        self.last = 0.0
+
+    def add(self, frame, value, method, ramp):
+        if len(self.keys) >= self.limit:
+            raise MotionError(f"the keyframe listing exceeds the limit of {self.limit} keyframes")
+        self.keys.append((float(frame), tuple(float(x) for x in value), method, float(ramp)))
+        self.cur, self.last = value, frame
+
+    def _at_step(self) -> bool:
+        """True if the last knot is the end of a zero-length segment (a velocity barrier)."""
+        if not self.keys:
+            return False
+        before = self.keys[-2][0] if len(self.keys) > 1 else 0.0
+        return before == self.keys[-1][0]
+
+    def hold_until(self, frame):
+        """Constant until ``frame``.
+
+        The hold is a LINEAR segment of zero displacement; it stays constant
+        only if both its ends have velocity 0, so it must start at the track's
+        start or at a step (a repeated keyframe is added to make one).
+        """
+        if self.last < frame:
+            if self.keys and not self._at_step():
+                self.add(self.last, self.cur, "LINEAR", RAMP)
+            self.add(frame, self.cur, "LINEAR", RAMP)
+
+    def junction(self, frame, start):
+        """A junction of + or *: a step, which also stops the velocity adjustment."""
+        self.hold_until(frame)
+        if not (self._at_step() and np.array_equal(self.cur, start)):
+            self.add(frame, start, "LINEAR", RAMP)
+
+
+def materialize(track: Track, limit: int) -> tuple[tuple, list]:
+    """Flatten a track into one keyframe list that evaluates to the same angles.
+
+    Junctions appear as zero-length steps, which also stop the LINEAR velocity
+    adjustment from crossing them, exactly like the junction they came from.
+
+    Parameters
+    ----------
+    track : Track
+    limit : int
+        Most keyframes allowed.
+
+    Returns
+    -------
+    start : tuple of 3 float
+    keys : list of (frame, (x, y, z), method_name, ramp)
+
+    Raises
+    ------
+    MotionError
+        If the listing would exceed ``limit`` (checked before building it when possible).
+    """
+    if track.min_keys > limit:
+        raise MotionError(
+            f"the keyframe listing would have at least {track.min_keys} keyframes, more than the limit of {limit}"
+        )
+    out = _Emitter(track.start_value, limit)
+    track._emit(out, 0.0)
+    out.hold_until(track.end)
+    return tuple(float(x) for x in track.start_value), out.keys
+
+
+class Footprint(NamedTuple):
+    """What a motion really stores.
+
+    Attributes
+    ----------
+    nodes : int
+        Distinct track nodes.
+    keyframes : int
+        Keyframes stored in distinct leaves.
+    """
+
+    nodes: int
+    keyframes: int
+
+
+def footprint(tracks) -> Footprint:
+    """Count distinct nodes and stored keyframes reachable from some tracks.
+
+    Parameters
+    ----------
+    tracks : iterable of Track
+
+    Returns
+    -------
+    Footprint
+    """
+    seen: dict[int, Track] = {}
+    stack = list(tracks)
+    keys = 0
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen[id(node)] = node
+        if isinstance(node, Leaf):
+            keys += len(node.frames)
+        stack.extend(node.children())
+    return Footprint(len(seen), keys)
