@@ -117,6 +117,11 @@ class Checker:
                     self._check_scope(p.body, scope, primitive=p)
                 self.final = True
                 self._check_scope(p.body, scope, primitive=p)
+                _, psig, _ = self.primitives[p.name.name]
+                for default in psig.defaults.values():
+                    if isinstance(default, A.Node):
+                        self.expr(default)
+                self._check_recursion(p)
                 self.final = False
                 prim, sig, _ = self.primitives[p.name.name]
                 for slot in sig.slots:
@@ -131,6 +136,23 @@ class Checker:
         if self.errors:
             raise LigDiagnostics(self.errors)
         return Checked(prog, main, self.primitives, self.types, self.scenes, self.warnings)
+
+    def _check_recursion(self, p: A.PrimitiveDef) -> None:
+        """A PRIMITIVE may not call itself, directly or through others (it would never end)."""
+        calls = {}
+        for q in self.program.primitives:
+            calls[q.name.name] = {n for n in _prim_calls(q)}
+        seen, stack = set(), [(c, c) for c in calls.get(p.name.name, ())]
+        while stack:
+            name, first = stack.pop()
+            if name == p.name.name:
+                node = next((n for n in _prim_call_nodes(p) if n.name == first), p)
+                self.err(node, f"PRIMITIVE {p.name.name} calls itself (through {first}), so it would never end")
+                return
+            if name in seen:
+                continue
+            seen.add(name)
+            stack.extend((c, first) for c in calls.get(name, ()))
 
     def _primitive_scope(self, p: A.PrimitiveDef) -> Scope:
         scope = Scope(f"PRIMITIVE {p.name.name}")
@@ -739,6 +761,22 @@ def _names_used(node) -> set:
             out.add(n.name)
         stack.extend(children(n))
     return out
+
+
+def _prim_call_nodes(node) -> list:
+    from liganimate.lang.structure import children
+
+    out, stack = [], [node]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, A.PrimCall):
+            out.append(n)
+        stack.extend(children(n))
+    return out
+
+
+def _prim_calls(node) -> set:
+    return {n.name for n in _prim_call_nodes(node)}
 
 
 def check(program: A.Program) -> Checked:

@@ -227,6 +227,10 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
                 word, at = opened[-1]
                 oline, _ = _line_col(text, at)
                 hint = f"the {word} opened at line {oline} must be closed with {_CLOSER[word]} first"
-        elif closers and tok.type in ("NAME",) and "ASSIGN_OP" not in expected:
-            hint = None
+        elif closers:
+            opened = _open_blocks(text, tok.start_pos)
+            if opened:
+                word, at = opened[-1]
+                oline, _ = _line_col(text, at)
+                hint = f"the {word} opened at line {oline} is not closed; add {_CLOSER[word]}"
     return Diagnostic(source.filename, pos, message, hint, source=source.text)

@@ -42,14 +42,14 @@ def decode(data: bytes, filename: str) -> str:
         good = data[: exc.start].decode("utf-8", errors="replace")
         line = good.count("\n") + 1
         col = len(good) - (good.rfind("\n") + 1) + 1
-        shown = good.splitlines()[-1] if good and not good.endswith("\n") else ""
+        shown = data.decode("utf-8", errors="replace")
         raise LigDiagnostics([
             Diagnostic(
                 filename,
                 Pos(line, col, line, col + 1),
                 f"the file is not valid UTF-8 (byte 0x{data[exc.start]:02x} at offset {exc.start})",
                 "save the file as UTF-8; a degree sign written by an old editor is a common cause",
-                source=shown + "\ufffd",
+                source=shown,
             )
         ]) from None
     if text.startswith("\ufeff"):

@@ -55,10 +55,42 @@ def check_depth(roots: list, source) -> None:
             stack.append((child, depth + 1))
 
 
+#: Blocks (DO, IF, scenes) nested deeper than this are refused: Python, which
+#: runs the compiled program, allows only 20 statically nested blocks.
+MAX_BLOCKS = 15
+
+
 def group_blocks(body: list, source) -> list:
     """Check nesting depth, then nest DO loops in every statement list."""
     check_depth(body, source)
-    return _group_list(body, source)
+    grouped = _group_list(body, source)
+    _check_blocks(grouped, source)
+    return grouped
+
+
+def _check_blocks(body: list, source) -> None:
+    stack = [(s, 1) for s in body]
+    while stack:
+        node, depth = stack.pop()
+        inner = []
+        if isinstance(node, A.Do):
+            inner = node.body
+        elif isinstance(node, A.If):
+            inner = list(node.then) + list(node.orelse or [])
+        elif isinstance(node, A.Scene):
+            inner = list(node.init) + list(node.body)
+        elif isinstance(node, A.PrimitiveDef):
+            inner = node.body
+        else:
+            continue
+        if depth > MAX_BLOCKS:
+            raise LigDiagnostics([Diagnostic(
+                source.filename, node.pos,
+                f"blocks (DO, IF, scenes) are nested more than {MAX_BLOCKS} deep here",
+                "move the inner part into a loop of its own or a PRIMITIVE",
+                source=source.text,
+            )])
+        stack.extend((s, depth + 1) for s in inner)
 
 
 def _group_list(stmts: list, source) -> list:
