@@ -505,7 +505,9 @@ class Repeat(Track):
 
     def _reversed(self, length, memo):
         # The last copy (it absorbs any hold after the repeat) comes first, then n-1 mirrored periods.
-        split = length - (self.n - 1) * self.period
+        # Written so that split is exactly one period when length is this repeat's n * period,
+        # the usual case, even when the frames are too large to subtract exactly.
+        split = self.period + (length - self.n * self.period)
         first = reverse(self.inner, split, memo)
         one = reverse(self.inner, self.period, memo)
         rest = one if self.n == 2 else Repeat(one, self.n - 1, self.period, not self.right)
