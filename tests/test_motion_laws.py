@@ -398,6 +398,23 @@ def test_velocity_is_continuous_where_linear_adjusts(spec):
 
 
 @PROFILE
+@given(leaf_tracks())
+def test_linear_chains_never_overshoot(spec):
+    spec = {j: (s, [(f, v, "LINEAR") for f, v, _ in keys]) for j, (s, keys) in spec.items()}
+    m = Motion.from_tracks(spec)
+    for j, (start, keys) in spec.items():
+        knots_ = [(0.0, np.array(start))] + [(f, np.array(v)) for f, v, _ in keys]
+        for (f0, v0), (f1, v1) in zip(knots_, knots_[1:]):
+            if f1 == f0:
+                continue
+            t = np.linspace(f0, f1, 33)[1:-1]
+            x, v, _ = m.evaluate_full(t, [j])
+            lo, hi = np.minimum(v0, v1), np.maximum(v0, v1)
+            assert np.all((x[:, 0] >= lo - 1e-9) & (x[:, 0] <= hi + 1e-9))
+            assert np.all(v[:, 0] * np.sign(v1 - v0) >= -1e-9)
+
+
+@PROFILE
 @given(leaf_tracks(joints=[1]))
 def test_hand_reversed_keyframes_give_the_mirrored_motion(spec):
     """The velocity adjustment is symmetric: writing the keyframes backwards is reversal."""
