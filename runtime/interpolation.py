@@ -115,6 +115,10 @@ class Method:
             np.broadcast_to(self._d2e(u), u.shape).astype(float),
         )
 
+    def __reduce__(self):
+        # Pickled by name: the curves are lambdas, and a registered name means the same curve.
+        return (get, (self.name,))
+
     def __repr__(self) -> str:
         return f"Method({self.name!r}, reverse={self.reverse!r})"
 

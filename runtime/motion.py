@@ -114,6 +114,16 @@ class Motion:
     __slots__ = ("_tracks", "_length", "_expr")
 
     def __init__(self, tracks: Mapping[int, tr.Track], expr: tuple, length: float | None = None):
+        """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
+
+        Parameters
+        ----------
+        tracks : mapping of int to Track
+        expr : tuple
+            The expression node :meth:`describe` renders.
+        length : float, optional
+            Defaults to the largest track end.
+        """
         self._tracks = dict(sorted(tracks.items()))
         self._length = float(
             length if length is not None else max((t.end for t in self._tracks.values()), default=0.0)
@@ -197,6 +207,17 @@ class Motion:
     # -- algebra ----------------------------------------------------------
 
     def __add__(self, other: "Motion") -> "Motion":
+        """``self + other``: ``other`` played after this motion (see :func:`concat`).
+
+        Parameters
+        ----------
+        other : Motion
+
+        Returns
+        -------
+        Motion
+            Of length ``self.length + other.length``.
+        """
         if not isinstance(other, Motion):
             return NotImplemented
         la, lb = self._length, other._length

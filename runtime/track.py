@@ -88,6 +88,12 @@ class Track:
         raise NotImplementedError
 
     def children(self) -> tuple["Track", ...]:
+        """Nodes this one evaluates (for inspection).
+
+        Returns
+        -------
+        tuple of Track
+        """
         return ()
 
     # Transformations are written per node and reached through the memoized

@@ -457,3 +457,13 @@ def test_unwrapping_keeps_a_half_turn_direction_and_fixed_axes():
     u = m.unwrapped({1: (True, False, True)})
     _, keys = u.keyframes(1)
     assert [k[1] for k in keys] == [(180.0, 350.0, -180.0), (190.0, 10.0, -160.0)]
+
+
+def test_motions_pickle_by_method_name(walk):
+    import pickle
+
+    m = 3 * walk + walk.scale_frames(-2).scale_extremes(0.5)
+    back = pickle.loads(pickle.dumps(m))
+    t = np.linspace(-1, m.length + 1, 101)
+    np.testing.assert_array_equal(back.evaluate(t), m.evaluate(t))
+    assert back.describe() == m.describe()
