@@ -15,6 +15,7 @@ import struct
 import subprocess
 import tempfile
 import zlib
+from fractions import Fraction
 from typing import Iterable
 
 import numpy as np
@@ -22,10 +23,11 @@ import numpy as np
 from .errors import RenderError
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
-# Chosen by measurement on flat-shaded 640x480 frames (see
-# docs/semantics-render.md): the Up filter turns runs of identical rows into
-# zeros and zlib's RLE strategy at level 1 compresses those as well as the
-# default strategy at level 6, several times faster.
+# Chosen by measurement on flat-shaded 640x480 frames of five figures
+# (filters None/Sub/Up x zlib levels 1-6 x default/RLE strategy): the Up
+# filter turns the many rows equal to the row above into zeros, and RLE at
+# level 1 then gives the smallest files of all (4.5 kB, as small as level 6
+# unfiltered) in 0.8 ms, where level 6 takes 2.1 ms.
 _PNG_LEVEL = 1
 _PNG_STRATEGY = zlib.Z_RLE
 _PNG_FILTER_UP = 2
@@ -170,7 +172,7 @@ def write_mp4(path, frames_iter: Iterable, fps: float) -> int:
     ``ffmpeg`` on PATH) and encoded with libx264, yuv420p, CRF 18, with
     ffmpeg's bit-exact flags and no metadata so that the same frames give
     the same bytes with the same ffmpeg.  Odd image sizes are padded by one
-    black pixel on the right/bottom (yuv420p needs even sizes).
+    white pixel on the right/bottom (yuv420p needs even sizes).
 
     Parameters
     ----------
@@ -201,10 +203,13 @@ def write_mp4(path, frames_iter: Iterable, fps: float) -> int:
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(dir=folder, prefix="." + os.path.basename(path) + ".", suffix=".tmp")
     os.close(fd)
+    # An exact rational rate, so e.g. 29.97 is not rounded by ffmpeg's parser.
+    frac = Fraction(fps).limit_denominator(1_000_000)
+    rate = f"{frac.numerator}/{frac.denominator}"
     cmd = [
         exe, "-hide_banner", "-nostdin", "-loglevel", "error", "-y",
-        "-f", "rawvideo", "-pix_fmt", "gray", "-s", f"{W}x{H}", "-framerate", repr(fps), "-i", "pipe:0",
-        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+        "-f", "rawvideo", "-pix_fmt", "gray", "-s", f"{W}x{H}", "-framerate", rate, "-i", "pipe:0",
+        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white",
         "-c:v", "libx264", "-preset", "medium", "-crf", "18", "-pix_fmt", "yuv420p",
         "-map_metadata", "-1", "-fflags", "+bitexact", "-flags:v", "+bitexact", "-flags:a", "+bitexact",
         "-movflags", "+faststart", "-f", "mp4", tmp,
@@ -215,17 +220,20 @@ def write_mp4(path, frames_iter: Iterable, fps: float) -> int:
         with tempfile.TemporaryFile() as err:
             proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=err)
             try:
-                for frame in _chain_checked(first, frames, (H, W)):
-                    proc.stdin.write(np.ascontiguousarray(frame).data)
-                    n += 1
-                proc.stdin.close()
-            except BrokenPipeError:
-                pass
+                try:
+                    for frame in _chain_checked(first, frames, (H, W)):
+                        proc.stdin.write(np.ascontiguousarray(frame).data)
+                        n += 1
+                except BrokenPipeError:
+                    pass  # ffmpeg stopped early; its exit status and message say why
+                finally:
+                    with contextlib.suppress(BrokenPipeError):
+                        proc.stdin.close()
+                rc = proc.wait()
             except BaseException:
                 proc.kill()
                 proc.wait()
                 raise
-            rc = proc.wait()
             if rc != 0:
                 err.seek(0)
                 msg = err.read().decode("utf-8", "replace").strip().splitlines()
@@ -235,6 +243,7 @@ def write_mp4(path, frames_iter: Iterable, fps: float) -> int:
                 )
         with open(tmp, "rb+") as f:
             os.fsync(f.fileno())
+        os.chmod(tmp, 0o666 & ~_UMASK)
         os.replace(tmp, path)
     finally:
         with contextlib.suppress(FileNotFoundError):
