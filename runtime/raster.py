@@ -261,9 +261,10 @@ def _expand(offset, wstart, step, tag, count, ends):
     starts = ends - count
     pix = np.repeat(offset - starts, count)
     pix += iar[:n]
-    # 1/z = wstart + (i - start) * step for fragment i; anchoring at
-    # fragment 0 saves a pass, and its rounding (under 1e-11 relative) is
-    # far below the key's 1e-6 resolution.
+    # 1/z = wstart + (i - start) * step for fragment i.  Anchoring the
+    # ramp at fragment 0 instead saves two passes; its extra rounding is
+    # about 1e-16 * start * |step| (start < _CHUNK + W, and |step| at most
+    # the triangle's 1/z range), far below the key's 1e-6 resolution.
     w = np.repeat(step, count)
     w *= far[:n]
     w += np.repeat(wstart - starts * step, count)
