@@ -249,13 +249,17 @@ class Checker:
                 self.err(args[3], f"{target} cannot be joined to itself: the model would contain a cycle",
                          f"join a copy: make another model from {target} first")
 
+    def _define_as(self, name: A.Name, t: str, message: str) -> None:
+        """Declare ``name`` implicitly with type ``t``, or report ``message`` if it has another type."""
+        current = self.scope.types.get(name.name)
+        if current is None:
+            self.scope.types[name.name] = t
+            self.scope.implicit.add(name.name)
+        elif current != t:
+            self.err(name, message.format(name=name.name, noun=T.NOUN[current]))
+
     def _s_KeyframeAssign(self, s, context):
-        t = self.scope.types.get(s.target.name)
-        if t is None:
-            self.scope.types[s.target.name] = T.MOTION
-            self.scope.implicit.add(s.target.name)
-        elif t != T.MOTION:
-            self.err(s.target, f"{s.target.name} is {T.NOUN[t]}; keyframes belong to a MOTION")
+        self._define_as(s.target, T.MOTION, "{name} is {noun}; keyframes belong to a MOTION")
         self._want(s.joint, T.INTEGER, "a joint identifier")
         self._want(s.index, T.INTEGER, "a keyframe number")
         self._keyframe(s.keyframe)
@@ -322,12 +326,7 @@ class Checker:
             self.scene.assigned.add(s.name.name)
 
     def _model_target(self, name: A.Name) -> None:
-        t = self.scope.types.get(name.name)
-        if t is None:
-            self.scope.types[name.name] = T.MODEL
-            self.scope.implicit.add(name.name)
-        elif t != T.MODEL:
-            self.err(name, f"{name.name} is {T.NOUN[t]}, not a MODEL")
+        self._define_as(name, T.MODEL, "{name} is {noun}, not a MODEL")
 
     def _joint_args(self, args: list, node, in_block: bool) -> None:
         if len(args) < 6 or len(args) > 8:
@@ -368,12 +367,7 @@ class Checker:
             self.err(e, f"a {role} segment is a GRAPHICAL object or a MODEL, not {T.NOUN[t]}")
 
     def _s_MotionBlock(self, s, context):
-        t = self.scope.types.get(s.name.name)
-        if t is None:
-            self.scope.types[s.name.name] = T.MOTION
-            self.scope.implicit.add(s.name.name)
-        elif t != T.MOTION:
-            self.err(s.name, f"{s.name.name} is {T.NOUN[t]}, not a MOTION")
+        self._define_as(s.name, T.MOTION, "{name} is {noun}, not a MOTION")
         seen = {}
         for j in s.joints:
             self._want(j.joint, T.INTEGER, "a joint identifier")
@@ -415,9 +409,7 @@ class Checker:
         self._want(s.length, T.INTEGER, "a scene length (a number of ticks)")
         if s.sameframe is not None:
             self._want(s.sameframe, T.INTEGER, "a number of ticks per image")
-        self._in_body = True
         self._stmts(s.body, "scene-body")
-        self._in_body = False
         self.scene = outer
         info.models = sorted(n for n in _names_used(s) if self.scope.types.get(n) == T.MODEL)
 

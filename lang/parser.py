@@ -221,13 +221,7 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
     else:
         message = f"unexpected {_describe_token(tok)}; expected {_describe_expected(expected)}"
         closers = {e for e in expected if e.startswith("END")}
-        if tok.type.startswith("END") and tok.type not in expected:
-            opened = _open_blocks(text, tok.start_pos)
-            if opened:
-                word, at = opened[-1]
-                oline, _ = _line_col(text, at)
-                hint = f"the {word} opened at line {oline} must be closed with {_CLOSER[word]} first"
-        elif closers:
+        if (tok.type.startswith("END") and tok.type not in expected) or closers:
             opened = _open_blocks(text, tok.start_pos)
             if opened:
                 word, at = opened[-1]

@@ -11,8 +11,6 @@ from lark import Token, Transformer
 
 from . import ast as A
 
-_KEYWORDS_KEPT = frozenset()
-
 
 def _tpos(tok: Token) -> A.Pos:
     return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column)

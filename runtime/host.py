@@ -405,14 +405,15 @@ class Runtime:
         base = m.base
         tracks: dict = {}
         for j in base.joints:
-            start, kfs = self._guard(at, base.keyframes, j)
-            tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None) for i, kf in enumerate(kfs)}]
+            # Keep each keyframe's ramp so a stretched motion stays stretched.
+            start, kfs = self._guard(at, lambda joint: base.keyframes(joint, with_ramps=True), j)
+            tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None, kf[3]) for i, kf in enumerate(kfs)}]
         for joint, k, frame, position, method, eat in edits:
             entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
             if k == 0:
                 entry[0] = position
             else:
-                entry[1][k] = (frame, position, method or "LINEAR", eat)
+                entry[1][k] = (frame, position, method or "LINEAR", eat, None)
         spec = {}
         for joint, (start, kfs) in tracks.items():
             n = max(kfs) if kfs else 0
@@ -427,7 +428,7 @@ class Runtime:
                     eat = seq[i][3] if seq[i][3] is not None else at
                     self.fail(eat, f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
                                    f"before keyframe {i} at frame {seq[i - 1][0]:g}")
-            spec[joint] = (start, [(f, p, meth) for f, p, meth, _ in seq])
+            spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
         motion = self._guard(at, M.Motion.from_tracks, spec)
         m._cache = motion
         return motion
