@@ -55,6 +55,10 @@ class Checked:
     types: dict  # id(expr node) -> type
     scenes: dict  # id(Scene node) -> SceneInfo
     warnings: list
+    libraries: list = field(default_factory=list)  # Library objects, in order of first LOAD
+    loads: dict = field(default_factory=dict)  # id(Load node) -> (library index, [names])
+    loaded_names: dict = field(default_factory=dict)  # NAME -> library index (values and primitives)
+    loaded_primitives: dict = field(default_factory=dict)  # NAME -> library index
 
 
 class _Stop(Exception):
@@ -64,8 +68,14 @@ class _Stop(Exception):
 class Checker:
     """Walks the tree once per scope, twice to settle implicit number types."""
 
-    def __init__(self, program: A.Program):
+    def __init__(self, program: A.Program, path: str | None = None, stack: tuple = ()):
         self.program = program
+        self.path = path if path is not None else program.filename
+        self.stack = stack
+        self.libraries: list = []
+        self.loads: dict = {}
+        self.loaded_names: dict = {}
+        self.loaded_primitives: dict = {}
         self.errors: list = []
         self.warnings: list = []
         self.types: dict = {}
@@ -107,8 +117,12 @@ class Checker:
         for name, sig in sigs.items():
             if name not in self.primitives:
                 self.primitives[name] = (None, sig, None)
-        self.signatures = sigs
         main = Scope("main program")
+        try:
+            self._loads(main, sigs)
+        except _Stop:
+            raise LigDiagnostics(self.errors)
+        self.signatures = sigs
         try:
             # First passes settle implicit types; the final pass reports.
             for p in prog.primitives:
@@ -135,7 +149,94 @@ class Checker:
             pass
         if self.errors:
             raise LigDiagnostics(self.errors)
-        return Checked(prog, main, self.primitives, self.types, self.scenes, self.warnings)
+        return Checked(prog, main, self.primitives, self.types, self.scenes, self.warnings,
+                       self.libraries, self.loads, self.loaded_names, self.loaded_primitives)
+
+    # -------------------------------------------------------------- LOAD
+    def _loads(self, main: Scope, sigs: dict) -> None:
+        """Bring in what the top-level LOAD statements name, before anything is checked."""
+        from . import library as L
+
+        self.final = True
+        defined: dict = {}  # NAME -> Pos where the program defines it before a LOAD
+        origin: dict = {}  # NAME -> (library path, Pos of the LOAD)
+        self.top_loads = {id(s) for s in self.program.body if isinstance(s, A.Load)}
+        for stmt in self.program.body:
+            if not isinstance(stmt, A.Load):
+                for name in _defined_names(stmt):
+                    defined.setdefault(name.name, name.pos)
+                continue
+            try:
+                path = L.resolve(stmt.library, self.path)
+                lib = L.load(stmt.library, path, self.stack + _here(self.path))
+            except L.LibraryNotFound as exc:
+                hint = None
+                if not L.is_path(stmt.library):
+                    hint = did_you_mean(stmt.library.lower(), L.stdlib_names()) or (
+                        "the standard libraries are " + ", ".join(L.stdlib_names()))
+                    hint += "; a file of your own is named by a path such as 'lib/mine.lig'"
+                self.err(stmt.library_pos, f"there is no library '{stmt.library}' (looked for {exc.tried[0]})", hint)
+                continue
+            except L.LibraryCycle as exc:
+                self.err(stmt.library_pos, "libraries load each other in a circle: " + " -> ".join(exc.chain),
+                         "move what both need into a third library")
+                continue
+            except LigDiagnostics as exc:
+                self.errors.extend(exc.diagnostics)
+                self.err(stmt.library_pos, f"the library '{stmt.library}' has errors (shown above)")
+                continue
+            except OSError as exc:
+                self.err(stmt.library_pos, f"the library '{stmt.library}' cannot be read: {exc.strerror or exc}")
+                continue
+            if lib.scenes:
+                self.err(stmt.library_pos, f"{lib.display} defines scenes, so it is a program, not a library",
+                         "a library holds models, motions and primitives only")
+                continue
+            index = next((i for i, known in enumerate(self.libraries) if known.path == lib.path), None)
+            if index is None:
+                index = len(self.libraries)
+                self.libraries.append(lib)
+            self.warnings.extend(w for w in lib.warnings if w not in self.warnings)
+            wanted = stmt.names or [A.Name(stmt.library_pos, n) for n in lib.default_names()]
+            taken = []
+            for name in wanted:
+                n = name.name
+                if not lib.offers(n):
+                    hint = did_you_mean(n, list(lib.types) + list(lib.signatures))
+                    self.err(name, f"{lib.display} has no {n}", hint or "it offers " + ", ".join(lib.default_names()))
+                    continue
+                if n in origin:
+                    where_path, where = origin[n]
+                    if where_path == lib.path:
+                        self.warn(name, f"{n} is already loaded from {lib.display} at line {where.line}; "
+                                        "this LOAD of it does nothing")
+                        continue
+                    self.err(name, f"{n} is already loaded from another library at line {where.line}",
+                             "load it from one library only")
+                    continue
+                if n in defined:
+                    self.err(name, f"{n} is already defined at line {defined[n].line}, so loading it would overwrite it",
+                             "load libraries first, or rename your own definition")
+                    continue
+                if n in sigs and n in lib.signatures:
+                    self.err(name, f"{n} is already a primitive here, so it cannot be loaded",
+                             "rename your own PRIMITIVE")
+                    continue
+                if n in lib.signatures:
+                    sigs[n] = lib.signatures[n]
+                    self.primitives[n] = (None, lib.signatures[n], None)
+                    self.loaded_primitives[n] = index
+                elif n in sigs:
+                    self.err(name, f"{n} is a primitive here, so it cannot also be a loaded variable")
+                    continue
+                else:
+                    main.types[n] = lib.types[n]
+                    main.declared[n] = name.pos
+                origin[n] = (lib.path, stmt.pos)
+                self.loaded_names[n] = index
+                taken.append(n)
+            self.loads[id(stmt)] = (index, taken)
+        self.final = False
 
     def _check_recursion(self, p: A.PrimitiveDef) -> None:
         """A PRIMITIVE may not call itself, directly or through others (it would never end)."""
@@ -459,6 +560,11 @@ class Checker:
     def _s_Stop(self, s, context):
         pass
 
+    def _s_Load(self, s, context):
+        if self.primitive is not None or context != "top" or id(s) not in self.top_loads:
+            self.err(s, "LOAD belongs at the top level of the program, outside loops, IFs, scenes and primitives",
+                     "a library is loaded once, before the program runs")
+
     def _s_Return(self, s, context):
         if self.primitive is None:
             self.err(s, "RETURN belongs in a PRIMITIVE")
@@ -771,6 +877,36 @@ def _prim_calls(node) -> set:
     return {n.name for n in _prim_call_nodes(node)}
 
 
-def check(program: A.Program) -> Checked:
-    """Check a parsed program; raise LigDiagnostics listing every error found."""
-    return Checker(program).run()
+def check(program: A.Program, path: str | None = None, stack: tuple = ()) -> Checked:
+    """Check a parsed program; raise LigDiagnostics listing every error found.
+
+    ``path`` is the program's file (relative LOADs start from its folder);
+    ``stack`` the libraries being loaded around it.
+    """
+    return Checker(program, path, stack).run()
+
+
+def _here(path: str | None) -> tuple:
+    """The loading file as the LOAD cycle check compares it (absolute), or nothing for text."""
+    import os
+
+    return (os.path.abspath(path),) if path and not path.startswith("<") else ()
+
+
+def _defined_names(stmt) -> list:
+    """The names a statement (and the statements inside it) declares or assigns."""
+    out = []
+    if isinstance(stmt, A.Decl):
+        out.extend(stmt.names)
+    elif isinstance(stmt, (A.Assign, A.KeyframeAssign)):
+        out.append(stmt.target)
+    elif isinstance(stmt, (A.ModelBlock, A.MotionBlock)):
+        out.append(stmt.name)
+    elif isinstance(stmt, A.Do):
+        out.append(stmt.var)
+    for attr in ("body", "then", "orelse"):
+        inner = getattr(stmt, attr, None)
+        if isinstance(inner, list) and not isinstance(stmt, A.PrimitiveDef):
+            for s in inner:
+                out.extend(_defined_names(s))
+    return out

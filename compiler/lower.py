@@ -73,6 +73,14 @@ class Lowerer:
             "",
         ]
         body_start = len(self.lines)
+        for i, lib in enumerate(self.c.libraries):
+            # The library's own compiled module travels inside this one, so the
+            # generated file stays standalone; it runs once, when first needed.
+            self.emit(f"_LIB{i} = _host.Library({lib.display!r}, {lib.python!r})")
+        for name, i in sorted(self.c.loaded_primitives.items()):
+            self.emit(f"_prim_{name} = _LIB{i}.primitive({name!r})")
+        if self.c.libraries:
+            self.emit("")
         for name, (pdef, sig, scope) in sorted(self.c.primitives.items()):
             if pdef is not None:
                 self.primitive(pdef, sig, scope)
@@ -300,6 +308,14 @@ class Lowerer:
         # In the main program, hand the variables over so Python users see them.
         self.emit("rt.stop(locals())" if where == "main" and getattr(self, "scope_types", None) is None else "rt.stop(None)")
 
+    def s_Load(self, s, where):
+        index, names = self.c.loads.get(id(s), (None, ()))
+        for name in names:
+            if name not in self.c.loaded_primitives:
+                self.emit(f"{name} = _LIB{index}.value(rt, {name!r}, {self.at(s)})")
+        if not any(n not in self.c.loaded_primitives for n in names):
+            self.emit("pass")
+
     def s_Return(self, s, where):
         self.emit("return _g.result()")
 
@@ -367,7 +383,8 @@ class Lowerer:
             if slot.keyword in given:
                 args.append(f"{slot.param}={self.expr(given[slot.keyword])}")
         pdef = self.c.primitives[e.name][0]
-        fn = f"_prim_{e.name}" if pdef is not None else f"rt.prim_{e.name}"
+        own = pdef is not None or e.name in self.c.loaded_primitives
+        fn = f"_prim_{e.name}" if own else f"rt.prim_{e.name}"
         return f"{fn}(rt, {', '.join(args)})"
 
     def e_JointExpr(self, e):

@@ -312,8 +312,9 @@ class DrawPoly(Node):
 
 @dataclass(slots=True)
 class Load(Node):
-    source: str
-    names: list  # of Name; empty means everything
+    library: str  # as written, without its quotes
+    library_pos: Pos
+    names: list  # of Name; empty means the library's models, motions, graphics and primitives
 
 
 @dataclass(slots=True)

@@ -18,6 +18,11 @@ from .diagnostics import Diagnostic, LigDiagnostics
 # it was a comment, but today the writer probably meant a variable called C.
 _LOOKS_LIKE_CODE = re.compile(r"^[Cc]\s*(=|:-|:=|\[)")
 _PRIMITIVE_HEAD = re.compile(r"(?im)^[ \t*]*PRIMITIVE[ \t]+([A-Za-z][A-Za-z0-9_]*)")
+# LOAD statements, found before parsing for the same reason as PRIMITIVE heads:
+# a loaded primitive's name must already be a PRIM_NAME when the lexer meets it.
+_LOAD = re.compile(
+    r"(?i)(?:^|[;\n])[ \t]*LOAD\s+(?:'([^'\n]*)'|((?:[A-Za-z][A-Za-z0-9_]*\s*,\s*)*[A-Za-z][A-Za-z0-9_]*)\s+FROM\s+'([^'\n]*)')")
+_BRACES = re.compile(r"\{[^}]*\}")
 
 
 @dataclass
@@ -32,6 +37,21 @@ class Source:
     def primitive_names(self) -> set:
         """Names of the PRIMITIVEs this file defines (found before parsing, see lang/lig.lark)."""
         return {m.group(1).upper() for m in _PRIMITIVE_HEAD.finditer(self.lexed)}
+
+    def load_requests(self) -> list:
+        """The LOAD statements, found before parsing: ``[(library, names or None), ...]``.
+
+        Only a hint for the lexer (which loaded names are primitives); the
+        parsed LOAD statements are what the checker acts on.
+        """
+        text = _BRACES.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), self.lexed)
+        found = []
+        for m in _LOAD.finditer(text):
+            if m.group(1) is not None:
+                found.append((m.group(1), None))
+            else:
+                found.append((m.group(3), [n.strip().upper() for n in m.group(2).split(",")]))
+        return found
 
 
 def decode(data: bytes, filename: str) -> str:

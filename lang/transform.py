@@ -204,6 +204,11 @@ class ToAst(Transformer):
     def shoot_stmt(self, children):
         return A.Shoot(span(children))
 
+    def load_stmt(self, children):
+        lib = children[-1]
+        names = [_name(t) for t in children[1:-1] if t.type in ("NAME", "PRIM_NAME")]
+        return A.Load(span(children), lib.value[1:-1], _tpos(lib), names)
+
     def stop_stmt(self, children):
         return A.Stop(span(children))
 

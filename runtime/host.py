@@ -23,6 +23,7 @@ from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
 from . import figure as F
 from . import motion as M
 from .errors import LigError
+from .library import Library  # noqa: F401  (generated modules name it _host.Library)
 from .values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
 _StopProgram = type("_StopProgram", (Exception,), {})
@@ -88,6 +89,7 @@ class Program:
             rt.variables = self.main(rt) or {}
         except _StopProgram:
             pass  # STOP handed over its variables
+        rt.variables = {k: rt.finished(v) for k, v in rt.variables.items() if not k.startswith("_")}
         for scene_id, (_, _, at) in sorted(rt.scenes.items()):
             rt.warn(at, f"scene {scene_id} is defined but never shot", "add SHOOTSCENES after the scenes")
 
@@ -380,6 +382,22 @@ class Runtime:
         return posed.with_figure(fig) if posed is not None else fig
 
     # ------------------------------------------------------------- motions
+    def finished(self, value):
+        """A variable's value as Python code or another program sees it: keyframe edits become a Motion."""
+        if isinstance(value, KeyframeEdits):
+            return self._apply_edits(value, value.edit[5])
+        return value
+
+    def for_program(self, program: "Program") -> "Runtime":
+        """This runtime, reporting positions in ``program`` (a library's primitive runs with it)."""
+        view = self.__dict__.get("_views", {}).get(id(program))
+        if view is None:
+            view = object.__new__(Runtime)
+            view.__dict__ = dict(self.__dict__)
+            view.program = program
+            self.__dict__.setdefault("_views", {})[id(program)] = view
+        return view
+
     def _motion(self, m, at) -> M.Motion:
         if isinstance(m, KeyframeEdits):
             return self._apply_edits(m, at)
