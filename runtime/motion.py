@@ -32,6 +32,9 @@ __all__ = [
 
 DEFAULT_KEYFRAME_LIMIT = 100_000
 
+# Derived motions remembered per motion (see Motion._derive).
+_DERIVED_MAX = 8
+
 
 def _joint_id(joint) -> int:
     if isinstance(joint, bool):
@@ -111,7 +114,7 @@ class Motion:
     ``n * m`` and the methods below.  All operations return new motions.
     """
 
-    __slots__ = ("_tracks", "_length", "_expr")
+    __slots__ = ("_tracks", "_length", "_expr", "_derived")
 
     def __init__(self, tracks: Mapping[int, tr.Track], expr: tuple, length: float | None = None):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
@@ -129,6 +132,36 @@ class Motion:
             length if length is not None else max((t.end for t in self._tracks.values()), default=0.0)
         )
         self._expr = expr
+        self._derived: dict | None = None
+
+    def _derive(self, key: tuple, keep, make) -> "Motion":
+        """``make()``, remembered under ``key`` (a few entries per motion).
+
+        A scene body such as ``ANIMATE H USING WALK <SCALE FRAMES 2>`` runs
+        once a tick; remembering the result hands back the same motion
+        object every tick, so the renderer evaluates its frames in one batch
+        and the per-tick cost of rebuilding the track graph disappears.
+        Motions are immutable, so the cached result is always right.  ``keep``
+        is held alongside (an operand whose ``id`` is part of the key).
+        """
+        d = self._derived
+        if d is None:
+            d = self._derived = {}
+        hit = d.get(key)
+        if hit is not None and hit[0] is keep:
+            return hit[1]
+        out = make()
+        if len(d) >= _DERIVED_MAX:
+            d.pop(next(iter(d)))
+        d[key] = (keep, out)
+        return out
+
+    def __getstate__(self):
+        return (self._tracks, self._length, self._expr)
+
+    def __setstate__(self, state):
+        self._tracks, self._length, self._expr = state
+        self._derived = None
 
     # -- construction -----------------------------------------------------
 
@@ -220,6 +253,9 @@ class Motion:
         """
         if not isinstance(other, Motion):
             return NotImplemented
+        return self._derive(("+", id(other)), other, lambda: self._concat(other))
+
+    def _concat(self, other: "Motion") -> "Motion":
         la, lb = self._length, other._length
         tracks = {}
         for j in self._tracks.keys() | other._tracks.keys():
@@ -256,6 +292,9 @@ class Motion:
         n = int(n)
         if n < 0:
             raise MotionError(f"a motion cannot be repeated a negative number of times ({n})")
+        return self._derive(("*", n), None, lambda: self._repeat(n))
+
+    def _repeat(self, n: int) -> "Motion":
         expr = ("*", n, self._expr)
         if n == 0:
             return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr)
@@ -316,6 +355,9 @@ class Motion:
         r = _real(r, "the SCALE FRAMES factor")
         if r == 0:
             raise MotionError("SCALE FRAMES 0 would squeeze the motion into no time", hint="use a non-zero factor")
+        return self._derive(("frames", r), None, lambda: self._scale_frames(r))
+
+    def _scale_frames(self, r: float) -> "Motion":
         s, L = abs(r), self._length * abs(r)
         memo: dict = {}
         tracks = {j: tr.scale_frames(t, s, memo) for j, t in self._tracks.items()}
@@ -335,6 +377,9 @@ class Motion:
         Motion
         """
         r = _real(r, "the SCALE EXTREMES factor")
+        return self._derive(("extremes", r), None, lambda: self._scale_extremes(r))
+
+    def _scale_extremes(self, r: float) -> "Motion":
         memo: dict = {}
         tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
         return Motion(tracks, ("extremes", r, self._expr), self._length)
