@@ -233,3 +233,50 @@ def test_library_values_are_shared_not_aliased(libs):
     s1 = v1["ARM"].locations[1]
     s2 = v2["ARM"].locations[1]
     assert np.allclose(s1, 2 * s2)
+
+
+def cli(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "liganimate", *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_archive_writes_a_library_that_loads_back(libs):
+    write(libs, """\
+        LOAD ARM, WAVE FROM 'lib/arm.lig'
+        {@ BIGARM: the arm, twice as big }
+        BIGARM :- ARM <SCALE MODEL 2>
+        W2 = 1000000000 * WAVE
+        INITIALIZE SCENE 1
+        STARTSCENE LENGTH 2
+        ANIMATE BIGARM FROM 0 TO 1 USING W2
+        ENDSCENE
+        IF 1 > 0 THEN SHOOTSCENES
+    """, "scene.lig")
+    (libs / "out").mkdir()
+    r = cli("archive", "scene.lig", "-o", "out/mine.lig", cwd=libs)
+    assert r.returncode == 0, r.stderr
+    text = (libs / "out" / "mine.lig").read_text()
+    assert "LOAD ARM, WAVE FROM '../lib/arm.lig'" in text  # re-aimed from the archive's folder
+    assert "STARTSCENE" not in text and "SHOOTSCENES" not in text
+    assert "{@ W2: MOTION defined in scene.lig }" in text
+    v = execute(write(libs, "LOAD 'out/mine.lig'\n", "user.lig"))
+    assert v["W2"].length == 10 * 1000000000
+    assert np.allclose(v["BIGARM"].locations[1], 2 * execute(write(libs, "LOAD ARM FROM 'lib/arm.lig'\n", "u2.lig"))["ARM"].locations[1])
+    r = cli("lib", "out/mine.lig", cwd=libs)
+    assert r.returncode == 0, r.stderr
+    assert "BIGARM  MODEL      the arm, twice as big" in r.stdout
+
+
+def test_archive_of_a_bad_program_writes_nothing(libs):
+    write(libs, "X = 1 +\n", "bad.lig")
+    r = cli("archive", "bad.lig", "-o", "bad_lib.lig", cwd=libs)
+    assert r.returncode == 1 and "bad.lig:2:1: error" in r.stderr
+    assert not (libs / "bad_lib.lig").exists()
+
+
+def test_lib_lists_the_standard_library(libs):
+    r = cli("lib", cwd=libs)
+    assert r.returncode == 0, r.stderr
+    for name in library.stdlib_names():
+        assert f"{name}  (stdlib/{name}.lig)" in r.stdout
+    r = cli("lib", "nope", cwd=libs)
+    assert r.returncode == 1 and "there is no library 'nope'" in r.stderr and "Traceback" not in r.stderr

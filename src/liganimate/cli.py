@@ -135,6 +135,51 @@ def cmd_compile(args) -> int:
     return _guarded(go)
 
 
+def cmd_archive(args) -> int:
+    def go():
+        from liganimate.compiler import compile_source
+        from liganimate.compiler.archive import archive_text
+        from liganimate.lang.source import prepare
+        from liganimate.runtime.imagefiles import _atomic
+
+        out = args.output or os.path.splitext(os.path.basename(args.file))[0] + "_lib.lig"
+        text = archive_text(args.file, out)
+        # The archive must itself load cleanly before it replaces anything.
+        compile_source(prepare(text, out), path=os.path.abspath(out))
+        with _atomic(out, True) as fh:
+            fh.write(text.encode("utf-8"))
+        print(f"wrote {out}", file=sys.stderr)
+        return 0
+
+    return _guarded(go)
+
+
+def cmd_lib(args) -> int:
+    def go():
+        from liganimate.compiler import library as L
+        from liganimate.runtime.errors import LigError
+
+        names = [args.library] if args.library else L.stdlib_names()
+        for i, name in enumerate(names):
+            try:
+                path = L.resolve(name, os.path.join(os.getcwd(), "-"))
+            except L.LibraryNotFound as exc:
+                raise LigError(f"there is no library '{name}' (looked for {exc.tried[0]})",
+                               "the standard libraries are " + ", ".join(L.stdlib_names())) from None
+            lib = L.load(name, path)
+            if i:
+                print()
+            print(f"{name}  ({lib.display})")
+            offered = lib.default_names()
+            width = max((len(n) for n in offered), default=0)
+            for n in offered:
+                kind = lib.kind_of(n)
+                print(f"  {n:<{width}}  {kind:<9}  {lib.descriptions.get(n, '(no description)')}")
+        return 0
+
+    return _guarded(go)
+
+
 def cmd_plot(args) -> int:
     def go():
         from liganimate.runtime.plot import plot_motion
@@ -166,6 +211,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file")
     p.add_argument("-o", "--output", metavar="FILE.py")
     p.set_defaults(func=cmd_compile)
+    p = sub.add_parser("lib", help="list the standard library's models, motions and primitives")
+    p.add_argument("library", nargs="?", help="one library (a standard name or a path)")
+    p.set_defaults(func=cmd_lib)
+    p = sub.add_parser("archive", help="write a program's models and motions out as a library file")
+    p.add_argument("file")
+    p.add_argument("-o", "--output", metavar="LIB.lig", help="default: <stem>_lib.lig")
+    p.set_defaults(func=cmd_archive)
     p = sub.add_parser("plot", help="draw a motion's joint angle curves with matplotlib")
     p.add_argument("file")
     p.add_argument("motion")
