@@ -18,6 +18,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedTok
 
 from . import ast as A
 from .diagnostics import Diagnostic, LigDiagnostics
+from .lexer import LigLexer
 from .source import Source, prepare
 from .structure import group_blocks
 from .transform import ToAst
@@ -53,7 +54,7 @@ def build_parser() -> Lark:
     return Lark(
         grammar,
         parser="lalr",
-        lexer="contextual",
+        lexer=LigLexer,
         postlex=_PrimitiveNames(),
         transformer=ToAst(),
         maybe_placeholders=False,

@@ -1,0 +1,91 @@
+"""Our one-scanner lexer against Lark's own contextual lexer: the same trees, the same failures.
+
+lang/lexer.py re-implements what Lark's contextual lexer decides (which
+terminal a word or operator is in each parser state) with one regular
+expression. Two implementations of one rule, cross-checked: on every example
+and on mutated programs, both parsers must build equal syntax trees, or
+both must reject the text at the same place.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import os
+from importlib import resources
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from lark import Lark
+from lark.exceptions import UnexpectedInput
+
+from liganimate.lang import parser as P
+from liganimate.lang.source import prepare
+from liganimate.lang.transform import ToAst
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+_spec = importlib.util.spec_from_file_location("liganimate_fuzz_compile_lexer", os.path.join(ROOT, "benchmarks", "fuzz_compile.py"))
+fuzz = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(fuzz)
+SOURCES = fuzz.example_sources()
+
+
+@functools.lru_cache(maxsize=1)
+def stock_parser() -> Lark:
+    grammar = resources.files("liganimate.lang").joinpath("lig.lark").read_text(encoding="utf-8")
+    return Lark(grammar, parser="lalr", lexer="contextual", postlex=P._PrimitiveNames(),
+                transformer=ToAst(), maybe_placeholders=False)
+
+
+def outcome(parser: Lark, text: str):
+    source = prepare(text, "x.lig")
+    token = P._primitive_names.set(frozenset(P.BUILTIN_PRIMITIVES | source.primitive_names()))
+    try:
+        return ("tree", parser.parse(source.lexed))
+    except UnexpectedInput as exc:
+        return ("error", getattr(exc, "line", None), getattr(exc, "column", None))
+    finally:
+        P._primitive_names.reset(token)
+
+
+def test_the_parser_uses_our_lexer():
+    assert P.build_parser().options.lexer is P.LigLexer
+
+
+def test_examples_give_identical_trees():
+    for name, text in SOURCES:
+        ours, stock = outcome(P.build_parser(), text), outcome(stock_parser(), text)
+        assert ours[0] == "tree", name
+        assert ours == stock, name
+
+
+def test_contextual_words_and_operators():
+    cases = [
+        "MOTION = 3\nMODEL M\nX = MOTION + 1\n",  # a type word used as a variable
+        "PRINT = 2\nPRINT PRINT\n",
+        "LOAD = 1\nY = LOAD\n",
+        "WIDTH = 2\nVIEW WIDTH = WIDTH\n",
+        "IF X <= 2 THEN Y = 1\nG :- BOX WIDTH 1, HEIGHT 1, DEPTH 1 <TRANS (0, 0, 1)>\n",
+        "M = W <SCALE FRAMES -2, SCALE EXTREMES 0.5>\nFRAMES = 3\nX = 2\n",
+        "IF A /= B THEN X = A / B\n",
+        "SYNCHRONISE = 1\nM = SYNCHRONIZE A, B\n",
+        "X = 1 @ 2\n",
+        "X = { never closed\n",
+        "Y = 'open\n",
+    ]
+    for text in cases:
+        assert outcome(P.build_parser(), text) == outcome(stock_parser(), text), text
+
+
+unit = st.floats(min_value=0.0, max_value=1.0, exclude_max=True, allow_nan=False)
+mutation = st.tuples(st.sampled_from(fuzz.MUTATIONS), unit, unit, st.integers(0, 1 << 16))
+
+
+@settings(max_examples=300, derandomize=True, deadline=None, database=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(example=st.integers(0, len(SOURCES) - 1), mutations=st.lists(mutation, min_size=1, max_size=3))
+def test_mutated_programs_agree(example, mutations):
+    name, text = SOURCES[example]
+    for kind, u, v, pick in mutations:
+        text = fuzz.mutate(text, kind, u, v, pick)
+    assert outcome(P.build_parser(), text) == outcome(stock_parser(), text)
