@@ -1,0 +1,488 @@
+"""Goals for goal-directed positioning: what they ask, their residuals and Jacobians.
+
+Three kinds of goal put a part of a figure somewhere in the world
+(``docs/semantics-ik.md`` has the formulas):
+
+* :class:`PointGoal` -- a point of a link onto a world point;
+* :class:`PlaneGoal` -- a point of a link onto a world plane;
+* :class:`AxisGoal` -- a direction fixed in a link along a world direction.
+
+Each has a weight.  As in Badler, Manoochehri and Walters' POSIT only the
+ratios of the weights matter, and a weight of 0 switches a goal off: the
+solvers minimise ``sum_i w_i |r_i|^2 / max_j w_j``.
+
+Targets, plane data, directions and weights may carry a leading batch
+dimension ``B`` (many independent solves of the same goal structure, e.g. a
+moving target); :class:`GoalStack` packs a list of goals into arrays and
+evaluates every residual and its analytic Jacobian for the whole batch at
+once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from .errors import LigError
+from .figure import Figure
+from .ikmodel import IKModel, matvec3
+
+__all__ = [
+    "GoalError",
+    "PointGoal",
+    "PlaneGoal",
+    "AxisGoal",
+    "GoalStack",
+    "resolve_link",
+]
+
+
+class GoalError(LigError):
+    """A goal that cannot be posed: an unknown link, a zero normal or direction, a negative weight."""
+
+
+@dataclass(frozen=True)
+class PointGoal:
+    """Put a point of a link onto a world point.
+
+    Parameters
+    ----------
+    link : str or int
+        The link: a name (case-insensitive; with several links of that name,
+        the first met depth first, as FIGURE ... MAIN LINK chooses) or an
+        index into ``figure.links``.
+    target : array_like, shape (3,) or (B, 3)
+        The world point.
+    point : array_like, shape (3,), default (0, 0, 0)
+        The point in the link's own coordinates (those of its shape, so a
+        SCALE MODEL keeps it on the same spot of the segment).
+    weight : float or array_like of shape (B,), default 1
+        Non-negative; 0 switches the goal off.
+    """
+
+    link: str | int
+    target: object
+    point: object = (0.0, 0.0, 0.0)
+    weight: object = 1.0
+
+
+@dataclass(frozen=True)
+class PlaneGoal:
+    """Put a point of a link onto a world plane.
+
+    Parameters
+    ----------
+    link : str or int
+        As for :class:`PointGoal`.
+    origin : array_like, shape (3,) or (B, 3)
+        A point of the plane.
+    normal : array_like, shape (3,) or (B, 3)
+        The plane's normal (any non-zero length).
+    point : array_like, shape (3,), default (0, 0, 0)
+        The point in the link's own coordinates.
+    weight : float or array_like of shape (B,), default 1
+    """
+
+    link: str | int
+    origin: object
+    normal: object
+    point: object = (0.0, 0.0, 0.0)
+    weight: object = 1.0
+
+
+@dataclass(frozen=True)
+class AxisGoal:
+    """Turn a direction fixed in a link onto a world direction.
+
+    Parameters
+    ----------
+    link : str or int
+        As for :class:`PointGoal`.
+    axis : array_like, shape (3,)
+        The direction in the link's own coordinates (any non-zero length).
+    direction : array_like, shape (3,) or (B, 3)
+        The world direction (any non-zero length).
+    weight : float or array_like of shape (B,), default 1
+
+    Notes
+    -----
+    Its residual is the chord between the two unit vectors times the link's
+    length (:func:`ikmodel.link_lengths`; the mean link length for a link
+    of length 0), so an axis goal weighs like a point goal at the link's far
+    end, and the solve does not change when the figure is scaled.
+    """
+
+    link: str | int
+    axis: object
+    direction: object
+    weight: object = 1.0
+
+
+Goal = PointGoal | PlaneGoal | AxisGoal
+
+
+def resolve_link(figure: Figure, ref) -> tuple[int, str | None]:
+    """The index of the link a goal names.
+
+    Parameters
+    ----------
+    figure : Figure
+    ref : str or int
+        A link name (case-insensitive) or an index into ``figure.links``.
+
+    Returns
+    -------
+    index : int
+    warning : str or None
+        When several links bear the name: which one was taken (the first met
+        depth first from the original main link, as FIGURE ... MAIN LINK
+        does) and which joints attach the others.
+
+    Raises
+    ------
+    GoalError
+        For an unknown name or an index out of range.
+    """
+    if isinstance(ref, str):
+        found = figure.links_named(ref)
+        if not found:
+            names = sorted({l.name.upper() for l in figure.links if l.name is not None})
+            raise GoalError(f"the model has no link named {ref}.", hint=f"its links are named {', '.join(names) or 'nothing'}")
+        warning = None
+        if len(found) > 1:
+            others = ", ".join(str(figure.parent_joint_of(i).id) for i in found[1:])
+            up = figure.parent_joint_of(found[0])
+            which = "the original main link" if up is None else f"the one attached by joint {up.id}"
+            warning = (
+                f"{len(found)} links are named {ref}; the goal uses {which}, the first met depth first "
+                f"(the others are attached by joint {others})."
+            )
+        return found[0], warning
+    if isinstance(ref, bool) or not isinstance(ref, (int, np.integer)):
+        raise GoalError(f"a goal's link must be a link name or a link number, not {ref!r}.")
+    if not 0 <= int(ref) < figure.n_links:
+        raise GoalError(f"the model has no link number {int(ref)}; it has links 0 to {figure.n_links - 1}.")
+    return int(ref), None
+
+
+def _vectors(value, what: str, batch: int | None) -> np.ndarray:
+    """``value`` as finite vectors of shape (3,) or (B, 3)."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise GoalError(f"{what} must be a vector of three numbers, not {value!r}.") from None
+    if v.shape[-1:] != (3,) or v.ndim > 2:
+        raise GoalError(f"{what} must be a vector of three numbers (or a batch of them), not an array of shape {v.shape}.")
+    if not np.all(np.isfinite(v)):
+        raise GoalError(f"{what} must be finite.")
+    return v
+
+
+def _unit(v: np.ndarray, what: str) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    if np.any(n == 0.0):
+        raise GoalError(f"{what} must not be the zero vector.")
+    return v / n
+
+
+def _weights(value, what: str) -> np.ndarray:
+    try:
+        w = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise GoalError(f"{what} must be a number, not {value!r}.") from None
+    if w.ndim > 1 or not np.all(np.isfinite(w)):
+        raise GoalError(f"{what} must be a finite number (or a batch of them).")
+    if np.any(w < 0):
+        raise GoalError(f"{what} must not be negative.", hint="only the ratios of weights matter; 0 switches a goal off")
+    return w
+
+
+def batch_size(goals: Sequence[Goal]) -> int | None:
+    """The batch size the goals' data imply (None when nothing is batched).
+
+    Raises
+    ------
+    GoalError
+        If two batched values disagree on the size.
+    """
+    sizes = set()
+    for g in goals:
+        fields = {
+            PointGoal: ("target", "weight"),
+            PlaneGoal: ("origin", "normal", "weight"),
+            AxisGoal: ("direction", "weight"),
+        }[type(g)]
+        for f in fields:
+            v = np.asarray(getattr(g, f))
+            if (f == "weight" and v.ndim == 1) or (f != "weight" and v.ndim == 2):
+                sizes.add(v.shape[0])
+    if len(sizes) > 1:
+        raise GoalError(f"the goals' batched values disagree on the batch size ({', '.join(map(str, sorted(sizes)))}).")
+    return sizes.pop() if sizes else None
+
+
+class GoalStack:
+    """A list of goals packed into arrays, evaluated for a batch of poses.
+
+    Parameters
+    ----------
+    model : IKModel
+    goals : sequence of PointGoal, PlaneGoal or AxisGoal
+    batch : int
+        ``B``; every goal value is broadcast to it.
+
+    Attributes
+    ----------
+    n_goals : int
+    n_rows : int
+        ``M``: 3 per point goal, 1 per plane goal, 3 per axis goal.
+    weights : numpy.ndarray, shape (B, n_goals)
+        As given, in the order of ``goals``.
+    warnings : list of str
+        Ambiguous link names (see :func:`resolve_link`).
+
+    Raises
+    ------
+    GoalError
+        For an unknown link, a malformed vector, a zero normal, axis or
+        direction, or a negative weight.
+    """
+
+    def __init__(self, model: IKModel, goals: Sequence[Goal], batch: int):
+        self.model = model
+        B = int(batch)
+        self.batch = B
+        self.goals = tuple(goals)
+        self.warnings: list[str] = []
+        scale = model.link_scale
+        pts = {"link": [], "local": [], "target": [], "w": [], "index": []}
+        pls = {"link": [], "local": [], "origin": [], "normal": [], "w": [], "index": []}
+        axs = {"link": [], "local": [], "dir": [], "ell": [], "w": [], "index": []}
+        positive = model.lengths[model.lengths > 0]
+        mean_length = float(positive.mean()) if positive.size else model.length
+        for i, g in enumerate(self.goals):
+            if not isinstance(g, (PointGoal, PlaneGoal, AxisGoal)):
+                raise GoalError(f"goal {i + 1} is not a point, plane or axis goal.")
+            what = f"goal {i + 1}"
+            link, warning = resolve_link(model.figure, g.link)
+            if warning:
+                self.warnings.append(f"{what}: {warning}")
+            w = np.broadcast_to(_weights(g.weight, f"the weight of {what}"), (B,))
+            if isinstance(g, AxisGoal):
+                a = _vectors(g.axis, f"the axis of {what}", None)
+                if a.ndim != 1:
+                    raise GoalError(f"the axis of {what} is a direction in the link and cannot be batched.")
+                # A mirrored link (negative scale) turns its own directions round.
+                axs["local"].append(_unit(a, f"the axis of {what}") * np.sign(scale[link]))
+                axs["dir"].append(np.broadcast_to(_unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)))
+                ell = model.lengths[link]
+                axs["ell"].append(ell if ell > 0 else mean_length)
+                d = axs
+            else:
+                point = _vectors(g.point, f"the link point of {what}", None)
+                if point.ndim != 1:
+                    raise GoalError(f"the link point of {what} cannot be batched.")
+                local = point * scale[link]  # shape coordinates to link frame
+                if isinstance(g, PointGoal):
+                    pts["target"].append(np.broadcast_to(_vectors(g.target, f"the target of {what}", B), (B, 3)))
+                    d = pts
+                else:
+                    pls["origin"].append(np.broadcast_to(_vectors(g.origin, f"the plane point of {what}", B), (B, 3)))
+                    pls["normal"].append(np.broadcast_to(_unit(_vectors(g.normal, f"the plane normal of {what}", B), f"the plane normal of {what}"), (B, 3)))
+                    d = pls
+                d["local"].append(local)
+            d["link"].append(link)
+            d["w"].append(w)
+            d["index"].append(i)
+
+        def stack(lst, shape):
+            return np.stack(lst, axis=1) if lst else np.zeros(shape)
+
+        self.p_link = np.array(pts["link"], dtype=np.intp)
+        self.p_local = np.array(pts["local"]).reshape(-1, 3)
+        self.p_target = stack(pts["target"], (B, 0, 3))
+        self.q_link = np.array(pls["link"], dtype=np.intp)
+        self.q_local = np.array(pls["local"]).reshape(-1, 3)
+        self.q_origin = stack(pls["origin"], (B, 0, 3))
+        self.q_normal = stack(pls["normal"], (B, 0, 3))
+        self.h_link = np.array(axs["link"], dtype=np.intp)
+        self.h_local = np.array(axs["local"]).reshape(-1, 3)
+        self.h_dir = stack(axs["dir"], (B, 0, 3))
+        self.h_ell = np.array(axs["ell"], dtype=float)
+        G, Q, H = len(self.p_link), len(self.q_link), len(self.h_link)
+        self.n_goals = G + Q + H
+        self.n_rows = 3 * G + Q + 3 * H
+        # Goal order: points, planes, axes; ``order`` maps it back to the user's.
+        self.order = np.array(pts["index"] + pls["index"] + axs["index"], dtype=np.intp)
+        w_packed = stack(pts["w"] + pls["w"] + axs["w"], (B, 0))
+        self.weights = np.empty_like(w_packed)
+        self.weights[:, self.order] = w_packed
+        wmax = w_packed.max(axis=1, keepdims=True) if self.n_goals else np.zeros((B, 1))
+        # Only ratios matter: normalising by the largest weight makes the
+        # cost, and so the damping and stopping rules, independent of the
+        # weights' overall size.
+        wn = np.divide(w_packed, wmax, out=np.zeros_like(w_packed), where=wmax > 0)
+        self._active_packed = wn > 0
+        rows_per_goal = np.array([3] * G + [1] * Q + [3] * H, dtype=np.intp)
+        self.row_weight = np.repeat(np.sqrt(wn), rows_per_goal, axis=1)  # (B, M)
+        self._downstream_p = model.downstream[:, self.p_link].T.astype(float)  # (G, V)
+        self._downstream_q = model.downstream[:, self.q_link].T.astype(float)
+        self._downstream_h = model.downstream[:, self.h_link].T.astype(float)
+
+    # ------------------------------------------------------------ batches
+
+    def take(self, idx: np.ndarray) -> "GoalStack":
+        """The same goals for the batch elements ``idx`` only.
+
+        Parameters
+        ----------
+        idx : numpy.ndarray of int, shape (B',)
+
+        Returns
+        -------
+        GoalStack
+            Sharing every unbatched array with this one.
+        """
+        out = object.__new__(GoalStack)
+        out.__dict__.update(self.__dict__)
+        out.batch = len(idx)
+        for name in ("p_target", "q_origin", "q_normal", "h_dir", "weights", "_active_packed", "row_weight"):
+            setattr(out, name, getattr(self, name)[idx])
+        return out
+
+    @property
+    def active(self) -> np.ndarray:
+        """Which goals count, shape (B, n_goals), in the user's order (weight above 0)."""
+        out = np.empty_like(self._active_packed)
+        out[:, self.order] = self._active_packed
+        return out
+
+    # ------------------------------------------------------------ evaluation
+
+    def _link_points(self, R, p, links, local):
+        return p[:, links] + matvec3(R[:, links], local)
+
+    def evaluate(self, R, p, t, omega=None, c=None):
+        """Weighted residuals, their Jacobian and each goal's distance.
+
+        Parameters
+        ----------
+        R, p : numpy.ndarray, shapes (B, n_links, 3, 3) and (B, n_links, 3)
+            Link frames from :meth:`IKModel.forward`.
+        t : numpy.ndarray, shape (B, 3), or None
+            Root translation (world), when translating.
+        omega, c : numpy.ndarray, shape (B, V, 3), optional
+            Variable axes and pivots from :meth:`IKModel.axes`; without
+            them no Jacobian is computed.
+
+        Returns
+        -------
+        r : numpy.ndarray, shape (B, M)
+            Residual rows, each times the square root of its goal's
+            normalised weight; the solvers minimise ``|r|^2 / 2``.
+        jac : numpy.ndarray, shape (B, M, n_params), or None
+            ``dr/dq``: per radian for angle variables, per figure length
+            for the translation variables (which are the translation over
+            :attr:`IKModel.length`).
+        dist : numpy.ndarray, shape (B, n_goals)
+            Unweighted, in the user's goal order: a point goal's distance,
+            a plane goal's absolute signed distance, an axis goal's angle
+            in radians times its length scale.  The tolerance applies to it.
+        """
+        m = self.model
+        B = R.shape[0]
+        V, Pn = m.n_vars, m.n_params
+        want_j = omega is not None
+        rows, jacs, dists = [], [], []
+        L = m.length
+
+        if len(self.p_link):
+            y = self._link_points(R, p, self.p_link, self.p_local)  # (B, G, 3)
+            res = m.to_world(y, t) - self.p_target
+            rows.append(res.reshape(B, 3 * len(self.p_link)))
+            dists.append(np.linalg.norm(res, axis=-1))
+            if want_j:
+                Jw = self._point_jacobian(y, omega, c, self._downstream_p)  # (B, G, 3, V)
+                Jp = np.zeros(Jw.shape[:3] + (Pn,))
+                Jp[..., :V] = Jw
+                if m.translate:
+                    Jp[..., V:] = np.eye(3) * L
+                jacs.append(Jp.reshape(B, 3 * len(self.p_link), Pn))
+
+        if len(self.q_link):
+            y = self._link_points(R, p, self.q_link, self.q_local)
+            n = self.q_normal
+            s = np.einsum("bqi,bqi->bq", n, m.to_world(y, t) - self.q_origin)
+            rows.append(s)
+            dists.append(np.abs(s))
+            if want_j:
+                Jw = self._point_jacobian(y, omega, c, self._downstream_q)  # (B, Q, 3, V)
+                Jq = np.zeros((B, len(self.q_link), Pn))
+                Jq[..., :V] = np.einsum("bqi,bqiv->bqv", n, Jw)
+                if m.translate:
+                    Jq[..., V:] = n * L
+                jacs.append(Jq)
+
+        if len(self.h_link):
+            vm = matvec3(R[:, self.h_link], self.h_local)  # model frame
+            vw = m.to_world_vectors(vm)
+            nv = np.linalg.norm(vw, axis=-1, keepdims=True)
+            u = vw / nv
+            ell = self.h_ell[:, None]
+            diff = u - self.h_dir
+            rows.append((diff * ell).reshape(B, 3 * len(self.h_link)))
+            chord = np.linalg.norm(diff, axis=-1)
+            dists.append(2.0 * np.arcsin(np.minimum(chord / 2.0, 1.0)) * self.h_ell)
+            if want_j:
+                dv = np.cross(omega[:, None], vm[:, :, None]) * self._downstream_h[None, :, :, None]  # (B, H, V, 3)
+                dv = m.to_world_vectors(dv)
+                # d(v/|v|) = (I - u u^T) dv / |v|
+                du = (dv - u[:, :, None] * np.einsum("bhi,bhvi->bhv", u, dv)[..., None]) / nv[:, :, None]
+                Jh = np.zeros((B, len(self.h_link), 3, Pn))
+                Jh[..., :V] = np.swapaxes(du, -1, -2) * self.h_ell[None, :, None, None]
+                jacs.append(Jh.reshape(B, 3 * len(self.h_link), Pn))
+
+        r = np.concatenate(rows, axis=1) if rows else np.zeros((B, 0))
+        r = r * self.row_weight
+        jac = None
+        if want_j:
+            jac = np.concatenate(jacs, axis=1) if jacs else np.zeros((B, 0, Pn))
+            jac = jac * self.row_weight[:, :, None]
+        packed = np.concatenate(dists, axis=1) if dists else np.zeros((B, 0))
+        dist = np.empty_like(packed)
+        dist[:, self.order] = packed
+        return r, jac, dist
+
+    def _point_jacobian(self, y, omega, c, down):
+        """World velocity of link points per radian of each variable, shape (B, N, 3, V)."""
+        # A point y moved by a variable turns about the variable's axis
+        # through its pivot: dy = omega x (y - c), zero if it does not move.
+        d = y[:, :, None, :] - c[:, None, :, :]  # (B, N, V, 3)
+        v = np.cross(omega[:, None], d) * down[None, :, :, None]
+        v = self.model.to_world_vectors(v)
+        return np.swapaxes(v, -1, -2)
+
+    def report(self, R, p, t) -> np.ndarray:
+        """Each goal's residual in its natural unit, for messages.
+
+        Parameters
+        ----------
+        R, p : numpy.ndarray
+            From :meth:`IKModel.forward`.
+        t : numpy.ndarray, shape (B, 3), or None
+
+        Returns
+        -------
+        numpy.ndarray, shape (B, n_goals)
+            In the user's goal order: a point goal's distance to its target
+            and a plane goal's distance to its plane (world units), an axis
+            goal's angle to its direction in degrees.
+        """
+        _, _, dist = self.evaluate(R, p, t)
+        out = dist.copy()
+        if len(self.h_link):
+            cols = self.order[len(self.p_link) + len(self.q_link):]
+            out[:, cols] = np.rad2deg(dist[:, cols] / self.h_ell)
+        return out

@@ -1,0 +1,396 @@
+"""A figure as the goal solvers see it: free variables, bounds, batched kinematics.
+
+Goal-directed positioning (``docs/semantics-ik.md``) moves some of a
+figure's joint axes, and optionally the whole figure, until parts of it are
+where goals ask.  :class:`IKModel` fixes, once per solve, which axes are free
+*variables* and precomputes everything about the tree that does not depend on
+the angles.  Its methods then work on a whole batch of poses at once (a
+leading dimension ``B``), so a thousand independent solves cost one pass of
+numpy per iteration, not a thousand.
+
+Conventions are the figure's (``docs/semantics-figure.md``): angles in the
+figure are degrees, ``R = Rz(az) Ry(ay) Rx(ax)``, poses are seen from the
+current main link.  The solvers' variables are the same angles in
+*radians*, so that a joint Jacobian column is "metres per radian" and
+steps are well scaled.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import kinematics as K
+from .figure import Figure
+
+__all__ = ["IKModel", "link_lengths", "figure_length", "matvec3"]
+
+
+def matvec3(M: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``M @ v`` for stacks of 3x3 matrices and 3-vectors, written out.
+
+    Parameters
+    ----------
+    M : numpy.ndarray, shape (..., 3, 3)
+    v : numpy.ndarray, shape (..., 3), broadcast against ``M``'s leading shape
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+
+    Notes
+    -----
+    numpy's batched ``matmul`` and ``einsum`` are several times slower than
+    these five elementwise operations for 3x3 blocks, and the solvers do
+    this in their inner loop.
+    """
+    return M[..., 0] * v[..., None, 0] + M[..., 1] * v[..., None, 1] + M[..., 2] * v[..., None, 2]
+
+
+def link_lengths(figure: Figure) -> np.ndarray:
+    """Each link's length: the largest distance between two of its joint locations.
+
+    Parameters
+    ----------
+    figure : Figure
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_links,)
+        In the link frame's units (joint locations, already scaled by SCALE
+        MODEL).  A link with fewer than two joints (a hand at the end of an
+        arm) has length 0: its shape is opaque, so its tip is unknown.
+    """
+    points: list[list[np.ndarray]] = [[] for _ in figure.links]
+    for j in figure.joints:
+        points[j.primary].append(j.loc1)
+        points[j.secondary].append(j.loc2)
+    out = np.zeros(figure.n_links)
+    for i, pts in enumerate(points):
+        if len(pts) > 1:
+            P = np.array(pts)
+            out[i] = np.max(np.linalg.norm(P[:, None] - P[None], axis=-1))
+    return out
+
+
+def figure_length(figure: Figure) -> float:
+    """The figure's characteristic length: the sum of its link lengths (1 if that is 0).
+
+    It scales the root translation variables, axis goals on zero-length
+    links and the default tolerance, so a solve of a figure scaled by ``r``
+    is the same solve with every length times ``r``.
+
+    Parameters
+    ----------
+    figure : Figure
+
+    Returns
+    -------
+    float
+    """
+    total = float(link_lengths(figure).sum())
+    return total if total > 0.0 else 1.0
+
+
+class IKModel:
+    """The figure's free variables, their bounds and batched kinematics.
+
+    Parameters
+    ----------
+    figure : Figure
+        Posed from its current main link, placed by its placement.
+    movable : array_like of bool, shape (n_joints, 3)
+        Which joint axes the solver may turn.  Axes whose extremes are a
+        single value (``min == max``, e.g. locked at ``(0, 0)``) are never
+        variables, whatever this says.
+    translate : bool
+        Whether the whole figure may also translate (POSIT's root
+        translation), adding three variables after the angles.
+
+    Attributes
+    ----------
+    var_joint, var_axis : numpy.ndarray of int, shape (V,)
+        Joint index (in joint order) and axis (0 = X, 1 = Y, 2 = Z) of each
+        angle variable, ordered from the joints farthest from the main link
+        to the nearest, X before Y before Z within a joint (the order CCD
+        visits them; see :meth:`IKModel.__init__`).
+    lower, upper : numpy.ndarray, shape (V,)
+        Bounds of the angle variables in radians; ``-inf``/``inf`` on free
+        axes (extremes spanning 360 degrees or more).
+    downstream : numpy.ndarray of bool, shape (V, n_links)
+        Whether each link moves with each variable (it lies on the far side
+        of the variable's joint from the main link).
+    sign : numpy.ndarray, shape (V,)
+        ``+1``, or ``-1`` for joints walked from secondary to primary
+        (FIGURE ... MAIN below the joint): turning such a joint turns the
+        primary side the opposite way.
+    length : float
+        :func:`figure_length`.
+    n_params : int
+        ``V`` plus 3 when translating.
+    """
+
+    def __init__(self, figure: Figure, movable, translate: bool = False):
+        self.figure = figure
+        J = figure.n_joints
+        movable = np.broadcast_to(np.asarray(movable, dtype=bool), (J, 3))
+        ext = figure.extremes  # (J, 3, 2) degrees
+        lo, hi = (ext[..., 0], ext[..., 1]) if J else (np.zeros((0, 3)), np.zeros((0, 3)))
+        free_range = hi - lo >= 360.0
+        is_var = movable & (hi > lo)
+
+        # Depth of each joint from the main link, and which links each joint moves.
+        depth = np.zeros(J, dtype=int)
+        for d, level in enumerate(figure.traversal):
+            depth[level.joints] = d
+        parent_of = np.full(figure.n_links, -1)
+        into = np.full(figure.n_links, -1)  # the joint through which the walk reaches each link
+        for level in figure.traversal:
+            parent_of[level.children] = level.parents
+            into[level.children] = level.joints
+        moves = np.zeros((J, figure.n_links), dtype=bool)
+        for link in range(figure.n_links):
+            # Walk up from the link to the main link, marking every joint passed.
+            cur = link
+            while cur != figure.main:
+                moves[into[cur], link] = True
+                cur = parent_of[cur]
+
+        # Variables: deepest joints first (stable within a depth, in joint
+        # order), X, Y, Z within a joint.  CCD relies on this order: turning
+        # a variable changes neither the axis nor the pivot of any variable
+        # visited after it in the same sweep.
+        order = sorted(range(J), key=lambda k: (-depth[k], k))
+        vj, va = [], []
+        for k in order:
+            for a in range(3):
+                if is_var[k, a]:
+                    vj.append(k)
+                    va.append(a)
+        self.var_joint = np.array(vj, dtype=np.intp)
+        self.var_axis = np.array(va, dtype=np.intp)
+        self.var_flat = self.var_joint * 3 + self.var_axis
+        V = len(vj)
+        self.n_vars = V
+        self.translate = bool(translate)
+        self.n_params = V + (3 if translate else 0)
+        free = free_range[self.var_joint, self.var_axis] if V else np.zeros(0, dtype=bool)
+        self.lower = np.where(free, -np.inf, np.deg2rad(lo[self.var_joint, self.var_axis]) if V else 0.0)
+        self.upper = np.where(free, np.inf, np.deg2rad(hi[self.var_joint, self.var_axis]) if V else 0.0)
+        self.downstream = moves[self.var_joint] if V else np.zeros((0, figure.n_links), dtype=bool)
+        rev = figure.reversed_joints
+        self.sign = np.where(rev[self.var_joint], -1.0, 1.0) if V else np.zeros(0)
+        self.var_primary = np.array([figure.joints[k].primary for k in vj], dtype=np.intp)
+        loc1, loc2 = figure.locations
+        self.var_loc1 = loc1[self.var_joint] if V else np.zeros((0, 3))
+        self._loc1, self._loc2, self._rev = loc1, loc2, rev
+        self._any_reversed = bool(rev.any())
+        self._near = np.where(rev[:, None], loc2, loc1)
+        self._far = np.where(rev[:, None], loc1, loc2)
+        self._levels = [
+            (int(l.joints[0]), int(l.parents[0]), int(l.children[0])) if len(l.joints) == 1 else (l.joints, l.parents, l.children)
+            for l in figure.traversal
+        ]
+        self.link_scale = np.asarray(figure.link_scales, dtype=float)
+        P = np.asarray(figure.placement, dtype=float)
+        self.A = P[:3, :3].copy()
+        self.b = P[:3, 3].copy()
+        self.placement_is_identity = bool(np.array_equal(P, np.eye(4)))
+        # Variables grouped by axis, with their joints, for :meth:`axes_trig`.
+        self._axis_vars = [
+            (np.flatnonzero(self.var_axis == a), self.var_joint[self.var_axis == a]) for a in range(3)
+        ]
+        self.lengths = link_lengths(figure)
+        self.length = figure_length(figure)
+        self.moves = moves  # (J, n_links): every joint, variable or not
+        self.parent_link = parent_of  # per link, the next link toward the main link (-1 for it)
+        self.into_joint = into  # per link, the joint joining it to parent_link (-1 for the main link)
+
+    # ------------------------------------------------------------ angles
+
+    def full_angles(self, q: np.ndarray, base: np.ndarray) -> np.ndarray:
+        """All joint angles in radians, the variables taken from ``q``.
+
+        Parameters
+        ----------
+        q : numpy.ndarray, shape (B, V)
+            Variable values, radians.
+        base : numpy.ndarray, shape (B, n_joints, 3) or (1, n_joints, 3)
+            Radians; supplies every axis that is not a variable.
+
+        Returns
+        -------
+        numpy.ndarray, shape (B, n_joints, 3)
+        """
+        B = q.shape[0]
+        a = np.broadcast_to(base.reshape(base.shape[0], -1), (B, base[0].size)).copy()
+        a[:, self.var_flat] = q
+        return a.reshape(B, self.figure.n_joints, 3)
+
+    def trig(self, q: np.ndarray, base_cos: np.ndarray, base_sin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Cosines and sines of all joint angles, computing only the variables' afresh.
+
+        Parameters
+        ----------
+        q : numpy.ndarray, shape (B, V)
+            Radians.
+        base_cos, base_sin : numpy.ndarray, shape (B, n_joints * 3) or (1, n_joints * 3)
+            Of the start angles (the axes that are not variables keep them).
+
+        Returns
+        -------
+        c, s : numpy.ndarray, shape (B, n_joints, 3)
+        """
+        B = q.shape[0]
+        shape = (B, self.figure.n_joints, 3)
+        c = np.broadcast_to(base_cos, (B, base_cos.shape[1])).copy()
+        s = np.broadcast_to(base_sin, (B, base_sin.shape[1])).copy()
+        # Sines and cosines are most of the cost of the kinematics, and most
+        # axes are not variables: only the variables' are recomputed.
+        c[:, self.var_flat] = np.cos(q)
+        s[:, self.var_flat] = np.sin(q)
+        return c.reshape(shape), s.reshape(shape)
+
+    # ------------------------------------------------------------ kinematics
+
+    def forward(self, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every link's rotation and origin in the model frame (main link at identity).
+
+        Parameters
+        ----------
+        angles : numpy.ndarray, shape (B, n_joints, 3)
+            Radians.
+
+        Returns
+        -------
+        R : numpy.ndarray, shape (B, n_links, 3, 3)
+        p : numpy.ndarray, shape (B, n_links, 3)
+            ``R[:, l] @ x + p[:, l]`` is link ``l``'s point ``x`` (link
+            frame) in the model frame.  The placement is not applied.
+        """
+        return self.forward_trig(np.cos(angles), np.sin(angles))
+
+    def forward_trig(self, c: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`forward` from the angles' cosines and sines (see :meth:`trig`).
+
+        Parameters
+        ----------
+        c, s : numpy.ndarray, shape (B, n_joints, 3)
+
+        Returns
+        -------
+        R : numpy.ndarray, shape (B, n_links, 3, 3)
+        p : numpy.ndarray, shape (B, n_links, 3)
+
+        Notes
+        -----
+        The same walk as :func:`kinematics.pose_transforms`, with the same
+        rotation ``Rz Ry Rx``, but computed link-major (each link's
+        transforms contiguous), one 4x4 product per tree level.
+        """
+        fig = self.figure
+        B = c.shape[0]
+        J = fig.n_joints
+        # Component-major: each entry of every joint's 4x4 transform is one
+        # contiguous (J, B) array, so each operation below is one long
+        # vector operation (numpy is slow on trailing axes of length 3).
+        cx, cy, cz = (np.ascontiguousarray(c[..., i].T) for i in range(3))
+        sx, sy, sz = (np.ascontiguousarray(s[..., i].T) for i in range(3))
+        szsy, czsy = sz * sy, cz * sy
+        r = [
+            [cy * cz, czsy * sx - sz * cx, czsy * cx + sz * sx],
+            [cy * sz, szsy * sx + cz * cx, szsy * cx - cz * sx],
+            [-sy, cy * sx, cy * cx],
+        ]
+        if self._any_reversed:
+            # Reversed joints (walked from the secondary) use R^T and
+            # L2 - R^T L1 instead of R and L1 - R L2.
+            rev = self._rev[:, None]
+            for i, j in ((0, 1), (0, 2), (1, 2)):
+                r[i][j], r[j][i] = np.where(rev, r[j][i], r[i][j]), np.where(rev, r[i][j], r[j][i])
+        near, far = self._near[:, :, None], self._far[:, :, None]  # (J, 3, 1)
+        t = [near[:, i] - (r[i][0] * far[:, 0] + r[i][1] * far[:, 1] + r[i][2] * far[:, 2]) for i in range(3)]
+        zero, one = np.zeros((J, B)), np.ones((J, B))
+        T = np.stack(r[0] + [t[0]] + r[1] + [t[1]] + r[2] + [t[2]] + [zero, zero, zero, one], axis=-1).reshape(J, B, 4, 4)
+        X = np.empty((fig.n_links, B, 4, 4))
+        X[fig.main] = np.eye(4)
+        for joints, parents, children in self._levels:
+            if isinstance(joints, int):
+                # A level of one joint (every level of a chain): contiguous
+                # blocks, written in place.
+                np.matmul(X[parents], T[joints], out=X[children])
+            else:
+                X[children] = X[parents] @ T[joints]
+        X = X.swapaxes(0, 1)
+        return X[..., :3, :3], X[..., :3, 3]
+
+    def axes(self, angles: np.ndarray, R: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each variable's signed rotation axis and pivot in the model frame.
+
+        Parameters
+        ----------
+        angles : numpy.ndarray, shape (B, n_joints, 3)
+            Radians.
+        R, p : numpy.ndarray
+            From :meth:`forward` for the same angles.
+
+        Returns
+        -------
+        omega : numpy.ndarray, shape (B, V, 3)
+            Unit axis times :attr:`sign`: a point ``y`` of a link in
+            ``downstream`` moves at ``omega x (y - c)`` per radian.
+        c : numpy.ndarray, shape (B, V, 3)
+            The joint's location, a point on the axis.
+        """
+        return self.axes_trig(np.cos(angles), np.sin(angles), R, p)
+
+    def axes_trig(self, c: np.ndarray, s: np.ndarray, R: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`axes` from the angles' cosines and sines (see :meth:`trig`).
+
+        Notes
+        -----
+        With ``R = Rz(az) Ry(ay) Rx(ax)``, turning ``ax`` turns the secondary
+        about ``Rz Ry e_x``, ``ay`` about ``Rz e_y`` and ``az`` about ``e_z``,
+        all in the primary's frame (the rotation nearest the point is applied
+        first).  For a reversed joint the primary side moves, by ``R^T``,
+        whose derivative is the same axis turned the other way.
+        """
+        B = c.shape[0]
+        V = self.n_vars
+        local = np.zeros((B, V, 3))
+        vx, jx = self._axis_vars[0]
+        if vx.size:
+            cy, sy, cz, sz = c[:, jx, 1], s[:, jx, 1], c[:, jx, 2], s[:, jx, 2]
+            local[:, vx, 0] = cy * cz
+            local[:, vx, 1] = cy * sz
+            local[:, vx, 2] = -sy
+        vy, jy = self._axis_vars[1]
+        if vy.size:
+            local[:, vy, 0] = -s[:, jy, 2]
+            local[:, vy, 1] = c[:, jy, 2]
+        vz, _ = self._axis_vars[2]
+        local[:, vz, 2] = 1.0
+        Rp = R[:, self.var_primary]  # (B, V, 3, 3)
+        omega = matvec3(Rp, local) * self.sign[:, None]
+        pivot = p[:, self.var_primary] + matvec3(Rp, self.var_loc1)
+        return omega, pivot
+
+    def to_world(self, y: np.ndarray, t: np.ndarray | None) -> np.ndarray:
+        """Model-frame points to the world: placement, then root translation.
+
+        Parameters
+        ----------
+        y : numpy.ndarray, shape (B, N, 3)
+        t : numpy.ndarray, shape (B, 3), or None
+
+        Returns
+        -------
+        numpy.ndarray, shape (B, N, 3)
+        """
+        x = y if self.placement_is_identity else y @ self.A.T + self.b
+        if t is not None:
+            x = x + t[:, None, :]
+        return x
+
+    def to_world_vectors(self, v: np.ndarray) -> np.ndarray:
+        """Model-frame vectors (velocities, directions) to the world, any leading shape."""
+        return v if self.placement_is_identity else v @ self.A.T

@@ -1,0 +1,498 @@
+"""Goal-directed positioning: poses and motions asked for by where parts of a figure should be.
+
+This is the Python face of the solvers, and what the language's goal
+construct calls.  :func:`solve_pose` finds the pose (and, optionally, the
+root translation) that best meets a list of weighted goals;
+:func:`reach` wraps that pose into an ordinary :class:`motion.Motion` going
+from a start pose at frame 0 to the solved pose at frame ``n``, which then
+works with ``+``, ``*``, STRIP, SYNCHRONIZE, SCALE and ANIMATE like any
+other motion; :func:`reach_keyframes` solves a batch of goals (a moving
+target) at once and strings the poses into one motion.
+
+A figure that cannot reach its goals is not an error: the result is the
+least-squares best pose, with each goal's residual reported.
+
+Example
+-------
+>>> from liganimate.runtime.goals import PointGoal
+>>> r = reach(arm, [PointGoal("HAND", (0.3, 0.2, 0.0))], frames=24, method="ACCDCC")
+>>> r.motion, r.residuals, r.translation          # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from . import kinematics as K
+from . import pose as PO
+from .figure import Figure
+from .goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
+from .ikmodel import IKModel
+from .motion import Motion
+from .solvers import CONVERGED, LIMIT, SOLVERS, STALLED, solve
+
+__all__ = [
+    "PointGoal",
+    "PlaneGoal",
+    "AxisGoal",
+    "GoalError",
+    "PoseSolution",
+    "Reach",
+    "solve_pose",
+    "reach",
+    "reach_keyframes",
+    "chain_joints",
+    "start_pose",
+    "DEFAULT_TOLERANCE",
+    "DEFAULT_MAX_ITERATIONS",
+]
+
+#: Default tolerance, as a fraction of the figure's length (the sum of its link lengths).
+DEFAULT_TOLERANCE = 1e-5
+#: Default iteration limits per solver (sweeps for CCD).
+DEFAULT_MAX_ITERATIONS = {"dls": 200, "transpose": 5000, "ccd": 500}
+
+_STATUS = {CONVERGED: "converged", STALLED: "stalled", LIMIT: "limit"}
+
+
+@dataclass(frozen=True)
+class PoseSolution:
+    """The result of :func:`solve_pose`.
+
+    Shapes are given for a batch of ``B`` solves; an unbatched solve has no
+    leading ``B``.
+
+    Attributes
+    ----------
+    angles : numpy.ndarray, shape (B, n_joints, 3)
+        The solved pose in degrees, in the figure's joint order, within
+        every joint's extremes (free axes wrapped into their range).
+    translation : numpy.ndarray, shape (B, 3)
+        World translation of the whole figure (zero unless translating):
+        the solved figure is ``figure.placed(translation matrix)``, i.e.
+        ``m :- m <TRANS (t)>``.
+    residuals : numpy.ndarray, shape (B, n_goals)
+        Per goal, in the order given: a point goal's distance to its target
+        and a plane goal's distance to its plane (world units), an axis
+        goal's angle to its direction (degrees).
+    converged : numpy.ndarray of bool, shape (B,)
+        Every goal of non-zero weight is within the tolerance.
+    status : numpy.ndarray of str, shape (B,)
+        ``"converged"``, ``"stalled"`` (no move lowers the weighted cost: the
+        least-squares best pose, goals left unmet) or ``"limit"`` (the
+        iteration limit came first).
+    iterations : numpy.ndarray of int, shape (B,)
+    tolerance : float
+        The tolerance used (world units).
+    weights : numpy.ndarray, shape (B, n_goals)
+    warnings : list of str
+        Ambiguous link names.
+    history : list of numpy.ndarray
+        The weighted cost after each iteration (each of shape (B,)), when
+        traced.
+    """
+
+    angles: np.ndarray
+    translation: np.ndarray
+    residuals: np.ndarray
+    converged: np.ndarray
+    status: np.ndarray
+    iterations: np.ndarray
+    tolerance: float
+    weights: np.ndarray
+    warnings: list = field(default_factory=list)
+    history: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Reach:
+    """The result of :func:`reach`: a motion and how well its last pose meets the goals.
+
+    Attributes
+    ----------
+    motion : Motion
+        From the start pose at frame 0 to the solved pose(s).
+    solution : PoseSolution
+    joints : tuple of int
+        The joint ids the motion drives.
+    """
+
+    motion: Motion
+    solution: PoseSolution
+    joints: tuple
+
+    @property
+    def residuals(self) -> np.ndarray:
+        """Per-goal residuals of the solved pose; see :class:`PoseSolution`."""
+        return self.solution.residuals
+
+    @property
+    def translation(self) -> np.ndarray:
+        """The solved root translation, shape (3,) (or (B, 3))."""
+        return self.solution.translation
+
+    @property
+    def converged(self):
+        """Whether every goal was met (bool, or an array for a batch)."""
+        return self.solution.converged
+
+
+# ---------------------------------------------------------------- helpers
+
+
+def chain_joints(figure: Figure, link: int, length: int) -> list[int]:
+    """The ``length`` joints nearest ``link`` on its path to the current main link.
+
+    Parameters
+    ----------
+    figure : Figure
+    link : int
+        Link index.
+    length : int
+        Non-negative; longer than the path means the whole path.
+
+    Returns
+    -------
+    list of int
+        Joint ids, from ``link`` toward the main link.
+    """
+    parent = {}
+    for level in figure.traversal:
+        for k, par, ch in zip(level.joints, level.parents, level.children):
+            parent[int(ch)] = (int(par), int(k))
+    out = []
+    cur = link
+    while cur != figure.main and len(out) < length:
+        cur, k = parent[cur]
+        out.append(figure.joints[k].id)
+    return out
+
+
+def start_pose(figure: Figure, start=None) -> np.ndarray:
+    """The pose a solve starts from, in degrees, clamped into the extremes.
+
+    Parameters
+    ----------
+    figure : Figure
+    start : None, Motion or array_like of shape (n_joints, 3) or (B, n_joints, 3)
+        None is neutral (all zero); a motion gives its final pose (frame
+        ``length``; joints it does not drive at neutral, as ANIMATE shows
+        them); an array gives the angles in the figure's joint order.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_joints, 3) or (B, n_joints, 3)
+    """
+    if start is None:
+        a = np.zeros((figure.n_joints, 3))
+    elif isinstance(start, Motion):
+        return PO.joint_angles(figure, start, np.array([start.length]))[0]
+    else:
+        a = np.asarray(start, dtype=float)
+        if a.shape[-2:] != (figure.n_joints, 3) or a.ndim > 3:
+            raise GoalError(f"a start pose must have shape ({figure.n_joints}, 3) for this model, not {a.shape}.")
+        if not np.all(np.isfinite(a)):
+            raise GoalError("a start pose must be finite.")
+    return K.clamp(figure, a)
+
+
+def _movable_mask(figure: Figure, goals: Sequence, movable) -> np.ndarray:
+    """Which joint axes may move, shape (n_joints, 3), from the ``movable`` option."""
+    J = figure.n_joints
+    mask = np.zeros((J, 3), dtype=bool)
+    if movable is None:
+        mask[:] = True
+        return mask
+    if isinstance(movable, (int, np.integer)) and not isinstance(movable, bool):
+        if movable < 0:
+            raise GoalError(f"a chain length must not be negative, not {int(movable)}.")
+        for g in goals:
+            link, _ = resolve_link(figure, g.link)
+            for jid in chain_joints(figure, link, int(movable)):
+                mask[figure.joint_index(jid)] = True
+        return mask
+    try:
+        ids = list(movable)
+    except TypeError:
+        raise GoalError("the movable joints must be a chain length or a list of joint ids.") from None
+    for jid in ids:
+        try:
+            mask[figure.joint_index(jid)] = True
+        except Exception as exc:  # FigureError, named for the user
+            raise GoalError(getattr(exc, "message", str(exc)), getattr(exc, "hint", None)) from None
+    return mask
+
+
+def _options(figure: Figure, solver: str, tolerance, max_iterations) -> tuple[float, int]:
+    if solver not in SOLVERS:
+        raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVERS)}")
+    from .ikmodel import figure_length
+
+    if tolerance is None:
+        tol = DEFAULT_TOLERANCE * figure_length(figure)
+    else:
+        tol = float(tolerance)
+        if not np.isfinite(tol) or tol <= 0:
+            raise GoalError(f"the tolerance must be a positive number, not {tolerance!r}.")
+    if max_iterations is None:
+        it = DEFAULT_MAX_ITERATIONS[solver]
+    else:
+        if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations or max_iterations < 0:
+            raise GoalError(f"the iteration limit must be a non-negative whole number, not {max_iterations!r}.")
+        it = int(max_iterations)
+    return tol, it
+
+
+# ---------------------------------------------------------------- solving
+
+
+def solve_pose(
+    figure: Figure,
+    goals: Sequence,
+    *,
+    start=None,
+    movable=None,
+    translate: bool = False,
+    solver: str = "dls",
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    restarts: int = 0,
+    trace: bool = False,
+) -> PoseSolution:
+    """The pose that best meets weighted goals.
+
+    Parameters
+    ----------
+    figure : Figure
+        Seen from its current main link and placed by its placement: goals
+        are in the world, ``placement @ pose``.
+    goals : sequence of PointGoal, PlaneGoal, AxisGoal
+        Their targets, directions, planes and weights may have a leading
+        batch dimension ``B`` (all the same ``B``): ``B`` independent solves,
+        done together.
+    start : None, Motion or array_like, optional
+        See :func:`start_pose`.  An array may also be batched,
+        ``(B, n_joints, 3)``.
+    movable : None, int or iterable of int, optional
+        Which joints may turn: all (None), the ``n`` joints nearest each
+        goal's link toward the main link (an int: a chain length), or a list
+        of joint ids.  The others keep their start angles, and so does every
+        axis locked by its extremes (``min == max``).
+    translate : bool, default False
+        Whether the whole figure may also move (POSIT's root translation).
+    solver : {"dls", "transpose", "ccd"}, default "dls"
+    tolerance : float, optional
+        World units; default :data:`DEFAULT_TOLERANCE` times the figure's
+        length.  The solve stops when every goal is this close (an axis goal
+        counts its angle in radians times its link's length).
+    max_iterations : int, optional
+        Default :data:`DEFAULT_MAX_ITERATIONS` for the solver.
+    restarts : int, default 0
+        When the goals are not met from ``start`` (a local minimum, often
+        against joint limits), try up to this many other start poses, drawn
+        within the limits by a fixed-seed generator, and keep the first
+        that meets them (see :func:`solvers.solve`).
+    trace : bool, default False
+        Keep the cost after every iteration (``history``).
+
+    Returns
+    -------
+    PoseSolution
+
+    Raises
+    ------
+    GoalError
+        For an unknown link or joint, a malformed goal, a negative weight,
+        an unknown solver or a bad option.  Unreachable goals are *not* an
+        error: see ``PoseSolution.status`` and ``residuals``.
+    """
+    goals = list(goals)
+    tol, max_iter = _options(figure, solver, tolerance, max_iterations)
+    start_deg = start_pose(figure, start)
+    B_goals = batch_size(goals)
+    B_start = start_deg.shape[0] if start_deg.ndim == 3 else None
+    if B_goals is not None and B_start is not None and B_goals != B_start:
+        raise GoalError(f"the goals are a batch of {B_goals} but the start poses a batch of {B_start}.")
+    batched = B_goals is not None or B_start is not None
+    B = B_goals or B_start or 1
+    base = np.deg2rad(start_deg).reshape(-1, figure.n_joints, 3)  # (1 or B, J, 3)
+    start_deg = np.broadcast_to(start_deg, (B, figure.n_joints, 3))
+
+    model = IKModel(figure, _movable_mask(figure, goals, movable), translate=translate)
+    stack = GoalStack(model, goals, B)
+    x0 = np.zeros((B, model.n_params))
+    x0[:, : model.n_vars] = np.deg2rad(start_deg).reshape(B, -1)[:, model.var_flat]
+    if isinstance(restarts, bool) or int(restarts) != restarts or restarts < 0:
+        raise GoalError(f"the number of restarts must be a non-negative whole number, not {restarts!r}.")
+    result = solve(model, stack, x0, base, method=solver, tolerance=tol, max_iterations=max_iter,
+                   restarts=int(restarts), trace=trace)
+
+    q = result.x[:, : model.n_vars]
+    angles = start_deg.copy()
+    flat = angles.reshape(B, -1)
+    flat[:, model.var_flat] = np.rad2deg(q)
+    angles = K.clamp(figure, flat.reshape(B, figure.n_joints, 3))
+    t = result.x[:, model.n_vars:] * model.length if translate else np.zeros((B, 3))
+    R, p = model.forward(np.deg2rad(angles))
+    residuals = stack.report(R, p, t if translate else None)
+    sol = PoseSolution(
+        angles=angles,
+        translation=t,
+        residuals=residuals,
+        converged=result.status == CONVERGED,
+        status=np.array([_STATUS[s] for s in result.status]),
+        iterations=result.iterations,
+        tolerance=tol,
+        weights=stack.weights,
+        warnings=stack.warnings,
+        history=result.history,
+    )
+    if batched:
+        return sol
+    return PoseSolution(
+        angles=sol.angles[0],
+        translation=sol.translation[0],
+        residuals=sol.residuals[0],
+        converged=bool(sol.converged[0]),
+        status=str(sol.status[0]),
+        iterations=int(sol.iterations[0]),
+        tolerance=tol,
+        weights=sol.weights[0],
+        warnings=sol.warnings,
+        history=[h[0] for h in sol.history],
+    )
+
+
+def _driven(figure: Figure, goals, movable, start, joints) -> list[int]:
+    """The joints a goal-made motion drives, in the figure's joint order."""
+    if joints is not None:
+        ids = set()
+        for jid in joints:
+            figure.joint_index(jid)  # raises for an unknown joint
+            ids.add(int(jid))
+    else:
+        mask = _movable_mask(figure, goals, movable)
+        ids = {figure.joints[k].id for k in np.flatnonzero(mask.any(axis=1))}
+        if isinstance(start, Motion):
+            # The start motion's joints keep their final angles; driving them
+            # keeps that true even when this motion is animated on its own.
+            ids |= set(start.joints) & set(figure.joint_ids)
+    return [jid for jid in figure.joint_ids if jid in ids]
+
+
+def reach(
+    figure: Figure,
+    goals: Sequence,
+    frames: float,
+    method: str = "LINEAR",
+    *,
+    start=None,
+    movable=None,
+    translate: bool = False,
+    solver: str = "dls",
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    joints: Iterable[int] | None = None,
+) -> Reach:
+    """A motion from a start pose to the pose that best meets the goals.
+
+    Parameters
+    ----------
+    figure, goals, start, movable, translate, solver, tolerance, max_iterations
+        As for :func:`solve_pose`; the goals must not be batched (see
+        :func:`reach_keyframes`).
+    frames : float
+        The frame of the solved pose (the motion's length), ``>= 0``.
+    method : str, default "LINEAR"
+        The interpolation method from the start pose to the solved one.
+    joints : iterable of int, optional
+        The joints the motion drives.  Default: the movable joints, and,
+        when ``start`` is a motion, the joints it drives (so that playing
+        this motion alone still shows them in the start motion's final
+        pose).
+
+    Returns
+    -------
+    Reach
+        ``motion`` has, for each driven joint, the start pose as its start
+        value and one keyframe ``(frames, solved angles, method)``.  The
+        root translation cannot live in a motion (motions hold angles), so
+        it is ``Reach.translation``: apply it to the model with a host
+        translation.
+
+    Raises
+    ------
+    GoalError
+        As :func:`solve_pose`; also for batched goals.
+    MotionError
+        For a negative frame count or an unknown method.
+    """
+    goals = list(goals)
+    if batch_size(goals) is not None:
+        raise GoalError("reach() takes unbatched goals; use reach_keyframes() for a batch.")
+    sol = solve_pose(figure, goals, start=start, movable=movable, translate=translate, solver=solver,
+                     tolerance=tolerance, max_iterations=max_iterations)
+    s0 = start_pose(figure, start)
+    driven = _driven(figure, goals, movable, start, joints)
+    tracks = {}
+    for jid in driven:
+        k = figure.joint_index(jid)
+        tracks[jid] = (tuple(s0[k]), [(frames, tuple(sol.angles[k]), method)])
+    return Reach(Motion.from_tracks(tracks, name="REACH"), sol, tuple(driven))
+
+
+def reach_keyframes(
+    figure: Figure,
+    goals: Sequence,
+    frames: Sequence[float],
+    method: str = "LINEAR",
+    *,
+    start=None,
+    movable=None,
+    translate: bool = False,
+    solver: str = "dls",
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    joints: Iterable[int] | None = None,
+) -> Reach:
+    """One motion through the solutions of a batch of goals (a moving target).
+
+    The ``B`` solves are independent, all from the start pose, and done as
+    one batch; the motion has keyframe ``i`` at ``frames[i]`` with solution
+    ``i``.
+
+    Parameters
+    ----------
+    figure, goals, start, movable, translate, solver, tolerance, max_iterations, joints
+        As for :func:`reach`; the goals carry a batch dimension ``B``.
+    frames : sequence of float, length B
+        Non-decreasing keyframe frames.
+    method : str, default "LINEAR"
+
+    Returns
+    -------
+    Reach
+        Its ``solution`` is batched: ``translation`` has shape (B, 3), one
+        per keyframe (apply them with a host translation per frame).
+    """
+    goals = list(goals)
+    frames = [float(f) for f in frames]
+    B = batch_size(goals)
+    if B is None:
+        B = 1
+    if len(frames) != B:
+        raise GoalError(f"{len(frames)} keyframe frames for a batch of {B} goals.")
+    s0 = start_pose(figure, start)
+    if s0.ndim == 3:
+        raise GoalError("reach_keyframes() starts every solve from one pose; give an unbatched start.")
+    sol = solve_pose(figure, goals, start=np.broadcast_to(s0, (B,) + s0.shape), movable=movable, translate=translate,
+                     solver=solver, tolerance=tolerance, max_iterations=max_iterations)
+    driven = _driven(figure, goals, movable, start, joints)
+    tracks = {}
+    for jid in driven:
+        k = figure.joint_index(jid)
+        tracks[jid] = (tuple(s0[k]), [(f, tuple(sol.angles[i, k]), method) for i, f in enumerate(frames)])
+    return Reach(Motion.from_tracks(tracks, name="REACH"), sol, tuple(driven))

@@ -1,0 +1,567 @@
+"""Batched solvers for goal-directed positioning: damped least squares, Jacobian transpose, CCD.
+
+All three minimise the same weighted cost of a :class:`goals.GoalStack`,
+
+    f(x) = |r(x)|^2 / 2,     lower <= angles <= upper,
+
+over the variables ``x`` of an :class:`ikmodel.IKModel` (angles in radians,
+then the root translation divided by the figure's length when it may
+translate), for a batch of ``B`` independent problems at once.  Every
+iterate is projected into the joint limits, and a step is only kept when it
+lowers ``f``, so the cost never rises: no iterate exceeds a limit, and an
+unreachable goal ends at a (local) least-squares best pose instead of
+oscillating.  ``docs/semantics-ik.md`` gives the formulas and the stopping
+rules.
+
+* ``"dls"`` -- damped least squares (Levenberg-Marquardt): the step solves
+  ``(J^T J + mu I) dx = -J^T r`` with the damping ``mu`` adapted by the gain
+  ratio (Nielsen's rule), variables held at a limit they push against.
+* ``"transpose"`` -- the Jacobian transpose (seed 000's choice): a step along
+  ``-J^T r`` of Buss's length ``|g|^2 / |J g|^2``, halved while it fails.
+* ``"ccd"`` -- cyclic coordinate descent: each variable in turn, from the
+  figure's extremities toward the main link, is set to the exact minimiser
+  of ``f`` along its own axis within its limits; then the translation.
+
+The batch elements that have stopped are dropped from the arrays, so a batch
+costs what its slowest member costs, with numpy doing the rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .goals import GoalStack
+from .ikmodel import IKModel
+
+__all__ = ["SOLVERS", "SolveResult", "solve", "CONVERGED", "STALLED", "LIMIT"]
+
+SOLVERS = ("dls", "transpose", "ccd")
+
+# Status codes per batch element.
+RUNNING, CONVERGED, STALLED, LIMIT = 0, 1, 2, 3
+
+# A step that lowers the cost by less than this fraction of it, or whose
+# length is less than XTOL times (XTOL + the variables' length), means the
+# solve has stopped making progress: it is at a least-squares best pose.
+# These are MINPACK's and scipy's defaults (about sqrt(machine epsilon)).
+FTOL = 1e-8
+XTOL = 1e-8
+# Damping beyond this multiple of the largest curvature means no step can
+# lower the cost any more.
+MU_MAX = 1e16
+# Progress window: see _State.check_progress.
+WINDOW = 10
+WINDOW_FTOL = 1e-6
+MU0 = 1e-1
+MAXSTEP = 0.5
+
+
+@dataclass
+class SolveResult:
+    """What a batched solve returns.
+
+    Attributes
+    ----------
+    x : numpy.ndarray, shape (B, n_params)
+        Final variables: angles in radians, then the translation over the
+        figure's length.
+    status : numpy.ndarray of int, shape (B,)
+        :data:`CONVERGED` (every active goal within tolerance),
+        :data:`STALLED` (no step lowers the cost: a least-squares best pose)
+        or :data:`LIMIT` (the iteration limit came first).
+    iterations : numpy.ndarray of int, shape (B,)
+        Iterations (DLS, transpose) or sweeps (CCD) used.
+    cost : numpy.ndarray, shape (B,)
+        Final ``f``.
+    dist : numpy.ndarray, shape (B, n_goals)
+        Final per-goal distances (see :meth:`GoalStack.evaluate`).
+    history : list of numpy.ndarray, each shape (B,)
+        ``f`` before the first iteration and after each one, when traced.
+    """
+
+    x: np.ndarray
+    status: np.ndarray
+    iterations: np.ndarray
+    cost: np.ndarray
+    dist: np.ndarray
+    history: list = field(default_factory=list)
+
+
+class _Problem:
+    """The pieces every solver needs: evaluation of a sub-batch at given variables."""
+
+    def __init__(self, model: IKModel, stack: GoalStack, base: np.ndarray):
+        self.model = model
+        self.stack = stack
+        # (1 or B, J * 3): an unbatched start pose is shared, not copied B times.
+        flat = base.reshape(base.shape[0], -1)
+        self.base_cos, self.base_sin = np.cos(flat), np.sin(flat)
+        P = model.n_params
+        V = model.n_vars
+        self.lower = np.full(P, -np.inf)
+        self.upper = np.full(P, np.inf)
+        self.lower[:V] = model.lower
+        self.upper[:V] = model.upper
+
+    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        V = self.model.n_vars
+        t = x[:, V:] * self.model.length if self.model.translate else None
+        return x[:, :V], t
+
+    def frames(self, idx, x):
+        """Cosines and sines of the angles, and link frames, of sub-batch ``idx`` at ``x``."""
+        q, t = self.split(x)
+        shared = self.base_cos.shape[0] == 1
+        bc = self.base_cos if shared else self.base_cos[idx]
+        bs = self.base_sin if shared else self.base_sin[idx]
+        c, s = self.model.trig(q, bc, bs)
+        R, p = self.model.forward_trig(c, s)
+        return (c, s), R, p, t
+
+    def evaluate(self, idx, stack, x, jac=True):
+        """``r (B', M)``, ``J (B', M, P)`` or None, ``dist (B', n_goals)``."""
+        (c, s), R, p, t = self.frames(idx, x)
+        if jac:
+            omega, pivot = self.model.axes_trig(c, s, R, p)
+            return stack.evaluate(R, p, t, omega, pivot)
+        return stack.evaluate(R, p, t)
+
+    def trial(self, idx, stack, x):
+        """Residuals at trial variables, keeping what :meth:`jacobian` needs.
+
+        Returns
+        -------
+        r : numpy.ndarray, shape (B', M)
+        dist : numpy.ndarray, shape (B', n_goals)
+        kept : tuple
+            The angles' cosines and sines, link frames and translation.
+        """
+        (c, s), R, p, t = self.frames(idx, x)
+        r, _, dist = stack.evaluate(R, p, t)
+        return r, dist, (c, s, R, p, t)
+
+    def jacobian(self, stack, kept, which):
+        """The Jacobian at the trials ``which`` (a boolean mask) kept by :meth:`trial`.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n_true, M, P)
+        """
+        if not which.any():
+            return np.zeros((0, stack.n_rows, self.model.n_params))
+        if not which.all():
+            kept = tuple(None if a is None else a[which] for a in kept)
+            stack = stack.take(np.flatnonzero(which))
+        c, s, R, p, t = kept
+        omega, pivot = self.model.axes_trig(c, s, R, p)
+        return stack.evaluate(R, p, t, omega, pivot)[1]
+
+
+def _converged(dist: np.ndarray, active: np.ndarray, tol: float) -> np.ndarray:
+    """Every goal that counts is within the tolerance, shape (B,)."""
+    return np.all((dist <= tol) | ~active, axis=1)
+
+
+def solve(model: IKModel, stack: GoalStack, x0: np.ndarray, base: np.ndarray, *, method: str = "dls",
+          tolerance: float, max_iterations: int, restarts: int = 0, seed: int = 0,
+          trace: bool = False) -> SolveResult:
+    """Minimise the goals' weighted cost for a batch of problems.
+
+    Parameters
+    ----------
+    model : IKModel
+    stack : GoalStack
+        With batch size ``B``.
+    x0 : numpy.ndarray, shape (B, n_params)
+        Start variables (angles in radians within the bounds, then the
+        translation over the figure's length).
+    base : numpy.ndarray, shape (B, n_joints, 3) or (1, n_joints, 3)
+        Radians, for the axes that are not variables.
+    method : {"dls", "transpose", "ccd"}
+    tolerance : float
+        A goal is met when its distance (see :meth:`GoalStack.evaluate`) is
+        at most this.
+    max_iterations : int
+        Iterations (sweeps for CCD) per batch element and attempt.
+    restarts : int, default 0
+        When a solve ends without meeting its goals (a local minimum, often
+        against joint limits), try again up to this many times from start
+        angles drawn uniformly within the limits, and keep the first
+        attempt that meets them.  An attempt that does not is discarded, so
+        a goal that cannot be met still ends at the best pose reached from
+        the given start.
+    seed : int, default 0
+        Seeds the restarts' random start angles (results are reproducible).
+    trace : bool
+        Record the cost after each iteration of the first attempt in
+        ``history``.
+
+    Returns
+    -------
+    SolveResult
+        ``iterations`` counts every attempt.
+    """
+    if method not in SOLVERS:
+        raise ValueError(f"unknown solver {method!r}; expected one of {', '.join(SOLVERS)}")
+    run = {"dls": _dls, "transpose": _transpose, "ccd": _ccd}[method]
+    prob = _Problem(model, stack, base)
+    x = np.clip(np.array(x0, dtype=float), prob.lower, prob.upper)
+    result = run(prob, x, float(tolerance), int(max_iterations), trace)
+    rng = np.random.default_rng(seed)
+    V = model.n_vars
+    lo = np.where(np.isfinite(prob.lower[:V]), prob.lower[:V], -np.pi)
+    hi = np.where(np.isfinite(prob.upper[:V]), prob.upper[:V], np.pi)
+    for _ in range(int(restarts)):
+        bad = np.flatnonzero(result.status != CONVERGED)
+        if bad.size == 0 or V == 0:
+            break
+        xr = result.x[bad].copy()
+        xr[:, :V] = rng.uniform(lo, hi, size=(bad.size, V))
+        xr[:, V:] = x[bad, V:]
+        sub = _Problem(model, stack.take(bad), base if base.shape[0] == 1 else base[bad])
+        again = run(sub, xr, float(tolerance), int(max_iterations), False)
+        result.iterations[bad] += again.iterations
+        won = bad[again.status == CONVERGED]
+        keep = again.status == CONVERGED
+        result.x[won], result.status[won] = again.x[keep], CONVERGED
+        result.cost[won], result.dist[won] = again.cost[keep], again.dist[keep]
+    return result
+
+
+class _State:
+    """Per-batch bookkeeping shared by the loops."""
+
+    def __init__(self, prob: _Problem, x: np.ndarray, tol: float, trace: bool, jac: bool):
+        self.prob = prob
+        self.x = x
+        B = x.shape[0]
+        everyone = np.arange(B)
+        self.r, self.J, self.dist = prob.evaluate(everyone, prob.stack, x, jac)
+        self.f = 0.5 * np.einsum("bm,bm->b", self.r, self.r)
+        self.active_goals = prob.stack.active
+        self.tol = tol
+        self.status = np.where(_converged(self.dist, self.active_goals, tol), CONVERGED, RUNNING)
+        self.iterations = np.zeros(B, dtype=int)
+        self.history = [self.f.copy()] if trace else None
+        self.window_f = self.f.copy()
+
+    def running(self) -> np.ndarray:
+        return np.flatnonzero(self.status == RUNNING)
+
+    def finish(self) -> SolveResult:
+        self.status[self.status == RUNNING] = LIMIT
+        return SolveResult(self.x, self.status, self.iterations, self.f, self.dist, self.history or [])
+
+    def record(self):
+        if self.history is not None:
+            self.history.append(self.f.copy())
+
+    def check_progress(self, idx: np.ndarray) -> None:
+        """Every WINDOW iterations, stop elements whose cost fell by less than WINDOW_FTOL of it.
+
+        Near a joint limit or a saddle (a straight chain pulled along its
+        length), steps can keep lowering the cost by a hair for hundreds of
+        iterations; a pose that close to stationary is the best pose.
+        """
+        due = idx[(self.iterations[idx] % WINDOW == 0) & (self.status[idx] == RUNNING)]
+        slow = due[self.window_f[due] - self.f[due] <= WINDOW_FTOL * self.window_f[due]]
+        self.status[slow] = STALLED
+        self.window_f[due] = self.f[due]
+
+
+def _solve_damped(J: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """``dx = -(J^T J + mu I)^-1 J^T r`` over the free variables (zero elsewhere).
+
+    Uses the smaller of the two equal forms: ``-J^T (J J^T + mu I)^-1 r``
+    when there are fewer residual rows than variables.
+    """
+    Jf = J * free[:, None, :]
+    B, M, P = J.shape
+    if M < P:
+        A = Jf @ np.swapaxes(Jf, 1, 2)
+        A[:, np.arange(M), np.arange(M)] += mu[:, None]
+        y = np.linalg.solve(A, -r[..., None])[..., 0]
+        return np.einsum("bmp,bm->bp", Jf, y)
+    A = np.swapaxes(Jf, 1, 2) @ Jf
+    A[:, np.arange(P), np.arange(P)] += mu[:, None]
+    g = np.einsum("bmp,bm->bp", Jf, r)
+    return -np.linalg.solve(A, g[..., None])[..., 0]
+
+
+def _project(prob: _Problem, x: np.ndarray, dx: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """The step actually taken: held variables stay, the rest is clipped into the limits."""
+    dx = np.where(free, dx, 0.0)
+    return np.clip(x + dx, prob.lower, prob.upper) - x
+
+
+def _held(prob: _Problem, x: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Variables at a limit that ``direction`` pushes against, shape (B, P)."""
+    return ((x <= prob.lower) & (direction < 0)) | ((x >= prob.upper) & (direction > 0))
+
+
+def _stop_checks(st: _State, idx, accept, gain, f_old, dx):
+    """Mark converged and stalled elements of sub-batch ``idx`` after an iteration."""
+    conv = _converged(st.dist[idx], st.active_goals[idx], st.tol)
+    small_gain = accept & (gain <= FTOL * f_old)
+    size = np.sqrt(np.einsum("bp,bp->b", st.x[idx], st.x[idx]))
+    small_step = np.sqrt(np.einsum("bp,bp->b", dx, dx)) <= XTOL * (XTOL + size)
+    st.status[idx[conv]] = CONVERGED
+    stalled = ~conv & (small_gain | small_step)
+    st.status[idx[stalled]] = STALLED
+
+
+def _dls(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) -> SolveResult:
+    """Levenberg-Marquardt with projection onto the limits (see module docstring)."""
+    st = _State(prob, x, tol, trace, jac=True)
+    B, P = x.shape
+    diag = np.einsum("bmp,bmp->bp", st.J, st.J)
+    curv = diag.max(axis=1, initial=0.0)
+    # Nothing any variable can change (no goal moves with them): done.
+    st.status[(st.status == RUNNING) & (curv == 0.0)] = STALLED
+    mu = MU0 * np.where(curv > 0, curv, 1.0)
+    nu = np.full(B, 2.0)
+    for _ in range(max_iter):
+        idx = st.running()
+        if idx.size == 0:
+            break
+        xs, rs, Js, fs, mus = st.x[idx], st.r[idx], st.J[idx], st.f[idx], mu[idx]
+        # Hold the variables at a limit that the descent direction pushes
+        # against, then those the step still pushes against, solving again
+        # without them (an active-set projection; rarely more than once).
+        free = ~_held(prob, xs, -np.einsum("bmp,bm->bp", Js, rs))
+        for _pass in range(3):
+            dx = _solve_damped(Js, rs, free, mus)
+            out = _held(prob, xs, dx) & free
+            if not out.any():
+                break
+            free &= ~out
+        big = np.max(np.abs(dx[:, :prob.model.n_vars]), axis=1, initial=0.0)
+        dx = dx * np.minimum(1.0, MAXSTEP / np.maximum(big, 1e-300))[:, None]
+        dx = _project(prob, xs, dx, free)
+        xn = xs + dx
+        stack = prob.stack.take(idx)
+        rn, dn, kept = prob.trial(idx, stack, xn)
+        fn = 0.5 * np.einsum("bm,bm->b", rn, rn)
+        lin = rs + np.einsum("bmp,bp->bm", Js, dx)
+        predicted = fs - 0.5 * np.einsum("bm,bm->b", lin, lin)
+        gain = fs - fn
+        accept = (gain > 0) & (predicted > 0)
+        rho = np.divide(gain, predicted, out=np.zeros_like(gain), where=predicted > 0)
+        # Nielsen's damping update: shrink after a good step, grow fast after a bad one.
+        mu[idx] = np.where(accept, mus * np.maximum(1 / 3, 1 - (2 * rho - 1) ** 3), mus * nu[idx])
+        nu[idx] = np.where(accept, 2.0, nu[idx] * 2.0)
+        a = idx[accept]
+        # The Jacobian is only needed where the step is kept.
+        st.J[a] = prob.jacobian(stack, kept, accept)
+        st.x[a], st.r[a], st.dist[a], st.f[a] = xn[accept], rn[accept], dn[accept], fn[accept]
+        st.iterations[idx] += 1
+        st.record()
+        _stop_checks(st, idx, accept, gain, fs, dx)
+        st.check_progress(idx)
+        blown = mu[idx] > MU_MAX * np.maximum(curv[idx], 1e-300)
+        st.status[idx[blown & (st.status[idx] == RUNNING)]] = STALLED
+    return st.finish()
+
+
+def _transpose(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) -> SolveResult:
+    """Jacobian transpose steps with Buss's step length, halved until the cost drops."""
+    st = _State(prob, x, tol, trace, jac=True)
+    B, P = x.shape
+    scale = np.ones(B)
+    for _ in range(max_iter):
+        idx = st.running()
+        if idx.size == 0:
+            break
+        xs, rs, Js, fs = st.x[idx], st.r[idx], st.J[idx], st.f[idx]
+        g = np.einsum("bmp,bm->bp", Js, rs)  # gradient of f
+        free = ~_held(prob, xs, -g)
+        g = np.where(free, g, 0.0)
+        Jg = np.einsum("bmp,bp->bm", Js, g)
+        gg = np.einsum("bp,bp->b", g, g)
+        JgJg = np.einsum("bm,bm->b", Jg, Jg)
+        # Buss: the step length that minimises the linearised cost along -g.
+        alpha = np.divide(gg, JgJg, out=np.zeros_like(gg), where=JgJg > 0)
+        dx = _project(prob, xs, -(scale[idx] * alpha)[:, None] * g, free)
+        xn = xs + dx
+        stack = prob.stack.take(idx)
+        rn, dn, kept = prob.trial(idx, stack, xn)
+        fn = 0.5 * np.einsum("bm,bm->b", rn, rn)
+        gain = fs - fn
+        accept = gain > 0
+        scale[idx] = np.where(accept, np.minimum(1.0, 2.0 * scale[idx]), 0.5 * scale[idx])
+        a = idx[accept]
+        st.J[a] = prob.jacobian(stack, kept, accept)
+        st.x[a], st.r[a], st.dist[a], st.f[a] = xn[accept], rn[accept], dn[accept], fn[accept]
+        st.iterations[idx] += 1
+        st.record()
+        _stop_checks(st, idx, accept, gain, fs, dx)
+        st.check_progress(idx)
+    return st.finish()
+
+
+# ---------------------------------------------------------------- CCD
+
+_GRID = 33  # samples of the 1-D cost per variable before Newton polishing
+
+
+def _rotate(d: np.ndarray, w: np.ndarray, s: np.ndarray, cm: np.ndarray) -> np.ndarray:
+    """Rodrigues: ``d`` turned about unit ``w`` by the angle with sine ``s``, ``1 - cos`` ``cm``."""
+    wd = np.cross(w, d)
+    return d + s[..., None] * wd + cm[..., None] * np.cross(w, wd)
+
+
+def _trig_cost(C, s, cm):
+    """The 1-D cost ``sum (a + b sin + c (1 - cos))^2`` from its six sums, any shape."""
+    c0, cab, cac, cbb, ccc, cbc = (C[..., i] for i in range(6))
+    return c0 + 2 * cab * s + 2 * cac * cm + cbb * s * s + ccc * cm * cm + 2 * cbc * s * cm
+
+
+def _trig_minimum(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The angle in ``[lo, hi]`` minimising :func:`_trig_cost`, per batch element.
+
+    Parameters
+    ----------
+    C : numpy.ndarray, shape (B, 6)
+    lo, hi : numpy.ndarray, shape (B,)
+        ``lo <= 0 <= hi``, within ``[-pi, pi]``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (B,)
+        0 unless some angle lowers the cost.
+    """
+    u = np.linspace(0.0, 1.0, _GRID)
+    grid = lo[:, None] + (hi - lo)[:, None] * u  # (B, N), includes both ends
+    Cg = C[:, None, :]
+    cost = _trig_cost(Cg, np.sin(grid), 1.0 - np.cos(grid))
+    best = grid[np.arange(len(lo)), np.argmin(cost, axis=1)]
+    c0, cab, cac, cbb, ccc, cbc = (C[:, i] for i in range(6))
+    th = best
+    for _ in range(3):
+        # Newton on the derivative, kept inside the interval.
+        s, c = np.sin(th), np.cos(th)
+        cm = 1.0 - c
+        d1 = 2 * (cab * c + cac * s + cbb * s * c + ccc * cm * s + cbc * (c * cm + s * s))
+        d2 = 2 * (-cab * s + cac * c + cbb * (c * c - s * s) + ccc * (s * s + cm * c) + cbc * (-s * cm + 3 * s * c))
+        step = np.divide(d1, d2, out=np.zeros_like(d1), where=d2 > 0)
+        cand = np.clip(th - step, lo, hi)
+        better = _trig_cost(C, np.sin(cand), 1.0 - np.cos(cand)) < _trig_cost(C, np.sin(th), 1.0 - np.cos(th))
+        th = np.where(better, cand, th)
+    keep = _trig_cost(C, np.sin(th), 1.0 - np.cos(th)) < c0
+    return np.where(keep, th, 0.0)
+
+
+def _ccd(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) -> SolveResult:
+    """Cyclic coordinate descent with exact 1-D minimisation (see module docstring)."""
+    st = _State(prob, x, tol, trace, jac=False)
+    model = prob.model
+    V = model.n_vars
+    A = model.A
+    for _ in range(max_iter):
+        idx = st.running()
+        if idx.size == 0:
+            break
+        stack = prob.stack.take(idx)
+        xs = st.x[idx].copy()
+        fs = st.f[idx]
+        (cos, sin), R, p, t = prob.frames(idx, xs)
+        omega, c = model.axes_trig(cos, sin, R, p)
+        tw = t if t is not None else np.zeros((idx.size, 3))
+        # Current goal points and link directions (model frame); each turn of
+        # a variable rotates those it moves, so no kinematics is redone
+        # within a sweep.
+        yp = stack._link_points(R, p, stack.p_link, stack.p_local)
+        yq = stack._link_points(R, p, stack.q_link, stack.q_local)
+        vh = np.einsum("bhij,hj->bhi", R[:, stack.h_link], stack.h_local)
+        wp = stack.row_weight[:, : 3 * len(stack.p_link)].reshape(idx.size, -1, 3)[..., 0]
+        wq = stack.row_weight[:, 3 * len(stack.p_link): 3 * len(stack.p_link) + len(stack.q_link)]
+        wh = stack.row_weight[:, 3 * len(stack.p_link) + len(stack.q_link):].reshape(idx.size, -1, 3)[..., 0]
+        nvh = np.linalg.norm(vh @ A.T, axis=-1)  # |A v|, unchanged by turns when A is a similarity
+        for v in range(V):
+            w = omega[:, v]
+            cv = c[:, v]
+            C = np.zeros((idx.size, 6))
+            mp = model.downstream[v, stack.p_link]
+            if mp.any():
+                d = yp[:, mp] - cv[:, None]
+                wd = np.cross(w[:, None], d)
+                a = (yp[:, mp] @ A.T + model.b + tw[:, None] - stack.p_target[:, mp]) * wp[:, mp, None]
+                b = (wd @ A.T) * wp[:, mp, None]
+                g = (np.cross(w[:, None], wd) @ A.T) * wp[:, mp, None]
+                C += _sums(a.reshape(idx.size, -1), b.reshape(idx.size, -1), g.reshape(idx.size, -1))
+            mq = model.downstream[v, stack.q_link]
+            if mq.any():
+                n = stack.q_normal[:, mq]
+                d = yq[:, mq] - cv[:, None]
+                wd = np.cross(w[:, None], d)
+                a = np.einsum("bqi,bqi->bq", n, yq[:, mq] @ A.T + model.b + tw[:, None] - stack.q_origin[:, mq]) * wq[:, mq]
+                b = np.einsum("bqi,bqi->bq", n, wd @ A.T) * wq[:, mq]
+                g = np.einsum("bqi,bqi->bq", n, np.cross(w[:, None], wd) @ A.T) * wq[:, mq]
+                C += _sums(a, b, g)
+            mh = model.downstream[v, stack.h_link]
+            if mh.any():
+                k = (stack.h_ell[mh] * wh[:, mh])[..., None] / nvh[:, mh, None]
+                vv = vh[:, mh]
+                wv = np.cross(w[:, None], vv)
+                a = (vv @ A.T) * k - stack.h_dir[:, mh] * (stack.h_ell[mh] * wh[:, mh])[..., None]
+                b = (wv @ A.T) * k
+                g = (np.cross(w[:, None], wv) @ A.T) * k
+                C += _sums(a.reshape(idx.size, -1), b.reshape(idx.size, -1), g.reshape(idx.size, -1))
+            if not (mp.any() or mq.any() or mh.any()):
+                continue
+            lo = np.maximum(prob.lower[v] - xs[:, v], -np.pi)
+            hi = np.minimum(prob.upper[v] - xs[:, v], np.pi)
+            th = _trig_minimum(C, np.minimum(lo, 0.0), np.maximum(hi, 0.0))
+            xs[:, v] = np.clip(xs[:, v] + th, prob.lower[v], prob.upper[v])
+            s, cm = np.sin(th), 1.0 - np.cos(th)
+            if mp.any():
+                yp[:, mp] = cv[:, None] + _rotate(yp[:, mp] - cv[:, None], w[:, None], s[:, None], cm[:, None])
+            if mq.any():
+                yq[:, mq] = cv[:, None] + _rotate(yq[:, mq] - cv[:, None], w[:, None], s[:, None], cm[:, None])
+            if mh.any():
+                vh[:, mh] = _rotate(vh[:, mh], w[:, None], s[:, None], cm[:, None])
+        if model.translate:
+            # The residuals are linear in the translation: one Gauss-Newton
+            # step on it alone is its exact minimiser given the angles.
+            rt, Jt, _ = prob.evaluate(idx, stack, xs, jac=True)
+            Jt = Jt[..., V:]
+            H = np.swapaxes(Jt, 1, 2) @ Jt
+            g = np.einsum("bmp,bm->bp", Jt, rt)
+            # A whisker of damping keeps H invertible when the goals pin the
+            # translation in fewer than three directions (plane goals only).
+            H += (1e-12 * np.trace(H, axis1=1, axis2=2) + 1e-300)[:, None, None] * np.eye(3)
+            dt = -np.linalg.solve(H, g[..., None])[..., 0]
+            xs[:, V:] += dt
+        rn, _, dn = prob.evaluate(idx, stack, xs, jac=False)
+        fn = 0.5 * np.einsum("bm,bm->b", rn, rn)
+        gain = fs - fn
+        # Every coordinate move was exact and kept only if it helped, so the
+        # sweep can only lower f (up to rounding, which the check absorbs).
+        accept = gain >= 0
+        a = idx[accept]
+        st.x[a], st.r[a], st.dist[a], st.f[a] = xs[accept], rn[accept], dn[accept], fn[accept]
+        st.iterations[idx] += 1
+        st.record()
+        conv = _converged(st.dist[idx], st.active_goals[idx], st.tol)
+        st.status[idx[conv]] = CONVERGED
+        stalled = ~conv & (~accept | (gain <= FTOL * fs))
+        st.status[idx[stalled]] = STALLED
+        st.check_progress(idx)
+    return st.finish()
+
+
+def _sums(a: np.ndarray, b: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """The six sums over rows of ``(a + b sin + g (1 - cos))^2``'s coefficients, shape (B, 6)."""
+    return np.stack(
+        [
+            np.einsum("bm,bm->b", a, a),
+            np.einsum("bm,bm->b", a, b),
+            np.einsum("bm,bm->b", a, g),
+            np.einsum("bm,bm->b", b, b),
+            np.einsum("bm,bm->b", g, g),
+            np.einsum("bm,bm->b", b, g),
+        ],
+        axis=1,
+    )
