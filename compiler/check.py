@@ -141,10 +141,8 @@ class Checker:
                 for slot in sig.slots:
                     sig.param_types[slot.keyword] = scope.types.get(slot.param, T.REAL)
                 self.primitives[p.name.name] = (prim, sig, scope)
-            for _ in range(3):
-                self._check_scope(prog.body, main, primitive=None)
-            self.final = True
             self._check_scope(prog.body, main, primitive=None)
+            self._settled_pass(prog.body, main)
         except _Stop:
             pass
         if self.errors:
@@ -237,6 +235,29 @@ class Checker:
                 taken.append(n)
             self.loads[id(stmt)] = (index, taken)
         self.final = False
+
+    def _settled_pass(self, body: list, main: Scope) -> None:
+        """Run reporting passes until one leaves the implicit types as it found them.
+
+        A pass can widen an implicit INTEGER to REAL that an earlier line
+        already used; only a pass that changes no type has trustworthy
+        reports. Big programs usually settle at once, so this costs one pass
+        where a fixed count of passes cost three.
+        """
+        errors, warnings = len(self.errors), len(self.warnings)
+        for attempt in range(4):
+            before = dict(main.types)
+            self.final = True
+            del self.errors[errors:]
+            del self.warnings[warnings:]
+            try:
+                self._check_scope(body, main, primitive=None)
+            except _Stop:
+                if main.types == before or attempt == 3:
+                    raise
+                continue
+            if main.types == before:
+                return
 
     def _check_recursion(self, p: A.PrimitiveDef) -> None:
         """A PRIMITIVE may not call itself, directly or through others (it would never end)."""

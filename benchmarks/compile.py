@@ -1,0 +1,192 @@
+"""Compile-speed benchmark: liganimate's front end against the alternatives, in one run.
+
+Measured, each as the best of several rounds (the machine is shared and
+noisy; other load only ever slows a round down):
+
+* Appendix A compiled in process once the parser is built (parse, check,
+  lower), against the same grammar parsed by Lark's stock contextual lexer
+  (what a user of Lark would write) and against CPython compiling the
+  generated module (a native compiler handling the same program). The
+  thesis' preprocessor took 1.139 CPU seconds for Appendix A's 99
+  statements; that ratio is reported too. Target: under 20 ms.
+* A 10,000-line program in the thesis' style (Appendix A's models, motion
+  and scene copied under new names: comments, blank lines, about five
+  tokens a line), compiled in process. Target: under 1 s. Also reported, as
+  a stress figure without a target: a dense 10,000-line program where every
+  line is a statement (arithmetic, vectors, keyframes, IF, DO, JOINT), about
+  fifteen tokens a line.
+* A cold ``liganimate check examples/appendix_a.lig`` in a new process,
+  against ``python -c "import numpy, lark"`` (the floor any Python tool
+  using them pays) and ``python -c pass``. Target: under 0.5 s.
+
+Usage: ``python benchmarks/compile.py [--quick]``. The last line printed is
+one JSON object holding the figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from importlib import resources
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+APPENDIX_A = os.path.join(ROOT, "examples", "appendix_a.lig")
+THESIS_SECONDS = 1.139
+
+
+def thesis_style_program(lines: int = 10_000) -> str:
+    """Appendix A's program, its models, motion and scene copied under new names, to ``lines`` lines.
+
+    The thesis' own text is the fairest sample of what LIG ANIMATE programs
+    look like: comments, blank lines, one statement a line or less. Each copy
+    renames the program's variables (HEAD -> HEAD2...) and shoots its own
+    scene, so the result is a program that also runs.
+    """
+    import re
+
+    text = open(APPENDIX_A, encoding="utf-8").read()
+    head_end = text.index("      END\n") + len("      END\n")  # the PRIMITIVE BOX
+    body = text[head_end:text.index("*     SHOOTSCENE")]
+    names = ["HEAD", "BODY", "TORSO", "FARM", "BARM", "FLEG", "BLEG", "FOOT", "LOCATN", "DISTAN",
+             "VUWID", "TORWID", "FRMNUM", "HUMAN", "LARM", "RARM", "LLEG", "RLEG", "SQUAT"]
+    word = re.compile(r"\b(" + "|".join(names) + r")\b")
+    out = [text[:head_end]]
+    total = text[:head_end].count("\n") + 3
+    k = 0
+    while total + body.count("\n") <= lines:
+        k += 1
+        copy = word.sub(lambda m: f"{m.group(1)}{k}", body).replace("INITIALIZE SCENE 1", f"INITIALIZE SCENE {k}")
+        out.append(copy)
+        total += copy.count("\n")
+    out.append("\n" * (lines - total) + "      SHOOTSCENES\n      STOP\n      END\n")
+    return "".join(out)
+
+
+def big_program(lines: int = 10_000) -> str:
+    """A dense program of ``lines`` lines, every line a statement, using most statement kinds."""
+    out = ["REAL X, Y", "VECTOR V", "MOTION M", "GRAPHICAL G", "MODEL A",
+           "G :- BOX WIDTH 1, HEIGHT 2, DEPTH 0.5"]
+    i = 0
+    while len(out) < lines:
+        i += 1
+        out += [
+            f"X = X + {i}.5 * (Y - 2) / 3",
+            f"V = (X, Y, {i}) + V * 0.5",
+            f"M[{i % 20 + 1}, 1] := FRAME {i % 50 + 1} POSITION X, 0, {i % 90}",
+            f"IF X > {i} THEN Y = Y + 1 ELSE Y = Y - 1",
+            f"DO {i + 10} J = 1, 3",
+            "  Y = Y + J MOD 2",
+            f"{i + 10} CONTINUE",
+            f"A :- JOINT {i % 30 + 1}, G, (0, 1, 0), G, (0, -1, 0), (-45, 45), (0, 0), (-90, {i % 90})",
+        ]
+    return "\n".join(out[:lines]) + "\n"
+
+
+def best(fn, rounds: int) -> float:
+    """The shortest of ``rounds`` timings of ``fn()``, in seconds."""
+    times = []
+    for _ in range(rounds):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def cold(cmd: list, rounds: int) -> float:
+    """The shortest wall time of running ``cmd`` in a new process."""
+    def once():
+        r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise SystemExit(f"{' '.join(cmd)} failed:\n{r.stderr}")
+    return best(once, rounds)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="fewer rounds (under a minute)")
+    args = ap.parse_args(argv)
+    rounds = 5 if args.quick else 20
+    big_rounds = 2 if args.quick else 5
+    cold_rounds = 3 if args.quick else 10
+
+    from lark import Lark
+
+    from liganimate.compiler import compile_text
+    from liganimate.lang import parser as P
+    from liganimate.lang.source import prepare
+    from liganimate.lang.transform import ToAst
+
+    text = open(APPENDIX_A, encoding="utf-8").read()
+    P.build_parser()
+    compiled = compile_text(text, APPENDIX_A)
+    grammar = resources.files("liganimate.lang").joinpath("lig.lark").read_text(encoding="utf-8")
+    stock = Lark(grammar, parser="lalr", lexer="contextual", postlex=P._PrimitiveNames(),
+                 transformer=ToAst(), maybe_placeholders=False)
+    lexed = prepare(text, APPENDIX_A).lexed
+
+    def stock_parse():
+        token = P._primitive_names.set(P.BUILTIN_PRIMITIVES)
+        try:
+            stock.parse(lexed)
+        finally:
+            P._primitive_names.reset(token)
+
+    # Interleave the three so drifting load hits all alike.
+    t_ours = t_parse = t_stock = t_python = float("inf")
+    for _ in range(rounds):
+        t_ours = min(t_ours, best(lambda: compile_text(text, APPENDIX_A), 1))
+        t_parse = min(t_parse, best(lambda: P.parse(text, APPENDIX_A), 1))
+        t_stock = min(t_stock, best(stock_parse, 1))
+        t_python = min(t_python, best(lambda: compile(compiled.python, "appendix_a.py", "exec"), 1))
+    print(f"Appendix A, parser built: compile {t_ours * 1e3:.1f} ms (parse {t_parse * 1e3:.1f} ms); "
+          f"stock Lark contextual parse {t_stock * 1e3:.1f} ms; CPython compiling the generated module "
+          f"{t_python * 1e3:.1f} ms; the thesis' preprocessor {THESIS_SECONDS:.3f} s")
+
+    thesis = thesis_style_program()
+    big = big_program()
+    t_thesis = t_big = float("inf")
+    for _ in range(big_rounds):
+        t_thesis = min(t_thesis, best(lambda: compile_text(thesis, "thesis_style.lig"), 1))
+        t_big = min(t_big, best(lambda: compile_text(big, "dense.lig"), 1))
+    print(f"10,000-line program in the thesis' style ({thesis.count(chr(10))} lines): compile {t_thesis:.3f} s; "
+          f"dense 10,000 statements: compile {t_big:.3f} s")
+
+    exe = sys.executable
+    t_check = t_floor = t_python0 = float("inf")
+    for _ in range(cold_rounds):
+        t_check = min(t_check, cold([exe, "-m", "liganimate", "check", APPENDIX_A], 1))
+        t_floor = min(t_floor, cold([exe, "-c", "import numpy, lark"], 1))
+        t_python0 = min(t_python0, cold([exe, "-c", "pass"], 1))
+    print(f"cold liganimate check appendix_a.lig: {t_check:.3f} s; python -c 'import numpy, lark' {t_floor:.3f} s; "
+          f"python -c pass {t_python0:.3f} s")
+
+    figures = {
+        "appendix_a_compile_ms": round(t_ours * 1e3, 2),
+        "appendix_a_parse_ms": round(t_parse * 1e3, 2),
+        "appendix_a_stock_lark_parse_ms": round(t_stock * 1e3, 2),
+        "appendix_a_cpython_compile_ms": round(t_python * 1e3, 2),
+        "ratio_stock_lark_parse_to_ours": round(t_stock / t_parse, 2),
+        "ratio_thesis_to_ours": round(THESIS_SECONDS / t_ours, 1),
+        "thesis_style_lines": thesis.count("\n"),
+        "thesis_style_compile_s": round(t_thesis, 3),
+        "dense_lines": big.count("\n"),
+        "dense_compile_s": round(t_big, 3),
+        "cold_check_s": round(t_check, 3),
+        "cold_import_numpy_lark_s": round(t_floor, 3),
+        "cold_python_s": round(t_python0, 3),
+        "targets_met": {
+            "appendix_a_under_20ms": t_ours < 0.020,
+            "10000_lines_under_1s": t_thesis < 1.0,
+            "cold_check_under_0.5s": t_check < 0.5,
+        },
+    }
+    print(json.dumps(figures))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
