@@ -129,42 +129,97 @@ class Canvas:
 
 
 def polygons_to_graphical(polys) -> Graphical:
-    """Fan-triangulate convex polygons; mark the set closed if it is a closed oriented surface."""
+    """Fan-triangulate convex polygons; mark the closed solids among them.
+
+    Polygons that together form a closed surface (every edge shared by
+    exactly two of them) are a solid, whatever the order their corners were
+    listed in: its triangles are wound outward (a polygon listed the other
+    way round has each triangle's corners reversed, which draws the same
+    pixels) and marked closed, so the rasterizer may skip those facing away.
+    The thesis' own PRIMITIVE BOX lists three of its six faces inward.
+    """
     if not polys:
         return EMPTY
-    tris, light = [], []
-    for pts, l in polys:
+    tris, light, owner = [], [], []
+    for i, (pts, l) in enumerate(polys):
         for k in range(1, len(pts) - 1):
             tris.append((pts[0], pts[k], pts[k + 1]))
             light.append(l)
+            owner.append(i)
     tris = np.asarray(tris, dtype=np.float64)
-    closed = _closed_orientation(polys)
-    if closed == 0:
-        return Graphical(tris, light, np.zeros(len(tris), dtype=bool))
-    if closed < 0:
-        tris = tris[:, ::-1, :]
-    return Graphical(tris, light, np.ones(len(tris), dtype=bool))
+    side = np.asarray(_solid_orientation(polys), dtype=np.int8)[owner]
+    flip = side < 0
+    if flip.any():
+        tris[flip] = tris[flip][:, ::-1, :]
+    return Graphical(tris, light, side != 0)
 
 
-def _closed_orientation(polys) -> int:
-    """+1 if the polygons form a closed surface wound outward, -1 if inward, 0 if not closed/consistent."""
-    edges = {}
-    for pts, _ in polys:
-        keyed = [tuple(np.round(p, 9)) for p in pts]
-        for a, b in zip(keyed, keyed[1:] + keyed[:1]):
-            edges[(a, b)] = edges.get((a, b), 0) + 1
-    for (a, b), n in edges.items():
-        if n != 1 or edges.get((b, a), 0) != 1:
-            return 0
-    vol = 0.0
-    for pts, _ in polys:
-        for k in range(1, len(pts) - 1):
-            vol += float(np.dot(pts[0], np.cross(pts[k], pts[k + 1])))
-    if vol > 0:
-        return 1
-    if vol < 0:
-        return -1
-    return 0
+def _solid_orientation(polys) -> list:
+    """Per polygon: +1 (part of a closed solid, wound outward), -1 (closed, wound inward), 0 (not closed).
+
+    The polygons are grouped into surfaces by shared edges.  A surface is a
+    solid when every edge is used by exactly two polygons and the polygons
+    can be wound consistently (each shared edge walked once each way); its
+    outward side is the one that gives a positive enclosed volume.
+    """
+    keyed = [[tuple(np.round(p, 9)) for p in pts] for pts, _ in polys]
+    uses: dict = {}  # undirected edge -> [(polygon, forward)]
+    bad = set()
+    for i, ks in enumerate(keyed):
+        if len(set(ks)) != len(ks):
+            bad.add(i)  # a repeated corner: not a proper face
+        for a, b in zip(ks, ks[1:] + ks[:1]):
+            if a == b:
+                continue
+            key, forward = ((a, b), True) if a < b else ((b, a), False)
+            uses.setdefault(key, []).append((i, forward))
+    n = len(polys)
+    side = [0] * n
+    seen = [False] * n
+    for first in range(n):
+        if seen[first]:
+            continue
+        # Walk one surface, choosing each polygon's winding relative to the first.
+        sign = {first: 1}
+        stack, ok = [first], first not in bad
+        seen[first] = True
+        while stack:
+            i = stack.pop()
+            ks = keyed[i]
+            for a, b in zip(ks, ks[1:] + ks[:1]):
+                if a == b:
+                    continue
+                users = uses[(a, b) if a < b else (b, a)]
+                if len(users) != 2:
+                    ok = False
+                    continue
+                (p, fp), (q, fq) = users
+                if p == q:
+                    ok = False
+                    continue
+                other, f_other, f_self = (q, fq, fp) if p == i else (p, fp, fq)
+                # Consistent winding walks a shared edge once each way.
+                want = sign[i] * (1 if f_self != f_other else -1)
+                if other in sign:
+                    ok = ok and sign[other] == want
+                else:
+                    sign[other] = want
+                    seen[other] = True
+                    ok = ok and other not in bad
+                    stack.append(other)
+        if not ok:
+            continue
+        vol = 0.0
+        for i, sgn in sign.items():
+            pts = polys[i][0]
+            for k in range(1, len(pts) - 1):
+                vol += sgn * float(np.dot(pts[0], np.cross(pts[k], pts[k + 1])))
+        if vol == 0:
+            continue
+        outward = 1 if vol > 0 else -1
+        for i, sgn in sign.items():
+            side[i] = sgn * outward
+    return side
 
 
 def box(centre, width, height, depth, light) -> Graphical:
