@@ -97,3 +97,27 @@ def test_compile_output_is_stable(path, regen_golden):
         return
     assert stored.exists(), "run with --regen-golden to store the compiled module"
     assert normalised == stored.read_text()
+
+
+def test_plot_draws_a_motion_deterministically(tmp_path):
+    import numpy as np
+    from PIL import Image
+
+    for out in ("a.png", "b.png"):
+        r = run("plot", str(EXAMPLES / "appendix_a.lig"), "squat", "-o", out, cwd=tmp_path)
+        assert r.returncode == 0, r.stderr
+    assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes()
+    img = np.asarray(Image.open(tmp_path / "a.png").convert("RGB"))
+    # One panel per joint of SQUAT (8 joints): a tall figure, with the blue Z curve drawn.
+    assert img.shape[0] > img.shape[1] > 500
+    blue = (abs(img[..., 0].astype(int) - 0x2C) < 12) & (abs(img[..., 2].astype(int) - 0xA8) < 12)
+    assert blue.sum() > 1000
+
+
+def test_plot_of_an_unknown_motion_is_an_error_and_writes_nothing(tmp_path):
+    r = run("plot", str(EXAMPLES / "appendix_a.lig"), "SQAT", "-o", "x.png", cwd=tmp_path)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert "the program has no motion called SQAT" in r.stderr and "did you mean SQUAT?" in r.stderr
+    r = run("plot", str(EXAMPLES / "appendix_a.lig"), "HUMAN", "-o", "x.png", cwd=tmp_path)
+    assert r.returncode == 1 and "HUMAN is not a MOTION" in r.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,99 @@
+"""``liganimate plot``: a motion's joint angle curves, drawn with matplotlib.
+
+One panel per joint, its X, Y and Z angles against the frame, each keyframe
+marked where it sets its value. The curves are sampled from the motion
+itself (the same evaluation ANIMATE uses), so ramps, holds and the velocity
+adjustment show as they play.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from .errors import LigError
+from .imagefiles import _atomic
+
+# Samples across the whole motion: enough for smooth curves over a few
+# hundred frames, bounded so that ``1000000000 * WALK`` still plots at once.
+MAX_SAMPLES = 4000
+MAX_MARKED_KEYFRAMES = 400
+_AXES = (("X", "#c0392b"), ("Y", "#27ae60"), ("Z", "#2c5fa8"))
+
+
+def sample_times(length: float, max_samples: int = MAX_SAMPLES) -> np.ndarray:
+    """Frames at which to sample a motion of ``length`` frames, shape (T,).
+
+    Every whole frame when there are few, otherwise ``max_samples`` evenly spaced.
+    """
+    if length <= 0:
+        return np.zeros(1)
+    if length <= max_samples / 4:
+        return np.linspace(0.0, length, int(round(length * 4)) + 1)
+    return np.linspace(0.0, length, max_samples)
+
+
+def plot_motion_figure(motion, title: str):
+    """A matplotlib Figure of ``motion``'s angle curves (one axes per joint)."""
+    from matplotlib.figure import Figure
+
+    joints = motion.joints
+    n = max(1, len(joints))
+    fig = Figure(figsize=(8.0, 1.6 + 1.5 * n), dpi=100)
+    axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+    t = sample_times(motion.length)
+    angles = motion.evaluate(t) if joints else np.zeros((len(t), 0, 3))
+    for i, j in enumerate(joints):
+        ax = axes[i]
+        for k, (label, colour) in enumerate(_AXES):
+            ax.plot(t, angles[:, i, k], color=colour, lw=1.4, label=label)
+        try:
+            start, keys = motion.keyframes(j, limit=MAX_MARKED_KEYFRAMES)
+        except LigError:
+            keys, start = None, None  # too many to mark (a long repetition): curves only
+        if keys is not None:
+            frames = np.array([0.0] + [k[0] for k in keys])
+            values = np.array([start] + [k[1] for k in keys], dtype=float)
+            for k, (_, colour) in enumerate(_AXES):
+                ax.plot(frames, values[:, k], "o", color=colour, ms=4, mfc="white", mew=1.2)
+        ax.set_ylabel(f"joint {j}\n(degrees)")
+        ax.grid(True, color="#dddddd", lw=0.6)
+    if not joints:
+        axes[0].text(0.5, 0.5, "this motion drives no joint", ha="center", va="center", transform=axes[0].transAxes)
+    axes[0].legend(loc="upper right", ncols=3, fontsize="small", frameon=False)
+    axes[-1].set_xlabel("frame")
+    fig.suptitle(f"MOTION {title}: {motion.length:g} frames (keyframes marked)")
+    fig.tight_layout()
+    return fig
+
+
+def plot_motion(rt, name: str, out_path: str) -> None:
+    """Plot the MOTION variable ``name`` of a program run by ``rt`` to the PNG ``out_path``.
+
+    Raises
+    ------
+    LigError
+        When the program has no such motion. Nothing is written then.
+    """
+    from liganimate.lang.diagnostics import did_you_mean
+
+    from .motion import Motion
+
+    variables = rt.variables
+    value = variables.get(name)
+    if value is None or not isinstance(value, Motion):
+        motions = sorted(n for n, v in variables.items() if isinstance(v, Motion))
+        if name in variables:
+            raise LigError(f"{name} is not a MOTION", "the program's motions are " + (", ".join(motions) or "none"))
+        hint = did_you_mean(name, motions) or ("the program's motions are " + (", ".join(motions) or "none"))
+        raise LigError(f"the program has no motion called {name}", hint)
+    fig = plot_motion_figure(value, name)
+    buffer = io.BytesIO()
+    # No metadata: the same motion gives the same bytes.
+    fig.savefig(buffer, format="png", metadata={"Software": None})
+    with _atomic(out_path, True) as fh:
+        fh.write(buffer.getvalue())
+
+
+__all__ = ["plot_motion", "plot_motion_figure", "sample_times"]
