@@ -395,13 +395,14 @@ def reach(
     solver: str = "dls",
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    restarts: int = 0,
     joints: Iterable[int] | None = None,
 ) -> Reach:
     """A motion from a start pose to the pose that best meets the goals.
 
     Parameters
     ----------
-    figure, goals, start, movable, translate, solver, tolerance, max_iterations
+    figure, goals, start, movable, translate, solver, tolerance, max_iterations, restarts
         As for :func:`solve_pose`; the goals must not be batched (see
         :func:`reach_keyframes`).
     frames : float
@@ -434,7 +435,7 @@ def reach(
     if batch_size(goals) is not None:
         raise GoalError("reach() takes unbatched goals; use reach_keyframes() for a batch.")
     sol = solve_pose(figure, goals, start=start, movable=movable, translate=translate, solver=solver,
-                     tolerance=tolerance, max_iterations=max_iterations)
+                     tolerance=tolerance, max_iterations=max_iterations, restarts=restarts)
     s0 = start_pose(figure, start)
     driven = _driven(figure, goals, movable, start, joints)
     tracks = {}
@@ -456,6 +457,7 @@ def reach_keyframes(
     solver: str = "dls",
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    restarts: int = 0,
     joints: Iterable[int] | None = None,
 ) -> Reach:
     """One motion through the solutions of a batch of goals (a moving target).
@@ -466,7 +468,7 @@ def reach_keyframes(
 
     Parameters
     ----------
-    figure, goals, start, movable, translate, solver, tolerance, max_iterations, joints
+    figure, goals, start, movable, translate, solver, tolerance, max_iterations, restarts, joints
         As for :func:`reach`; the goals carry a batch dimension ``B``.
     frames : sequence of float, length B
         Non-decreasing keyframe frames.
@@ -489,7 +491,7 @@ def reach_keyframes(
     if s0.ndim == 3:
         raise GoalError("reach_keyframes() starts every solve from one pose; give an unbatched start.")
     sol = solve_pose(figure, goals, start=np.broadcast_to(s0, (B,) + s0.shape), movable=movable, translate=translate,
-                     solver=solver, tolerance=tolerance, max_iterations=max_iterations)
+                     solver=solver, tolerance=tolerance, max_iterations=max_iterations, restarts=restarts)
     driven = _driven(figure, goals, movable, start, joints)
     tracks = {}
     for jid in driven:
