@@ -451,7 +451,16 @@ def _doc_escape(text: str) -> str:
 def _source_text(source: str, pos: A.Pos) -> str:
     lines = source.splitlines()
     if pos.line == pos.end_line and 1 <= pos.line <= len(lines):
-        return lines[pos.line - 1][pos.column - 1: pos.end_column - 1].upper()
+        line = lines[pos.line - 1]
+        end = pos.end_column - 1
+        # A call's span stops at its last argument (the parser drops the
+        # ")" token); take the closing parentheses the label still needs.
+        while line[pos.column - 1:end].count("(") > line[pos.column - 1:end].count(")"):
+            close = line.find(")", end)
+            if close < 0:
+                break
+            end = close + 1
+        return line[pos.column - 1:end].upper()
     return "value"
 
 

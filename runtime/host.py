@@ -234,7 +234,8 @@ class Runtime:
         return int(x)
 
     def f_NINT(self, x, at):
-        return int(math.floor(x + 0.5))
+        # FORTRAN's NINT, which the thesis' host language had: halves away from zero.
+        return int(math.copysign(math.floor(abs(x) + 0.5), x))
 
     def f_REAL(self, x, at):
         return float(x)

@@ -121,3 +121,12 @@ def test_plot_of_an_unknown_motion_is_an_error_and_writes_nothing(tmp_path):
     r = run("plot", str(EXAMPLES / "appendix_a.lig"), "HUMAN", "-o", "x.png", cwd=tmp_path)
     assert r.returncode == 1 and "HUMAN is not a MOTION" in r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_print_labels_whole_calls_and_nint_rounds_like_fortran(tmp_path):
+    prog = tmp_path / "p.lig"
+    prog.write_text("PRINT MOD(-7, 3), NINT(-2.5), NINT(2.5), NINT(-2.4), MAX(ABS(-2), 1)\n")
+    r = run("run", str(prog), "--quiet", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == ["MOD(-7, 3) = 2", "NINT(-2.5) = -3", "NINT(2.5) = 3", "NINT(-2.4) = -2",
+                                     "MAX(ABS(-2), 1) = 2"]
