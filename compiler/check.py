@@ -23,6 +23,8 @@ from . import types as T
 from .primitives import Signature, builtin_signatures, signature_from_pattern
 
 MAX_ERRORS = 20
+# REACH solvers: the language's word -> the runtime's name (runtime/solvers.py).
+_SOLVERS = {"DLS": "dls", "TRANSPOSE": "transpose", "CCD": "ccd"}
 
 
 @dataclass
@@ -510,6 +512,62 @@ class Checker:
         if self.scene is not None:
             self.scene.assigned.add(s.name.name)
 
+    def _s_ReachBlock(self, s, context):
+        if self.primitive is not None:
+            self.err(s, "STARTREACH belongs in the main program or a scene, not in a PRIMITIVE")
+        self._define_as(s.name, T.MOTION, "{name} is {noun}, not a MOTION")
+        self._want(s.model, T.MODEL, "the model of a REACH")
+        self._want_number(s.frames, "the frame of the solved pose")
+        if s.method is not None:
+            self._method(s.method)
+        if s.start is not None:
+            self._want(s.start, T.MOTION, "the start motion (FROM)")
+        for word, places in s.options.items():
+            if word != "GOAL" and len(places) > 1:
+                self.err(places[1], f"{word} is given twice in this REACH",
+                         f"the first is at line {places[0].line}; keep one")
+        if s.joints is not None and s.chain is not None:
+            self.err(s.options["MOVE CHAIN"][0], "MOVE JOINTS and MOVE CHAIN both choose the movable joints; keep one")
+        if not s.goals:
+            self.err(s, f"REACH {s.name.name} has no GOAL",
+                     "add a line such as  GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10")
+        for g in s.goals:
+            if g.joint is not None:
+                self._want(g.joint, T.INTEGER, "a joint identifier")
+            if g.point is not None:
+                self._want(g.point, T.VECTOR, "a point in the link's coordinates (AT)")
+            if g.kind == "point":
+                self._want(g.target, T.VECTOR, "the goal's world point (TO)")
+            elif g.kind == "plane":
+                self._want(g.target, T.VECTOR, "a point of the plane (ON PLANE)")
+                self._want(g.normal, T.VECTOR, "the plane's normal (NORMAL)")
+            else:
+                self._want(g.normal, T.VECTOR, "a direction in the link's coordinates (AXIS)")
+                self._want(g.target, T.VECTOR, "the world direction (ALONG)")
+            if g.weight is not None:
+                self._want_number(g.weight, "a goal's weight")
+                c = _const(g.weight)
+                if c is not None and c < 0:
+                    self.err(g.weight, f"a goal's weight cannot be negative ({_fmt(c)})",
+                             "only the ratios of weights matter; 0 switches a goal off")
+        for j in s.joints or ():
+            self._want(j, T.INTEGER, "a joint identifier")
+        if s.chain is not None:
+            self._want(s.chain, T.INTEGER, "a chain length")
+        if s.translate is not None:
+            self._define_as(s.translate, T.VECTOR, "{name} is {noun}; TRANSLATE INTO needs a VECTOR")
+            if self.scene is not None:
+                self.scene.assigned.add(s.translate.name)
+        if s.solver is not None and s.solver.name not in _SOLVERS:
+            hint = did_you_mean(s.solver.name, list(_SOLVERS))
+            self.err(s.solver, f"{s.solver.name} is not a solver", hint or "the solvers are " + ", ".join(_SOLVERS))
+        if s.tolerance is not None:
+            self._want_number(s.tolerance, "the tolerance")
+        if s.iterations is not None:
+            self._want(s.iterations, T.INTEGER, "the iteration limit")
+        if self.scene is not None:
+            self.scene.assigned.add(s.name.name)
+
     def _s_FigureStmt(self, s, context):
         self._want_var(s.model, T.MODEL)
         if s.kind == "JOINT":
@@ -923,6 +981,10 @@ def _defined_names(stmt) -> list:
         out.append(stmt.target)
     elif isinstance(stmt, (A.ModelBlock, A.MotionBlock)):
         out.append(stmt.name)
+    elif isinstance(stmt, A.ReachBlock):
+        out.append(stmt.name)
+        if stmt.translate is not None:
+            out.append(stmt.translate)
     elif isinstance(stmt, A.Do):
         out.append(stmt.var)
     for attr in ("body", "then", "orelse"):

@@ -16,7 +16,7 @@ from liganimate import __version__
 from liganimate.lang import ast as A
 
 from . import types as T
-from .check import Checked
+from .check import _SOLVERS, Checked
 
 _ZERO = {
     T.INTEGER: "0",
@@ -229,6 +229,30 @@ class Lowerer:
             self.emit(f"    ({self.expr(j.joint)}, {start}, ({inner}), {self.at(j)}),")
         self.emit(f"), {self.at(s)})")
 
+    def s_ReachBlock(self, s, where):
+        def opt(e):
+            return "None" if e is None else self.expr(e)
+
+        goals = []
+        for g in s.goals:
+            link = repr(g.link.name) if g.link is not None else "None"
+            goals.append(f"({g.kind!r}, {link}, {opt(g.joint)}, {opt(g.point)}, {opt(g.target)}, "
+                         f"{opt(g.normal)}, {opt(g.weight)}, {self.at(g)})")
+        if s.joints is not None:
+            movable = "('joints', (" + "".join(self.expr(j) + ", " for j in s.joints) + "))"
+        elif s.chain is not None:
+            movable = f"('chain', {self.expr(s.chain)})"
+        else:
+            movable = "None"
+        solver = repr(_SOLVERS[s.solver.name]) if s.solver is not None else "'dls'"
+        method = repr(s.method.name) if s.method is not None else "'LINEAR'"
+        target = f"{s.name.name}, {s.translate.name}" if s.translate is not None else f"{s.name.name}, _"
+        self.emit(f"{target} = rt.reach({self.expr(s.model)}, {opt(s.start)}, {self.expr(s.frames)}, {method}, (")
+        for g in goals:
+            self.emit(f"    {g},")
+        self.emit(f"), {movable}, {s.translate is not None}, {solver}, {opt(s.tolerance)}, {opt(s.iterations)}, "
+                  f"{self.at(s)})")
+
     def s_FigureStmt(self, s, where):
         if s.kind is None:
             arg = "None"
@@ -438,6 +462,10 @@ def _assigned_in(scene: A.Scene) -> set:
             out.add(n.name.name)
         elif isinstance(n, A.FigureStmt):
             out.add(n.model.name)
+        elif isinstance(n, A.ReachBlock):
+            out.add(n.name.name)
+            if n.translate is not None:
+                out.add(n.translate.name)
         elif isinstance(n, A.Do):
             out.add(n.var.name)
         stack.extend(children(n))

@@ -232,6 +232,36 @@ class MotionBlock(Node):
 
 
 @dataclass(slots=True)
+class Goal(Node):
+    """One goal of a REACH block: ``kind`` is "point", "plane" or "axis"."""
+
+    kind: str
+    link: Optional[Name]  # a link name, or None when ``joint`` names it
+    joint: Optional[Node]  # GOAL JOINT n: the link joint n attaches
+    point: Optional[Node]  # AT (p): the point in the link's coordinates
+    target: Optional[Node]  # point: TO (x); plane: its point; axis: ALONG (d)
+    normal: Optional[Node]  # plane: NORMAL (n); axis: AXIS (a) in the link
+    weight: Optional[Node]
+
+
+@dataclass(slots=True)
+class ReachBlock(Node):
+    name: Name
+    model: Node
+    frames: Node
+    method: Optional[Name]
+    start: Optional[Node]  # FROM motion
+    goals: list  # of Goal
+    joints: Optional[list] = None  # MOVE JOINTS ...
+    chain: Optional[Node] = None  # MOVE CHAIN n
+    translate: Optional[Name] = None  # TRANSLATE INTO v
+    solver: Optional[Name] = None
+    tolerance: Optional[Node] = None
+    iterations: Optional[Node] = None
+    options: dict = field(default_factory=dict)  # option word -> Pos of its first use (for duplicates)
+
+
+@dataclass(slots=True)
 class FigureStmt(Node):
     model: Name
     kind: Optional[str]  # None, LINK or JOINT

@@ -101,6 +101,84 @@ class ToAst(Transformer):
     def position(self, children):
         return list(children)
 
+    # ------------------------------------------------------------- REACH
+    def reach_block(self, children):
+        name, model, frames = _name(children[1]), children[3], children[5]
+        method = start = None
+        items = []
+        i = 6
+        while i < len(children):
+            c = children[i]
+            if isinstance(c, A.Name) and method is None and not items and start is None:
+                method = c
+            elif isinstance(c, Token) and c.type == "FROM":
+                start = children[i + 1]
+                i += 1
+            elif isinstance(c, tuple):
+                items.append(c)
+            i += 1
+        block = A.ReachBlock(span(children), name, model, frames, method, start, [])
+        for word, pos, value in items:
+            block.options.setdefault(word, []).append(pos)
+            if word == "GOAL":
+                block.goals.append(value)
+            elif word == "MOVE JOINTS":
+                block.joints = value
+            elif word == "MOVE CHAIN":
+                block.chain = value
+            elif word == "TRANSLATE":
+                block.translate = value
+            elif word == "SOLVER":
+                block.solver = value
+            elif word == "TOLERANCE":
+                block.tolerance = value
+            elif word == "ITERATIONS":
+                block.iterations = value
+        return block
+
+    def reach_goal(self, children):
+        link, spec = children[1], children[2]
+        kind, point, target, normal = spec
+        weight = children[4] if len(children) > 3 else None
+        last = max((n for n in (weight, target, normal) if n is not None), key=lambda n: (n.pos.end_line, n.pos.end_column))
+        goal = A.Goal(_tpos(children[0]).to(last.pos), kind, link if isinstance(link, A.Name) else None,
+                      None if isinstance(link, A.Name) else link, point, target, normal, weight)
+        return ("GOAL", goal.pos, goal)
+
+    def goal_link(self, children):
+        if len(children) == 1:
+            return _name(children[0])
+        return _number(children[1])
+
+    def goal_point(self, children):
+        point = children[1] if len(children) == 4 else None
+        return ("point", point, children[-1], None)
+
+    def goal_plane(self, children):
+        point = children[1] if len(children) == 7 else None
+        return ("plane", point, children[-3], children[-1])
+
+    def goal_axis(self, children):
+        return ("axis", None, children[3], children[1])
+
+    def reach_move_joints(self, children):
+        return ("MOVE JOINTS", span(children), [c for c in children[2:] if not isinstance(c, Token)])
+
+    def reach_move_chain(self, children):
+        return ("MOVE CHAIN", span(children), children[2])
+
+    def reach_translate(self, children):
+        return ("TRANSLATE", span(children), _name(children[2]))
+
+    def reach_solver(self, children):
+        return ("SOLVER", span(children), _name(children[1]))
+
+    def reach_tolerance(self, children):
+        return ("TOLERANCE", span(children), children[1])
+
+    def reach_iterations(self, children):
+        return ("ITERATIONS", span(children), children[1])
+
     def interpolate(self, children):
         return _name(children[1])
 

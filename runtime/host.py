@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import sys
 from typing import Iterable
 
@@ -451,6 +452,62 @@ class Runtime:
         motion = self._guard(at, M.Motion.from_tracks, spec)
         m._cache = motion
         return motion
+
+    # ------------------------------------------------------------- REACH
+    def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
+        """A STARTREACH block: (the motion to the solved pose, the solved translation)."""
+        from . import reach as R
+
+        fig = self._model(model, at, "the model of a REACH")
+        start_motion = self._motion(start, at) if start is not None else None
+        if frames < 0:
+            self.fail(at, f"the solved pose's frame cannot be negative ({frames:g})")
+        built = []
+        for kind, link, joint, point, target, normal, weight, gat in goals:
+            if link is None:
+                try:
+                    link = fig.joint(int(joint)).secondary
+                except LigError as exc:
+                    self.fail(gat, _sentence(exc.message), exc.hint)
+            w = 1.0 if weight is None else float(weight)
+            p = (0.0, 0.0, 0.0) if point is None else tuple(point)
+            if kind == "point":
+                built.append(R.PointGoal(link, tuple(target), p, w))
+            elif kind == "plane":
+                built.append(R.PlaneGoal(link, tuple(target), tuple(normal), p, w))
+            else:
+                built.append(R.AxisGoal(link, tuple(normal), tuple(target), w))
+        if movable is not None:
+            movable = list(movable[1]) if movable[0] == "joints" else int(movable[1])
+        try:
+            result = R.reach(fig, built, float(frames), method, start=start_motion, movable=movable,
+                             translate=bool(translate), solver=solver, tolerance=tolerance,
+                             max_iterations=iterations)
+        except LigError as exc:
+            # A goal's own problem (an unknown link, a zero normal) is shown at that goal.
+            where = at
+            for g, (_, link, *_rest, gat) in zip(built, goals):
+                if link is not None and str(link).upper() in exc.message.upper():
+                    where = gat
+            self.fail(where, _sentence(exc.message), exc.hint)
+        sol = result.solution
+        for w in sol.warnings:
+            m = re.match(r"goal (\d+): ", w)
+            where = goals[int(m.group(1)) - 1][-1] if m and 0 < int(m.group(1)) <= len(goals) else at
+            self.warn(where, _sentence(w[m.end():] if m else w))
+        for i, ((kind, link, joint, *_r, gat), g) in enumerate(zip(goals, built)):
+            res = float(sol.residuals[i])
+            if float(sol.weights[i]) == 0:
+                continue
+            if kind == "axis":
+                if res > 0.01:
+                    self.warn(gat, f"this goal is missed: the axis ends {res:.3g} degrees from its direction",
+                              "the model cannot turn that far within its extremes, or other goals pull it away")
+            elif res > sol.tolerance:
+                self.warn(gat, f"this goal is missed by {res:.4g} (the tolerance is {sol.tolerance:.3g})",
+                          "the model cannot reach it within its extremes, or other goals pull it away")
+        t = np.asarray(result.translation, dtype=float).reshape(3)
+        return result.motion, Vec(float(t[0]), float(t[1]), float(t[2]))
 
     def motion_block(self, joints, at):
         spec = {}

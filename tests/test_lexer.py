@@ -38,8 +38,11 @@ def stock_parser() -> Lark:
 
 
 def outcome(parser: Lark, text: str):
+    from liganimate.compiler import _loaded_primitive_names
+
     source = prepare(text, "x.lig")
-    token = P._primitive_names.set(frozenset(P.BUILTIN_PRIMITIVES | source.primitive_names()))
+    loaded = _loaded_primitive_names(source, os.path.join(ROOT, "examples", "x.lig"), ())
+    token = P._primitive_names.set(frozenset(P.BUILTIN_PRIMITIVES | source.primitive_names() | loaded))
     try:
         return ("tree", parser.parse(source.lexed))
     except UnexpectedInput as exc:
@@ -69,6 +72,11 @@ def test_contextual_words_and_operators():
         "M = W <SCALE FRAMES -2, SCALE EXTREMES 0.5>\nFRAMES = 3\nX = 2\n",
         "IF A /= B THEN X = A / B\n",
         "SYNCHRONISE = 1\nM = SYNCHRONIZE A, B\n",
+        "X = 1\nNORMAL = (0, 1, 0)\nWEIGHT = 2\nGOAL = 3\nMOVE = GOAL + WEIGHT\n",  # REACH words as variables
+        "G :- BOX AT (0, 0, 0), WIDTH 1, HEIGHT 1, DEPTH 1\nAT = 2\n",
+        "STARTREACH R MODEL H FRAME 10 INTERPOLATE ACCDCC FROM S\n GOAL HAND AT (0, 1, 0) TO (1, 2, 3) WEIGHT 2\n"
+        " GOAL JOINT 4 ON PLANE (0, 0, 0) NORMAL (0, 1, 0)\n GOAL T AXIS (0, 1, 0) ALONG (1, 0, 0)\n"
+        " MOVE CHAIN 3; TRANSLATE INTO V; SOLVER CCD; TOLERANCE 0.01; ITERATIONS 9\nENDREACH\n",
         "X = 1 @ 2\n",
         "X = { never closed\n",
         "Y = 'open\n",
