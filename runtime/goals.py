@@ -27,7 +27,7 @@ import numpy as np
 
 from .errors import LigError
 from .figure import Figure
-from .ikmodel import IKModel, matvec3
+from .ikmodel import IKModel, cross3, matvec3
 
 __all__ = [
     "GoalError",
@@ -402,7 +402,7 @@ class GoalStack:
             y = self._link_points(R, p, self.p_link, self.p_local)  # (B, G, 3)
             res = m.to_world(y, t) - self.p_target
             rows.append(res.reshape(B, 3 * len(self.p_link)))
-            dists.append(np.linalg.norm(res, axis=-1))
+            dists.append(np.sqrt(np.einsum("bgi,bgi->bg", res, res)))
             if want_j:
                 Jw = self._point_jacobian(y, omega, c, self._downstream_p)  # (B, G, 3, V)
                 Jp = np.zeros(Jw.shape[:3] + (Pn,))
@@ -436,7 +436,7 @@ class GoalStack:
             chord = np.linalg.norm(diff, axis=-1)
             dists.append(2.0 * np.arcsin(np.minimum(chord / 2.0, 1.0)) * self.h_ell)
             if want_j:
-                dv = np.cross(omega[:, None], vm[:, :, None]) * self._downstream_h[None, :, :, None]  # (B, H, V, 3)
+                dv = cross3(omega[:, None], vm[:, :, None]) * self._downstream_h[None, :, :, None]  # (B, H, V, 3)
                 dv = m.to_world_vectors(dv)
                 # d(v/|v|) = (I - u u^T) dv / |v|
                 du = (dv - u[:, :, None] * np.einsum("bhi,bhvi->bhv", u, dv)[..., None]) / nv[:, :, None]
@@ -460,7 +460,7 @@ class GoalStack:
         # A point y moved by a variable turns about the variable's axis
         # through its pivot: dy = omega x (y - c), zero if it does not move.
         d = y[:, :, None, :] - c[:, None, :, :]  # (B, N, V, 3)
-        v = np.cross(omega[:, None], d) * down[None, :, :, None]
+        v = cross3(omega[:, None], d) * down[None, :, :, None]
         v = self.model.to_world_vectors(v)
         return np.swapaxes(v, -1, -2)
 

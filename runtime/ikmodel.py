@@ -22,7 +22,7 @@ import numpy as np
 from . import kinematics as K
 from .figure import Figure
 
-__all__ = ["IKModel", "link_lengths", "figure_length", "matvec3"]
+__all__ = ["IKModel", "link_lengths", "figure_length", "matvec3", "cross3"]
 
 
 def matvec3(M: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -44,6 +44,28 @@ def matvec3(M: np.ndarray, v: np.ndarray) -> np.ndarray:
     this in their inner loop.
     """
     return M[..., 0] * v[..., None, 0] + M[..., 1] * v[..., None, 1] + M[..., 2] * v[..., None, 2]
+
+
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of stacks of 3-vectors (broadcast), written out.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray, shape (..., 3)
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+
+    Notes
+    -----
+    ``np.cross`` moves axes around and checks its arguments on every call,
+    which costs more than the arithmetic for the small arrays of a solver
+    iteration.
+    """
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0), axis=-1)
 
 
 def link_lengths(figure: Figure) -> np.ndarray:
@@ -242,8 +264,10 @@ class IKModel:
         """
         B = q.shape[0]
         shape = (B, self.figure.n_joints, 3)
-        c = np.broadcast_to(base_cos, (B, base_cos.shape[1])).copy()
-        s = np.broadcast_to(base_sin, (B, base_sin.shape[1])).copy()
+        if base_cos.shape[0] == B:
+            c, s = base_cos.copy(), base_sin.copy()
+        else:
+            c, s = np.repeat(base_cos, B, axis=0), np.repeat(base_sin, B, axis=0)
         # Sines and cosines are most of the cost of the kinematics, and most
         # axes are not variables: only the variables' are recomputed.
         c[:, self.var_flat] = np.cos(q)

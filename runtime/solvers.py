@@ -15,7 +15,8 @@ rules.
 
 * ``"dls"`` -- damped least squares (Levenberg-Marquardt): the step solves
   ``(J^T J + mu I) dx = -J^T r`` with the damping ``mu`` adapted by the gain
-  ratio (Nielsen's rule), variables held at a limit they push against.
+  ratio (Nielsen's rule), no angle moving more than MAXSTEP per step,
+  variables held at a limit they push against.
 * ``"transpose"`` -- the Jacobian transpose (seed 000's choice): a step along
   ``-J^T r`` of Buss's length ``|g|^2 / |J g|^2``, halved while it fails.
 * ``"ccd"`` -- cyclic coordinate descent: each variable in turn, from the
@@ -23,7 +24,10 @@ rules.
   of ``f`` along its own axis within its limits; then the translation.
 
 The batch elements that have stopped are dropped from the arrays, so a batch
-costs what its slowest member costs, with numpy doing the rest.
+costs what its slowest member costs, with numpy doing the rest.  Restarts
+(from random angles, for solves stuck in a local minimum) run inside the
+same loop as the other elements' iterations, so they cost little more than
+the iterations they take.
 """
 
 from __future__ import annotations
@@ -33,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .goals import GoalStack
-from .ikmodel import IKModel
+from .ikmodel import IKModel, cross3
 
 __all__ = ["SOLVERS", "SolveResult", "solve", "CONVERGED", "STALLED", "LIMIT"]
 
@@ -51,11 +55,25 @@ XTOL = 1e-8
 # Damping beyond this multiple of the largest curvature means no step can
 # lower the cost any more.
 MU_MAX = 1e16
-# Progress window: see _State.check_progress.
+# Progress window: see _State.end_iteration.
 WINDOW = 10
 WINDOW_FTOL = 1e-6
+# Giving up early, only while restarts remain: from GIVEUP_FROM iterations
+# on, every GIVEUP_EVERY iterations, an attempt whose cost has not halved and
+# is still above GIVEUP_FLOOR times the cost of goals at the tolerance is
+# heading for a local minimum; it makes way for a restart, and is resumed if
+# every restart fails (see _State.end_iteration).
+GIVEUP_FROM = 8
+GIVEUP_EVERY = 4
+GIVEUP_FLOOR = 100.0
+# DLS: the first damping, as a fraction of the largest diagonal entry of
+# J^T J, and the largest angle (radians) any variable turns in one step.
+# The cap is a trust region: it keeps each step where the linearisation
+# holds and stops early steps from slamming joints into their limits,
+# which is where most local minima are (it doubled the success of
+# unrestarted solves on the benchmark's limited chains).
 MU0 = 1e-1
-MAXSTEP = 0.5
+MAXSTEP = 0.8
 
 
 @dataclass
@@ -186,17 +204,18 @@ def solve(model: IKModel, stack: GoalStack, x0: np.ndarray, base: np.ndarray, *,
     max_iterations : int
         Iterations (sweeps for CCD) per batch element and attempt.
     restarts : int, default 0
-        When a solve ends without meeting its goals (a local minimum, often
-        against joint limits), try again up to this many times from start
-        angles drawn uniformly within the limits, and keep the first
-        attempt that meets them.  An attempt that does not is discarded, so
-        a goal that cannot be met still ends at the best pose reached from
-        the given start.
+        When an attempt ends without meeting its goals (a local minimum,
+        often against joint limits, or the iteration limit), try again, up
+        to this many times, from angles drawn uniformly within the limits
+        (the translation restarts from ``x0``'s), and keep the first attempt
+        that meets them.  If none does, the result is the first attempt's:
+        a goal that cannot be met ends at the best pose reached from the
+        given start, not from a random one.
     seed : int, default 0
-        Seeds the restarts' random start angles (results are reproducible).
+        Seeds the restarts' random angles (results are reproducible).
     trace : bool
-        Record the cost after each iteration of the first attempt in
-        ``history``.
+        Record the cost after each iteration in ``history`` (with restarts,
+        that of the attempt under way).
 
     Returns
     -------
@@ -208,67 +227,176 @@ def solve(model: IKModel, stack: GoalStack, x0: np.ndarray, base: np.ndarray, *,
     run = {"dls": _dls, "transpose": _transpose, "ccd": _ccd}[method]
     prob = _Problem(model, stack, base)
     x = np.clip(np.array(x0, dtype=float), prob.lower, prob.upper)
-    result = run(prob, x, float(tolerance), int(max_iterations), trace)
-    rng = np.random.default_rng(seed)
-    V = model.n_vars
-    lo = np.where(np.isfinite(prob.lower[:V]), prob.lower[:V], -np.pi)
-    hi = np.where(np.isfinite(prob.upper[:V]), prob.upper[:V], np.pi)
-    for _ in range(int(restarts)):
-        bad = np.flatnonzero(result.status != CONVERGED)
-        if bad.size == 0 or V == 0:
-            break
-        xr = result.x[bad].copy()
-        xr[:, :V] = rng.uniform(lo, hi, size=(bad.size, V))
-        xr[:, V:] = x[bad, V:]
-        sub = _Problem(model, stack.take(bad), base if base.shape[0] == 1 else base[bad])
-        again = run(sub, xr, float(tolerance), int(max_iterations), False)
-        result.iterations[bad] += again.iterations
-        won = bad[again.status == CONVERGED]
-        keep = again.status == CONVERGED
-        result.x[won], result.status[won] = again.x[keep], CONVERGED
-        result.cost[won], result.dist[won] = again.cost[keep], again.dist[keep]
-    return result
+    st = _State(prob, x, float(tolerance), trace, jac=method != "ccd", max_iter=int(max_iterations),
+                restarts=int(restarts), seed=seed)
+    run(prob, st)
+    return st.finish()
 
 
 class _State:
-    """Per-batch bookkeeping shared by the loops."""
+    """Per-batch bookkeeping shared by the solver loops: status, stopping rules, restarts.
 
-    def __init__(self, prob: _Problem, x: np.ndarray, tol: float, trace: bool, jac: bool):
+    Holds the current variables ``x`` (B, P), residuals ``r`` (B, M),
+    Jacobian ``J`` (B, M, P) (None for CCD), cost ``f`` (B,) and goal
+    distances ``dist`` (B, n_goals) of every batch element.
+    """
+
+    def __init__(self, prob: _Problem, x: np.ndarray, tol: float, trace: bool, jac: bool,
+                 max_iter: int, restarts: int, seed: int):
         self.prob = prob
         self.x = x
+        self.x0 = x.copy()
         B = x.shape[0]
-        everyone = np.arange(B)
-        self.r, self.J, self.dist = prob.evaluate(everyone, prob.stack, x, jac)
+        self.jac = jac
+        self.r, self.J, self.dist = prob.evaluate(np.arange(B), prob.stack, x, jac)
         self.f = 0.5 * np.einsum("bm,bm->b", self.r, self.r)
         self.active_goals = prob.stack.active
         self.tol = tol
+        self.max_iter = max_iter
         self.status = np.where(_converged(self.dist, self.active_goals, tol), CONVERGED, RUNNING)
+        if max_iter <= 0:
+            self.status[self.status == RUNNING] = LIMIT
         self.iterations = np.zeros(B, dtype=int)
+        self.attempt_iter = np.zeros(B, dtype=int)
         self.history = [self.f.copy()] if trace else None
         self.window_f = self.f.copy()
+        V = prob.model.n_vars
+        self.attempts_left = np.full(B, restarts if V else 0)
+        self.rng = np.random.default_rng(seed)
+        self.saved: dict | None = None  # the first attempt of elements that restarted
+        self.gave_up = np.zeros(B, dtype=bool)  # the current attempt was given up early
+        self.resumed = np.zeros(B, dtype=bool)  # the first attempt was taken up again
+        self.fast_f = self.f.copy()
+        n_active = np.maximum(self.active_goals.sum(axis=1), 1)
+        self.giveup_floor = GIVEUP_FLOOR * 0.5 * tol * tol * n_active
+        self.on_restart = None  # the solver's hook to reset its own per-element state
+        self.solver_arrays: dict = {}  # the solver's own per-element state, (B,) arrays, saved with an attempt
 
     def running(self) -> np.ndarray:
+        """Indices of the elements still iterating."""
         return np.flatnonzero(self.status == RUNNING)
 
-    def finish(self) -> SolveResult:
-        self.status[self.status == RUNNING] = LIMIT
-        return SolveResult(self.x, self.status, self.iterations, self.f, self.dist, self.history or [])
+    def accept(self, idx, accept, x, r, dist, f, J=None) -> None:
+        """Keep the trial values of sub-batch ``idx`` where ``accept``."""
+        a = idx[accept]
+        self.x[a], self.r[a], self.dist[a], self.f[a] = x[accept], r[accept], dist[accept], f[accept]
+        if J is not None:
+            self.J[a] = J
 
-    def record(self):
+    def stop_checks(self, idx, accept, gain, f_old, dx) -> None:
+        """Mark converged and stalled elements of sub-batch ``idx`` after an iteration.
+
+        Converged: every goal within tolerance.  Stalled: an accepted step
+        gained less than FTOL of the cost, or a step was shorter than XTOL
+        relative to the variables.
+        """
+        conv = _converged(self.dist[idx], self.active_goals[idx], self.tol)
+        small_gain = accept & (gain <= FTOL * f_old)
+        size = np.sqrt(np.einsum("bp,bp->b", self.x[idx], self.x[idx]))
+        small_step = np.sqrt(np.einsum("bp,bp->b", dx, dx)) <= XTOL * (XTOL + size)
+        self.status[idx[conv]] = CONVERGED
+        self.status[idx[~conv & (small_gain | small_step)]] = STALLED
+
+    def end_iteration(self, idx: np.ndarray) -> None:
+        """Count an iteration of sub-batch ``idx``; apply the window and the limit; restart.
+
+        Every WINDOW iterations, an element whose cost fell by less than
+        WINDOW_FTOL of it is stalled: near a joint limit or a saddle (a
+        straight chain pulled along its length), steps can keep lowering
+        the cost by a hair for hundreds of iterations, and a pose that close
+        to stationary is the best pose.
+
+        While an element has restarts left, an attempt converging slowly
+        toward a cost well above the tolerance's (a local minimum) is given
+        up early (GIVEUP_*) and restarted, so that restarts cost few
+        iterations; should every restart fail, the first attempt is resumed
+        where it was given up, so the result does not depend on restarts
+        being allowed.
+        """
+        self.iterations[idx] += 1
+        self.attempt_iter[idx] += 1
         if self.history is not None:
             self.history.append(self.f.copy())
-
-    def check_progress(self, idx: np.ndarray) -> None:
-        """Every WINDOW iterations, stop elements whose cost fell by less than WINDOW_FTOL of it.
-
-        Near a joint limit or a saddle (a straight chain pulled along its
-        length), steps can keep lowering the cost by a hair for hundreds of
-        iterations; a pose that close to stationary is the best pose.
-        """
-        due = idx[(self.iterations[idx] % WINDOW == 0) & (self.status[idx] == RUNNING)]
+        run = idx[self.status[idx] == RUNNING]
+        k = self.attempt_iter[run]
+        due = run[k % WINDOW == 0]
         slow = due[self.window_f[due] - self.f[due] <= WINDOW_FTOL * self.window_f[due]]
         self.status[slow] = STALLED
         self.window_f[due] = self.f[due]
+        self.status[run[k >= self.max_iter]] = LIMIT
+        check = run[(k % GIVEUP_EVERY == 0) & (self.attempts_left[run] > 0) & (self.status[run] == RUNNING)]
+        if check.size:
+            hopeless = (self.attempt_iter[check] >= GIVEUP_FROM) & (self.f[check] > self.giveup_floor[check]) & (
+                self.f[check] > 0.5 * self.fast_f[check]
+            )
+            self.status[check[hopeless]] = STALLED
+            self.gave_up[check[hopeless]] = True
+            self.fast_f[check] = self.f[check]
+        ended = idx[(self.status[idx] == STALLED) | (self.status[idx] == LIMIT)]
+        again = ended[self.attempts_left[ended] > 0]
+        if again.size:
+            self._restart(again)
+        if self.saved is not None:
+            back = ended[(self.attempts_left[ended] == 0) & self.saved["mask"][ended]]
+            back = back[self.saved["gave_up"][back] & ~self.resumed[back]]
+            if back.size:
+                self._resume(back)
+
+    _SAVED = ("x", "r", "f", "dist", "status", "attempt_iter", "window_f", "gave_up")
+
+    def _restart(self, idx: np.ndarray) -> None:
+        """Start elements ``idx`` again from random angles within the limits."""
+        if self.saved is None:
+            self.saved = {key: getattr(self, key).copy() for key in self._SAVED}
+            self.saved["mask"] = np.zeros(self.x.shape[0], dtype=bool)
+            if self.jac:
+                self.saved["J"] = self.J.copy()
+            self.saved["solver"] = {k: v.copy() for k, v in self.solver_arrays.items()}
+        first = idx[~self.saved["mask"][idx]]
+        for key in self._SAVED + (("J",) if self.jac else ()):
+            self.saved[key][first] = getattr(self, key)[first]
+        for k, v in self.solver_arrays.items():
+            self.saved["solver"][k][first] = v[first]
+        self.saved["mask"][first] = True
+        prob = self.prob
+        V = prob.model.n_vars
+        lo = np.where(np.isfinite(prob.lower[:V]), prob.lower[:V], -np.pi)
+        hi = np.where(np.isfinite(prob.upper[:V]), prob.upper[:V], np.pi)
+        x = self.x0[idx].copy()
+        x[:, :V] = self.rng.uniform(lo, hi, size=(idx.size, V))
+        r, J, dist = prob.evaluate(idx, prob.stack.take(idx), x, self.jac)
+        self.x[idx], self.r[idx], self.dist[idx] = x, r, dist
+        if self.jac:
+            self.J[idx] = J
+        self.f[idx] = 0.5 * np.einsum("bm,bm->b", r, r)
+        self.window_f[idx] = self.fast_f[idx] = self.f[idx]
+        self.attempt_iter[idx] = 0
+        self.attempts_left[idx] -= 1
+        self.gave_up[idx] = False
+        self.status[idx] = np.where(_converged(dist, self.active_goals[idx], self.tol), CONVERGED, RUNNING)
+        if self.on_restart is not None:
+            self.on_restart(idx)
+
+    def _resume(self, idx: np.ndarray) -> None:
+        """Take up the first attempt of elements ``idx`` where it was given up."""
+        for key in self._SAVED + (("J",) if self.jac else ()):
+            getattr(self, key)[idx] = self.saved[key][idx]
+        for k, v in self.solver_arrays.items():
+            v[idx] = self.saved["solver"][k][idx]
+        # Exactly where it was given up: the attempt goes on as it would have
+        # without restarts.
+        self.status[idx] = RUNNING
+        self.gave_up[idx] = False
+        self.resumed[idx] = True
+
+    def finish(self) -> SolveResult:
+        """The result; elements whose every attempt failed get their first attempt back."""
+        self.status[self.status == RUNNING] = LIMIT
+        if self.saved is not None:
+            back = self.saved["mask"] & (self.status != CONVERGED) & ~self.resumed
+            for key in ("x", "f", "dist", "status"):
+                getattr(self, key)[back] = self.saved[key][back]
+        return SolveResult(self.x, self.status, self.iterations, self.f, self.dist, self.history or [])
 
 
 def _solve_damped(J: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> np.ndarray:
@@ -301,28 +429,27 @@ def _held(prob: _Problem, x: np.ndarray, direction: np.ndarray) -> np.ndarray:
     return ((x <= prob.lower) & (direction < 0)) | ((x >= prob.upper) & (direction > 0))
 
 
-def _stop_checks(st: _State, idx, accept, gain, f_old, dx):
-    """Mark converged and stalled elements of sub-batch ``idx`` after an iteration."""
-    conv = _converged(st.dist[idx], st.active_goals[idx], st.tol)
-    small_gain = accept & (gain <= FTOL * f_old)
-    size = np.sqrt(np.einsum("bp,bp->b", st.x[idx], st.x[idx]))
-    small_step = np.sqrt(np.einsum("bp,bp->b", dx, dx)) <= XTOL * (XTOL + size)
-    st.status[idx[conv]] = CONVERGED
-    stalled = ~conv & (small_gain | small_step)
-    st.status[idx[stalled]] = STALLED
-
-
-def _dls(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) -> SolveResult:
+def _dls(prob: _Problem, st: _State) -> None:
     """Levenberg-Marquardt with projection onto the limits (see module docstring)."""
-    st = _State(prob, x, tol, trace, jac=True)
-    B, P = x.shape
-    diag = np.einsum("bmp,bmp->bp", st.J, st.J)
-    curv = diag.max(axis=1, initial=0.0)
-    # Nothing any variable can change (no goal moves with them): done.
-    st.status[(st.status == RUNNING) & (curv == 0.0)] = STALLED
-    mu = MU0 * np.where(curv > 0, curv, 1.0)
+    B, P = st.x.shape
+    V = prob.model.n_vars
+    curv = np.zeros(B)
+    mu = np.zeros(B)
     nu = np.full(B, 2.0)
-    for _ in range(max_iter):
+
+    def reset(idx):
+        # The damping starts at a fraction of the largest curvature; where
+        # no variable moves any goal there is nothing to do.
+        c = np.einsum("bmp,bmp->bp", st.J[idx], st.J[idx]).max(axis=1, initial=0.0)
+        curv[idx] = c
+        mu[idx] = MU0 * np.where(c > 0, c, 1.0)
+        nu[idx] = 2.0
+        st.status[idx[(st.status[idx] == RUNNING) & (c == 0.0)]] = STALLED
+
+    reset(np.arange(B))
+    st.on_restart = reset
+    st.solver_arrays = {"curv": curv, "mu": mu, "nu": nu}
+    while True:
         idx = st.running()
         if idx.size == 0:
             break
@@ -337,7 +464,7 @@ def _dls(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) 
             if not out.any():
                 break
             free &= ~out
-        big = np.max(np.abs(dx[:, :prob.model.n_vars]), axis=1, initial=0.0)
+        big = np.max(np.abs(dx[:, :V]), axis=1, initial=0.0)
         dx = dx * np.minimum(1.0, MAXSTEP / np.maximum(big, 1e-300))[:, None]
         dx = _project(prob, xs, dx, free)
         xn = xs + dx
@@ -352,25 +479,25 @@ def _dls(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) 
         # Nielsen's damping update: shrink after a good step, grow fast after a bad one.
         mu[idx] = np.where(accept, mus * np.maximum(1 / 3, 1 - (2 * rho - 1) ** 3), mus * nu[idx])
         nu[idx] = np.where(accept, 2.0, nu[idx] * 2.0)
-        a = idx[accept]
         # The Jacobian is only needed where the step is kept.
-        st.J[a] = prob.jacobian(stack, kept, accept)
-        st.x[a], st.r[a], st.dist[a], st.f[a] = xn[accept], rn[accept], dn[accept], fn[accept]
-        st.iterations[idx] += 1
-        st.record()
-        _stop_checks(st, idx, accept, gain, fs, dx)
-        st.check_progress(idx)
+        st.accept(idx, accept, xn, rn, dn, fn, prob.jacobian(stack, kept, accept))
+        st.stop_checks(idx, accept, gain, fs, dx)
         blown = mu[idx] > MU_MAX * np.maximum(curv[idx], 1e-300)
         st.status[idx[blown & (st.status[idx] == RUNNING)]] = STALLED
-    return st.finish()
+        st.end_iteration(idx)
 
 
-def _transpose(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) -> SolveResult:
+def _transpose(prob: _Problem, st: _State) -> None:
     """Jacobian transpose steps with Buss's step length, halved until the cost drops."""
-    st = _State(prob, x, tol, trace, jac=True)
-    B, P = x.shape
+    B, P = st.x.shape
     scale = np.ones(B)
-    for _ in range(max_iter):
+
+    def reset(idx):
+        scale[idx] = 1.0
+
+    st.on_restart = reset
+    st.solver_arrays = {"scale": scale}
+    while True:
         idx = st.running()
         if idx.size == 0:
             break
@@ -391,14 +518,9 @@ def _transpose(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: 
         gain = fs - fn
         accept = gain > 0
         scale[idx] = np.where(accept, np.minimum(1.0, 2.0 * scale[idx]), 0.5 * scale[idx])
-        a = idx[accept]
-        st.J[a] = prob.jacobian(stack, kept, accept)
-        st.x[a], st.r[a], st.dist[a], st.f[a] = xn[accept], rn[accept], dn[accept], fn[accept]
-        st.iterations[idx] += 1
-        st.record()
-        _stop_checks(st, idx, accept, gain, fs, dx)
-        st.check_progress(idx)
-    return st.finish()
+        st.accept(idx, accept, xn, rn, dn, fn, prob.jacobian(stack, kept, accept))
+        st.stop_checks(idx, accept, gain, fs, dx)
+        st.end_iteration(idx)
 
 
 # ---------------------------------------------------------------- CCD
@@ -408,8 +530,8 @@ _GRID = 33  # samples of the 1-D cost per variable before Newton polishing
 
 def _rotate(d: np.ndarray, w: np.ndarray, s: np.ndarray, cm: np.ndarray) -> np.ndarray:
     """Rodrigues: ``d`` turned about unit ``w`` by the angle with sine ``s``, ``1 - cos`` ``cm``."""
-    wd = np.cross(w, d)
-    return d + s[..., None] * wd + cm[..., None] * np.cross(w, wd)
+    wd = cross3(w, d)
+    return d + s[..., None] * wd + cm[..., None] * cross3(w, wd)
 
 
 def _trig_cost(C, s, cm):
@@ -453,13 +575,12 @@ def _trig_minimum(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return np.where(keep, th, 0.0)
 
 
-def _ccd(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) -> SolveResult:
+def _ccd(prob: _Problem, st: _State) -> None:
     """Cyclic coordinate descent with exact 1-D minimisation (see module docstring)."""
-    st = _State(prob, x, tol, trace, jac=False)
     model = prob.model
     V = model.n_vars
     A = model.A
-    for _ in range(max_iter):
+    while True:
         idx = st.running()
         if idx.size == 0:
             break
@@ -486,28 +607,28 @@ def _ccd(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) 
             mp = model.downstream[v, stack.p_link]
             if mp.any():
                 d = yp[:, mp] - cv[:, None]
-                wd = np.cross(w[:, None], d)
+                wd = cross3(w[:, None], d)
                 a = (yp[:, mp] @ A.T + model.b + tw[:, None] - stack.p_target[:, mp]) * wp[:, mp, None]
                 b = (wd @ A.T) * wp[:, mp, None]
-                g = (np.cross(w[:, None], wd) @ A.T) * wp[:, mp, None]
+                g = (cross3(w[:, None], wd) @ A.T) * wp[:, mp, None]
                 C += _sums(a.reshape(idx.size, -1), b.reshape(idx.size, -1), g.reshape(idx.size, -1))
             mq = model.downstream[v, stack.q_link]
             if mq.any():
                 n = stack.q_normal[:, mq]
                 d = yq[:, mq] - cv[:, None]
-                wd = np.cross(w[:, None], d)
+                wd = cross3(w[:, None], d)
                 a = np.einsum("bqi,bqi->bq", n, yq[:, mq] @ A.T + model.b + tw[:, None] - stack.q_origin[:, mq]) * wq[:, mq]
                 b = np.einsum("bqi,bqi->bq", n, wd @ A.T) * wq[:, mq]
-                g = np.einsum("bqi,bqi->bq", n, np.cross(w[:, None], wd) @ A.T) * wq[:, mq]
+                g = np.einsum("bqi,bqi->bq", n, cross3(w[:, None], wd) @ A.T) * wq[:, mq]
                 C += _sums(a, b, g)
             mh = model.downstream[v, stack.h_link]
             if mh.any():
                 k = (stack.h_ell[mh] * wh[:, mh])[..., None] / nvh[:, mh, None]
                 vv = vh[:, mh]
-                wv = np.cross(w[:, None], vv)
+                wv = cross3(w[:, None], vv)
                 a = (vv @ A.T) * k - stack.h_dir[:, mh] * (stack.h_ell[mh] * wh[:, mh])[..., None]
                 b = (wv @ A.T) * k
-                g = (np.cross(w[:, None], wv) @ A.T) * k
+                g = (cross3(w[:, None], wv) @ A.T) * k
                 C += _sums(a.reshape(idx.size, -1), b.reshape(idx.size, -1), g.reshape(idx.size, -1))
             if not (mp.any() or mq.any() or mh.any()):
                 continue
@@ -540,16 +661,11 @@ def _ccd(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, trace: bool) 
         # Every coordinate move was exact and kept only if it helped, so the
         # sweep can only lower f (up to rounding, which the check absorbs).
         accept = gain >= 0
-        a = idx[accept]
-        st.x[a], st.r[a], st.dist[a], st.f[a] = xs[accept], rn[accept], dn[accept], fn[accept]
-        st.iterations[idx] += 1
-        st.record()
+        st.accept(idx, accept, xs, rn, dn, fn)
         conv = _converged(st.dist[idx], st.active_goals[idx], st.tol)
         st.status[idx[conv]] = CONVERGED
-        stalled = ~conv & (~accept | (gain <= FTOL * fs))
-        st.status[idx[stalled]] = STALLED
-        st.check_progress(idx)
-    return st.finish()
+        st.status[idx[~conv & (~accept | (gain <= FTOL * fs))]] = STALLED
+        st.end_iteration(idx)
 
 
 def _sums(a: np.ndarray, b: np.ndarray, g: np.ndarray) -> np.ndarray:
