@@ -17,6 +17,8 @@ steps are well scaled.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from . import kinematics as K
@@ -68,6 +70,9 @@ def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0), axis=-1)
 
 
+_lengths_cache: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
 def link_lengths(figure: Figure) -> np.ndarray:
     """Each link's length: the largest distance between two of its joint locations.
 
@@ -78,10 +83,13 @@ def link_lengths(figure: Figure) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, shape (n_links,)
-        In the link frame's units (joint locations, already scaled by SCALE
-        MODEL).  A link with fewer than two joints (a hand at the end of an
+        Read-only.  In the link frame's units (joint locations, already
+        scaled by SCALE MODEL).  A link with fewer than two joints (a hand at the end of an
         arm) has length 0: its shape is opaque, so its tip is unknown.
     """
+    hit = _lengths_cache.get(figure)
+    if hit is not None:
+        return hit  # figures are immutable values
     points: list[list[np.ndarray]] = [[] for _ in figure.links]
     for j in figure.joints:
         points[j.primary].append(j.loc1)
@@ -91,6 +99,8 @@ def link_lengths(figure: Figure) -> np.ndarray:
         if len(pts) > 1:
             P = np.array(pts)
             out[i] = np.max(np.linalg.norm(P[:, None] - P[None], axis=-1))
+    out.setflags(write=False)
+    _lengths_cache[figure] = out
     return out
 
 

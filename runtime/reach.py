@@ -318,7 +318,7 @@ def solve_pose(
         raise GoalError(f"the goals are a batch of {B_goals} but the start poses a batch of {B_start}.")
     batched = B_goals is not None or B_start is not None
     B = B_goals or B_start or 1
-    base = np.deg2rad(start_deg).reshape(-1, figure.n_joints, 3)  # (1 or B, J, 3)
+    base = np.deg2rad(start_deg).reshape(B_start or 1, figure.n_joints, 3)  # (1 or B, J, 3)
     start_deg = np.broadcast_to(start_deg, (B, figure.n_joints, 3))
 
     model = IKModel(figure, _movable_mask(figure, goals, movable), translate=translate)

@@ -485,3 +485,14 @@ def test_an_ambiguous_link_name_takes_the_first_and_warns():
     fig = Figure(links, joints)
     sol = solve_pose(fig, [PointGoal("hand", (1.0, 0.5, 0.0), point=(0, 0, 0))])
     assert any("2 links are named hand" in w and "joint 2" in w for w in sol.warnings)
+
+
+def test_a_one_link_figure_can_only_translate_and_no_goals_is_nothing_to_do():
+    box = Figure((Link("BOX", None),))
+    moved = solve_pose(box, [PointGoal("BOX", (1.0, 2.0, 3.0))], translate=True, tolerance=1e-9)
+    assert moved.converged and moved.angles.shape == (0, 3)
+    np.testing.assert_allclose(moved.translation, (1.0, 2.0, 3.0), atol=1e-9)
+    still = solve_pose(box, [PointGoal("BOX", (1.0, 2.0, 3.0))])
+    assert still.status == "stalled" and still.residuals[0] == pytest.approx(np.sqrt(14))
+    idle = solve_pose(chain(2), [], start=np.full((2, 3), 10.0))
+    assert idle.converged and np.all(idle.angles == 10.0)
