@@ -36,6 +36,7 @@ __all__ = [
     "AxisGoal",
     "GoalStack",
     "resolve_link",
+    "batch_size",
 ]
 
 
@@ -202,18 +203,32 @@ def _weights(value, what: str) -> np.ndarray:
 def batch_size(goals: Sequence[Goal]) -> int | None:
     """The batch size the goals' data imply (None when nothing is batched).
 
+    Parameters
+    ----------
+    goals : sequence of PointGoal, PlaneGoal or AxisGoal
+
+    Returns
+    -------
+    int or None
+        The common leading size of every batched target, plane, direction
+        (shape (B, 3)) and weight (shape (B,)).
+
     Raises
     ------
     GoalError
-        If two batched values disagree on the size.
+        If a goal is of no known kind, or two batched values disagree on
+        the size.
     """
+    batched_fields = {
+        PointGoal: ("target", "weight"),
+        PlaneGoal: ("origin", "normal", "weight"),
+        AxisGoal: ("direction", "weight"),
+    }
     sizes = set()
-    for g in goals:
-        fields = {
-            PointGoal: ("target", "weight"),
-            PlaneGoal: ("origin", "normal", "weight"),
-            AxisGoal: ("direction", "weight"),
-        }[type(g)]
+    for i, g in enumerate(goals):
+        fields = batched_fields.get(type(g))
+        if fields is None:
+            raise GoalError(f"goal {i + 1} is not a point, plane or axis goal.")
         for f in fields:
             v = np.asarray(getattr(g, f))
             if (f == "weight" and v.ndim == 1) or (f != "weight" and v.ndim == 2):

@@ -12,11 +12,13 @@ target) at once and strings the poses into one motion.
 A figure that cannot reach its goals is not an error: the result is the
 least-squares best pose, with each goal's residual reported.
 
-Example
--------
->>> from liganimate.runtime.goals import PointGoal
->>> r = reach(arm, [PointGoal("HAND", (0.3, 0.2, 0.0))], frames=24, method="ACCDCC")
->>> r.motion, r.residuals, r.translation          # doctest: +SKIP
+Example (``arm`` a model with a link named HAND)::
+
+    r = reach(arm, [PointGoal("HAND", (0.3, 0.2, 0.0), point=(0, -12, 0), weight=10)],
+              frames=24, method="ACCDCC", movable=3)
+    r.motion        # a Motion of length 24 driving the three joints above the hand
+    r.residuals     # the hand's distance to its goal, shape (1,)
+    r.translation   # (0, 0, 0): translate=True would let the whole arm move
 """
 
 from __future__ import annotations
@@ -311,6 +313,8 @@ def solve_pose(
     """
     goals = list(goals)
     tol, max_iter = _options(figure, solver, tolerance, max_iterations)
+    if isinstance(restarts, bool) or not isinstance(restarts, (int, np.integer)) or restarts < 0:
+        raise GoalError(f"the number of restarts must be a non-negative whole number, not {restarts!r}.")
     start_deg = start_pose(figure, start)
     B_goals = batch_size(goals)
     B_start = start_deg.shape[0] if start_deg.ndim == 3 else None
@@ -325,8 +329,6 @@ def solve_pose(
     stack = GoalStack(model, goals, B)
     x0 = np.zeros((B, model.n_params))
     x0[:, : model.n_vars] = np.deg2rad(start_deg).reshape(B, -1)[:, model.var_flat]
-    if isinstance(restarts, bool) or int(restarts) != restarts or restarts < 0:
-        raise GoalError(f"the number of restarts must be a non-negative whole number, not {restarts!r}.")
     result = solve(model, stack, x0, base, method=solver, tolerance=tol, max_iterations=max_iter,
                    restarts=int(restarts), trace=trace)
 
