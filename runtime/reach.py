@@ -48,6 +48,7 @@ __all__ = [
     "reach_keyframes",
     "chain_joints",
     "start_pose",
+    "residual_warnings",
     "DEFAULT_TOLERANCE",
     "DEFAULT_MAX_ITERATIONS",
 ]
@@ -90,6 +91,9 @@ class PoseSolution:
     tolerance : float
         The tolerance used (world units).
     weights : numpy.ndarray, shape (B, n_goals)
+    met : numpy.ndarray of bool, shape (B, n_goals)
+        Which goals are within the tolerance (a goal of weight 0 counts as
+        met: it asks for nothing).
     warnings : list of str
         Ambiguous link names.
     history : list of numpy.ndarray
@@ -105,6 +109,7 @@ class PoseSolution:
     iterations: np.ndarray
     tolerance: float
     weights: np.ndarray
+    met: np.ndarray
     warnings: list = field(default_factory=list)
     history: list = field(default_factory=list)
 
@@ -349,6 +354,7 @@ def solve_pose(
         iterations=result.iterations,
         tolerance=tol,
         weights=stack.weights,
+        met=(result.dist <= tol) | ~stack.active,
         warnings=stack.warnings,
         history=result.history,
     )
@@ -363,9 +369,44 @@ def solve_pose(
         iterations=int(sol.iterations[0]),
         tolerance=tol,
         weights=sol.weights[0],
+        met=sol.met[0],
         warnings=sol.warnings,
         history=[h[0] for h in sol.history],
     )
+
+
+def residual_warnings(figure: Figure, goals: Sequence, solution: PoseSolution) -> list[str]:
+    """One sentence per goal an unbatched solution leaves unmet, for warnings.
+
+    Parameters
+    ----------
+    figure : Figure
+    goals : sequence of PointGoal, PlaneGoal, AxisGoal
+        As given to the solve.
+    solution : PoseSolution
+        Unbatched.
+
+    Returns
+    -------
+    list of str
+        E.g. ``"goal 2: the point of R_HAND stays 0.1231 from its target."``;
+        when the iteration limit stopped the solve, a last sentence says so.
+        Empty when every goal is met.
+    """
+    out = []
+    for i, (g, ok, d) in enumerate(zip(goals, solution.met, solution.residuals), start=1):
+        if ok:
+            continue
+        link = figure.links[resolve_link(figure, g.link)[0]].label
+        if isinstance(g, PointGoal):
+            out.append(f"goal {i}: the point of {link} stays {d:.4g} from its target.")
+        elif isinstance(g, PlaneGoal):
+            out.append(f"goal {i}: the point of {link} stays {d:.4g} from its plane.")
+        else:
+            out.append(f"goal {i}: the axis of {link} stays {d:.3g} degrees from its direction.")
+    if out and solution.status == "limit":
+        out.append(f"the solver stopped at its iteration limit ({solution.iterations}) before settling.")
+    return out
 
 
 def _driven(figure: Figure, goals, movable, start, joints) -> list[int]:

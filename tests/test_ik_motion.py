@@ -142,3 +142,21 @@ def test_reach_rejects_batched_goals_and_bad_motion_options():
         reach(fig, [GOAL], 10, "WOBBLE", movable=3)
     with pytest.raises(M.MotionError):
         reach(fig, [GOAL], -1, movable=3)
+
+
+def test_unmet_goals_become_one_sentence_each():
+    from liganimate.runtime.reach import PlaneGoal, AxisGoal, residual_warnings
+
+    fig = body()
+    goals = [
+        PointGoal("HAND", (3.0, -3.0, 0.0), point=(0, -0.2, 0)),
+        PlaneGoal("FORE", (0, 0, 0), (0, 1, 0), weight=0),
+        AxisGoal("THIGH", (0, -1, 0), (0, 1, 0)),
+    ]
+    sol = solve_pose(fig, goals)
+    assert list(sol.met) == [False, True, False]
+    lines = residual_warnings(fig, goals, sol)
+    assert lines[0] == f"goal 1: the point of HAND stays {sol.residuals[0]:.4g} from its target."
+    assert lines[1].startswith("goal 3: the axis of THIGH stays") and lines[1].endswith("degrees from its direction.")
+    assert len(lines) == 2
+    assert residual_warnings(fig, [GOAL], solve_pose(fig, [GOAL])) == []
