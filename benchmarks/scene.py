@@ -77,30 +77,31 @@ def run_render(program, size, workers) -> float:
 def capture_draws(program, size, every: int):
     """The triangles liganimate draws for every ``every``-th image: [(camera, tris, grey, cull)]."""
     got = []
-    original = R.draw_image
+    original = R.draw_images
 
-    def grab(path, size_, draws):
-        index = int(os.path.basename(path)[:-4])
-        if index % every:
-            return
-        parts = [(cam, p) for cam, ps in draws for p in ps]
-        camera = parts[0][0]
-        assert all(c == camera for c, _ in parts), "the benchmark scene has one camera"
-        got.append(
-            (
-                camera,
-                np.concatenate([p[0] for _, p in parts]),
-                np.concatenate([p[1] for _, p in parts]),
-                np.concatenate([p[2] for _, p in parts]),
+    def grab(size_, chunk):
+        for path, draws in chunk:
+            index = int(os.path.basename(path)[:-4])
+            if index % every:
+                continue
+            parts = [(cam, p) for cam, ps in draws for p in ps]
+            camera = parts[0][0]
+            assert all(c == camera for c, _ in parts), "the benchmark scene has one camera"
+            got.append(
+                (
+                    camera,
+                    np.concatenate([p[0] for _, p in parts]),
+                    np.concatenate([p[1] for _, p in parts]),
+                    np.concatenate([p[2] for _, p in parts]),
+                )
             )
-        )
 
-    R.draw_image = grab
+    R.draw_images = grab
     try:
         with tempfile.TemporaryDirectory() as out:
             program.render(out, size=size, quiet=True, workers=1)
     finally:
-        R.draw_image = original
+        R.draw_images = original
     return got
 
 

@@ -28,6 +28,7 @@ __all__ = [
     "invert_transform",
     "joint_transforms",
     "pose_transforms",
+    "placed_transforms",
     "pose_transforms_reference",
     "shape_transforms",
     "clamp",
@@ -157,28 +158,129 @@ def pose_transforms(figure: Figure, angles) -> np.ndarray:
     Notes
     -----
     Vectorised over frames; the only Python loop is over the depth levels of
-    the tree seen from the current main link (``figure.traversal``), each
-    level one batched matrix product.  Joints walked from secondary to
-    primary use ``Trans(L2) R^T Trans(-L1)``.
+    the tree seen from the current main link (``figure.traversal``).  Joints
+    walked from secondary to primary use ``Trans(L2) R^T Trans(-L1)``.  See
+    :func:`placed_transforms` for how it is computed.
     """
     a = _check_angles(figure, angles)
     lead = a.shape[:-2]
     a = a.reshape((int(np.prod(lead)), figure.n_joints, 3))  # -1 fails when n_joints == 0
-    loc1, loc2 = figure.locations
-    R = matrix_from_euler_zyx(a)  # (B, J, 3, 3)
-    rev = figure.reversed_joints
-    # Forward: rotation R, translation L1 - R L2.  Reversed (S to P):
-    # rotation R^T, translation L2 - R^T L1.  Picking per joint keeps one
-    # array of local transforms for the level loop below.
-    Rl = np.where(rev[:, None, None], np.swapaxes(R, -1, -2), R)
-    near = np.where(rev[:, None], loc2, loc1)
-    far = np.where(rev[:, None], loc1, loc2)
-    local = transform_from(Rl, near - np.einsum("...ij,...j->...i", Rl, far))
-    X = np.empty((a.shape[0], figure.n_links, 4, 4))
-    X[:, figure.main] = np.eye(4)
-    for level in figure.traversal:
-        X[:, level.children] = X[:, level.parents] @ local[:, level.joints]
-    return X.reshape(lead + (figure.n_links, 4, 4))
+    return placed_transforms(figure, a, None).reshape(lead + (figure.n_links, 4, 4))
+
+
+def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
+    """Link transforms for a batch of poses, each composed onto a root transform.
+
+    Parameters
+    ----------
+    figure : Figure
+    angles : numpy.ndarray, shape (B, n_joints, 3)
+        Degrees, in the figure's joint order.
+    root : numpy.ndarray, shape (B, 4, 4), or None
+        Where each pose's current main link goes (an affine map, e.g. the
+        host's placement); None for the identity.
+
+    Returns
+    -------
+    numpy.ndarray, shape (B, n_links, 4, 4)
+        ``root @ pose`` for every link: a view of component-major storage,
+        not C-contiguous (``np.ascontiguousarray`` makes it so).
+
+    Notes
+    -----
+    Computed component-major: every entry of every joint's rotation and
+    translation is one contiguous array over the batch, so each step is one
+    long vector operation (numpy is slow on trailing axes of length 3 or 4,
+    and batched 4x4 ``matmul`` spends most of its time on overhead and on
+    the constant bottom row).  A child link's transform is its parent's
+    times the joint's, ``R = Rp Rj`` and ``t = Rp tj + tp``, summed in
+    the order a 4x4 product would.  Only elementwise operations are used,
+    never BLAS, so the result is the same on every machine.
+    """
+    B, L = angles.shape[0], figure.n_links
+    # Component-major storage: buf[i, j, link] holds entry (i, j) of that
+    # link's transform for every frame, contiguous; the result is a
+    # transposed view of it, so nothing is copied into frame-major order.
+    buf = np.empty((4, 4, L, B))
+    buf[3, :3] = 0.0
+    buf[3, 3] = 1.0
+    if root is not None:
+        root = np.asarray(root, dtype=np.float64)
+    # Blocks of frames small enough for the intermediates to stay in cache.
+    for lo in range(0, B, _BLOCK):
+        hi = min(lo + _BLOCK, B)
+        _placed_block(figure, angles[lo:hi], None if root is None else root[lo:hi], buf[:, :, :, lo:hi])
+    return buf.transpose(3, 2, 0, 1)
+
+
+_BLOCK = 1024
+
+
+def _placed_block(figure: Figure, angles: np.ndarray, root, buf: np.ndarray) -> None:
+    """Fill ``buf`` (4, 4, n_links, B) with the transforms of a block of B poses."""
+    B, J = angles.shape[0], figure.n_joints
+    main = figure.main
+    XR = buf[:3, :3]  # XR[i, j, link]: entry (i, j) of the link's rotation, over the frames
+    Xt = buf[:3, 3]
+    if root is None:
+        XR[:, :, main] = np.eye(3)[:, :, None]
+        Xt[:, main] = 0.0
+    else:
+        XR[:, :, main] = root[:, :3, :3].transpose(1, 2, 0)
+        Xt[:, main] = root[:, :3, 3].T
+    if J:
+        comp = np.deg2rad(angles.transpose(2, 1, 0))  # (3, J, B), contiguous
+        (cx, cy, cz), (sx, sy, sz) = _cos_sin(comp)
+        # Each joint's rotation, entry by entry as in matrix_from_euler_zyx.
+        R = np.empty((3, 3, J, B))
+        R[0, 0] = cy * cz
+        R[0, 1] = cz * sy * sx - sz * cx
+        R[0, 2] = cz * sy * cx + sz * sx
+        R[1, 0] = cy * sz
+        R[1, 1] = sz * sy * sx + cz * cx
+        R[1, 2] = sz * sy * cx - cz * sx
+        np.negative(sy, out=R[2, 0])
+        R[2, 1] = cy * sx
+        R[2, 2] = cy * cx
+        rev = figure.reversed_joints
+        loc1, loc2 = figure.locations
+        if rev.any():
+            # Walked from the secondary: R^T, and L2 - R^T L1.
+            R[:, :, rev] = R[:, :, rev].transpose(1, 0, 2, 3)
+        near = np.where(rev[:, None], loc2, loc1).T[:, :, None]  # (3, J, 1)
+        far = np.where(rev[:, None], loc1, loc2).T[:, :, None]
+        T = near - (R[:, 0] * far[0] + R[:, 1] * far[1] + R[:, 2] * far[2])  # (3, J, B)
+        for level in figure.traversal:
+            ks, ps, cs = level.joints, level.parents, level.children
+            if len(ks) == 1:
+                # One joint (every level of a chain): slices keep the operands views.
+                ks, ps, cs = (slice(int(v[0]), int(v[0]) + 1) for v in (ks, ps, cs))
+            P = XR[:, :, ps]
+            Rj = R[:, :, ks]
+            tj = T[:, ks]
+            # R = P Rj and t = P tj + tp, summed in the order of a 4x4 product.
+            XR[:, :, cs] = P[:, 0, None] * Rj[0] + P[:, 1, None] * Rj[1] + P[:, 2, None] * Rj[2]
+            Xt[:, cs] = P[:, 0] * tj[0] + P[:, 1] * tj[1] + P[:, 2] * tj[2] + Xt[:, ps]
+
+
+def _cos_sin(a: np.ndarray):
+    """``cos`` and ``sin`` of ``a`` (3, J, B); rows that hold still are computed once.
+
+    Most axes hold still over a motion (pinned by their extremes, or not
+    driven), and the trigonometry is the costliest step.
+    """
+    rows = a.reshape(-1, a.shape[-1])
+    first = rows[:, :1]
+    moving = np.flatnonzero((rows != first).any(axis=1))
+    c = np.empty_like(rows)
+    s = np.empty_like(rows)
+    c[...] = np.cos(first)
+    s[...] = np.sin(first)
+    if len(moving):
+        m = rows[moving]
+        c[moving] = np.cos(m)
+        s[moving] = np.sin(m)
+    return c.reshape(a.shape), s.reshape(a.shape)
 
 
 # -- the reference implementation: plain loops, one frame at a time ----------
@@ -299,6 +401,8 @@ def clamp(figure: Figure, angles) -> np.ndarray:
     ext = figure.extremes
     lo, hi = ext[..., 0], ext[..., 1]
     free = hi - lo >= 360.0
+    if not free.any():
+        return np.clip(a, lo, hi)
     turns = np.mod(a - lo, 360.0)
     turns = np.where(turns >= 360.0, 0.0, turns)  # np.mod(-1e-17, 360) rounds to 360
     return np.where(free, lo + turns, np.clip(a, lo, hi))

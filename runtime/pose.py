@@ -148,10 +148,10 @@ def world_transforms(fig: F.Figure, angles: np.ndarray, placements: np.ndarray) 
     ndarray, shape (T, n_links, 4, 4)
         ``placement @ pose @ diag(s, s, s, 1)``.
     """
-    X = K.pose_transforms(fig, angles)
-    X = placements[:, None] @ X
+    X = K.placed_transforms(fig, np.asarray(angles, dtype=np.float64), placements)
     s = fig.link_scales
-    X[..., :3, :3] *= s[None, :, None, None]
+    if (s != 1.0).any():
+        X[..., :3, :3] *= s[None, :, None, None]
     return X
 
 

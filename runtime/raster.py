@@ -92,9 +92,11 @@ def rasterize(triangles, shade, camera: Camera, background: int = 255, cull=None
         If the arrays have the wrong shape, coordinates are not finite, or a
         grey level is outside 0..255.
     """
-    fb = Framebuffer(camera.size, background)
-    fb.draw(triangles, shade, camera, cull)
-    return fb.image
+    W, H = camera.size
+    img = np.full((H, W), _grey(background, "background"), dtype=np.uint8)
+    # Nothing drawn yet: the depth buffer need only span the pixels touched.
+    _draw(None, img, triangles, shade, camera, cull, 0)
+    return img
 
 
 class Framebuffer:
@@ -215,8 +217,17 @@ def _draw(zbuf, img, triangles, shade, camera, cull, first_index):
     if spans is None:
         return first_index + n
     offset, wstart, step, tag, count = spans
-    flat_z = zbuf.reshape(-1)
     flat_img = img.reshape(-1)
+    if zbuf is None:
+        # A fresh buffer: allocate depth keys for the touched range only.
+        drawn = count > 0
+        lo = int(offset[drawn].min())
+        hi = int((offset[drawn] + count[drawn]).max())
+        flat_z = np.zeros(hi - lo, dtype=np.int64)
+        flat_img = flat_img[lo:hi]
+        offset = offset - lo
+    else:
+        flat_z = zbuf.reshape(-1)
     ends = np.cumsum(count)
     if ends[-1] <= _CHUNK:
         pix, key = _expand(offset, wstart, step, tag, count, ends)

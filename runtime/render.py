@@ -2,8 +2,10 @@
 
 The runtime hands over each tick's drawings; images are gathered in small
 batches so that poses are evaluated for a whole batch of frames at once,
-then each image is rasterized and written (by a pool of worker processes
-when there are many), so memory stays flat however long a scene is.
+then the images are rasterized and written by a pool of worker processes
+(several images a task, so the cost of handing work over stays small), or
+in this process for scenes of only a few images.  At most a few batches are
+in flight at once, so memory stays flat however long a scene is.
 """
 
 from __future__ import annotations
@@ -11,17 +13,23 @@ from __future__ import annotations
 import json
 import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import numpy as np
 
 from .camera import Camera
 from .imagefiles import read_png, write_gif, write_mp4, write_png
 from .pose import joint_angles, mesh_table, static_triangles, world_transforms, world_triangles
-from .raster import Framebuffer
+from .raster import Framebuffer, rasterize
 from .values import Graphical, grey_levels
 
+# Images whose poses are evaluated together.
 BATCH = 32
+# Images handed to a worker process in one task.
+CHUNK = 8
+# Bounds of the memory of evaluated joint angles: (model, motion) pairs, frames each.
+_ANGLE_MODELS = 64
+_ANGLE_FRAMES = 4096
 
 
 class Renderer:
@@ -40,7 +48,8 @@ class Renderer:
     quiet : bool
         No progress bar.
     workers : int or None
-        Processes rasterizing in parallel (default: the machine's cores, at most 2... 8).
+        Processes rasterizing in parallel (default: the machine's cores, at
+        most 8); 1 draws everything in this process.
     """
 
     def __init__(self, out_dir, size=(640, 480), gif=None, mp4=None, poses=None, fps=24.0, quiet=False,
@@ -54,9 +63,13 @@ class Renderer:
         self.pool = None
         self.pending: list = []
         self.current = None
-        self.written: list = []
+        self.images = 0  # images handed over so far, all scenes
+        self.scenes: list = []  # [scene id, images], for the GIF and MP4
         self.futures: list = []
+        self._chunk: list = []
+        self._angles: dict = {}
         self.scene_id = None
+        self.scene_total = 0
         self.progress = progress if progress is not None else (not quiet and sys.stderr.isatty())
         self._poses_tmp = None
         self._poses_fh = None
@@ -69,6 +82,8 @@ class Renderer:
     # --------------------------------------------------------------- scenes
     def begin_scene(self, scene_id) -> None:
         self.scene_id = scene_id
+        self.scene_total = 0
+        self.scenes.append([scene_id, 0])
         os.makedirs(os.path.join(self.out_dir, f"scene{scene_id}"), exist_ok=True)
 
     def end_scene(self) -> None:
@@ -80,6 +95,7 @@ class Renderer:
     def add_tick(self, state, rt) -> None:
         tick, k = state.tick, state.sameframe
         image = tick // k
+        self.scene_total = -(-state.length // k)
         camera = (tuple(float(x) for x in state.view_point), float(state.view_width))
         if self.current is None or self.current["image"] != image:
             if self.current is not None:
@@ -122,7 +138,7 @@ class Renderer:
             fig, motion = reqs[0][4].figure, reqs[0][4].motion
             frames = np.array([r[4].frame for r in reqs])
             placements = np.stack([np.asarray(r[4].figure.placement, dtype=np.float64) for r in reqs])
-            angles = joint_angles(fig, motion, frames)
+            angles = self._joint_angles(fig, motion, frames.tolist())
             X = world_transforms(fig, angles, placements)
             table = mesh_table(fig)
             tris = world_triangles(table, X)
@@ -145,6 +161,29 @@ class Renderer:
             self._submit(path, draws)
         self.pending = []
 
+    def _joint_angles(self, fig, motion, frames: list) -> np.ndarray:
+        """Clamped joint angles (T, J, 3) at ``frames``, each frame evaluated once per render.
+
+        A REPEATed motion comes back to the same frames every period, so
+        angles are remembered per (model's joints, motion, frame); a frame's
+        angles do not depend on which other frames are evaluated with it.
+        """
+        key = (id(fig.joints), id(motion))
+        entry = self._angles.get(key)
+        if entry is None or entry[0] is not fig.joints or entry[1] is not motion:
+            if len(self._angles) >= _ANGLE_MODELS:
+                self._angles.clear()
+            entry = self._angles[key] = (fig.joints, motion, {})
+        memo = entry[2]
+        missing = [f for f in dict.fromkeys(frames) if f not in memo]
+        if missing:
+            if len(memo) + len(missing) > _ANGLE_FRAMES:
+                memo.clear()
+                missing = list(dict.fromkeys(frames))
+            for f, row in zip(missing, joint_angles(fig, motion, np.array(missing, dtype=np.float64))):
+                memo[f] = row
+        return np.stack([memo[f] for f in frames])
+
     def _write_pose(self, scene, tick, image, name, fig, angles, X) -> None:
         joints = {str(j): [_r(a) for a in angles[k]] for k, j in enumerate(fig.joint_ids)}
         segments = []
@@ -156,30 +195,42 @@ class Renderer:
         self._poses_fh.write(json.dumps(rec, separators=(", ", ": ")) + "\n")
 
     def _submit(self, path, draws) -> None:
-        n = sum(len(parts) for _, parts in draws)
-        if self.workers > 1 and self.pool is None and len(self.futures) + len(self.written) >= 4:
-            self.pool = ProcessPoolExecutor(max_workers=self.workers)
-        if self.pool is not None:
-            self.futures.append(self.pool.submit(draw_image, path, self.size, draws))
-            while len(self.futures) > 4 * self.workers:
-                self.futures.pop(0).result()
-        else:
-            draw_image(path, self.size, draws)
-        self.written.append(path)
+        self._chunk.append((path, draws))
+        self.images += 1
+        self.scenes[-1][1] += 1
+        if len(self._chunk) >= CHUNK:
+            self._send()
         self._show_progress()
+
+    def _send(self) -> None:
+        """Hand the gathered images to a worker (or draw them here: one worker, or a short scene)."""
+        chunk, self._chunk = self._chunk, []
+        if not chunk:
+            return
+        if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
+            self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init)
+        if self.pool is None:
+            draw_images(self.size, chunk)
+            return
+        self.futures.append(self.pool.submit(draw_images, self.size, chunk))
+        # Enough in flight to keep every worker busy, no more (memory stays flat).
+        while len(self.futures) > 2 * self.workers:
+            self.futures.pop(0).result()
 
     def _show_progress(self) -> None:
         if self.progress:
-            sys.stderr.write(f"\rscene {self.scene_id}: {len(self.written)} images")
+            total = f"/{self.scene_total}" if self.scene_total else ""
+            sys.stderr.write(f"\rscene {self.scene_id}: {self.scenes[-1][1]}{total} images")
             sys.stderr.flush()
 
     # ---------------------------------------------------------------- finish
     def finish(self) -> None:
         """Wait for every image, then write the GIF, MP4 and pose record."""
+        self._send()
         for f in self.futures:
             f.result()
         self.futures = []
-        if self.progress and self.written:
+        if self.progress and self.images:
             sys.stderr.write("\n")
         if self._poses_fh is not None:
             self._poses_fh.flush()
@@ -187,11 +238,16 @@ class Renderer:
             self._poses_fh.close()
             self._poses_fh = None
             os.replace(self._poses_tmp, self.poses_path)
-        frames = (read_png(p) for p in self.written)
-        if self.gif and self.written:
-            write_gif(self.gif, frames, self.fps)
-        if self.mp4 and self.written:
-            write_mp4(self.mp4, (read_png(p) for p in self.written), self.fps)
+        if self.gif and self.images:
+            write_gif(self.gif, self._frames(), self.fps)
+        if self.mp4 and self.images:
+            write_mp4(self.mp4, self._frames(), self.fps)
+
+    def _frames(self):
+        """Every image written, in order, read back one at a time."""
+        for scene_id, count in self.scenes:
+            for i in range(count):
+                yield read_png(os.path.join(self.out_dir, f"scene{scene_id}", f"{i:05d}.png"))
 
     def close(self) -> None:
         """Release the worker pool and any half-written pose record."""
@@ -207,16 +263,71 @@ class Renderer:
                 pass
 
 
+def _worker_init() -> None:
+    """Set up a worker process: keep freed memory for reuse.
+
+    Each image allocates and frees the same few large arrays; by default
+    glibc hands large blocks back to the kernel and gets them again as fresh
+    zeroed pages every image.  Raising the mmap and trim thresholds (what
+    the MALLOC_MMAP_THRESHOLD_ and MALLOC_TRIM_THRESHOLD_ environment
+    variables do at start-up) keeps them in the heap.
+    """
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None)
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):
+        return  # not glibc
+    M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
+    mallopt(M_MMAP_THRESHOLD, 32 << 20)
+    mallopt(M_TRIM_THRESHOLD, 256 << 20)
+
+
+def draw_images(size, chunk) -> None:
+    """Draw and write several images: ``chunk`` is a list of (path, draws) (a worker's task).
+
+    Each image is encoded and written by a helper thread while the next one
+    is drawn: writing waits for the disk (``fsync``), and zlib and numpy
+    release the interpreter lock, so the wait overlaps with drawing.  Every
+    file is complete when this returns.
+    """
+    writer = _writer()
+    writes = []
+    try:
+        for path, draws in chunk:
+            writes.append(writer.submit(write_png, path, draw(size, draws)))
+    finally:
+        for w in writes:
+            w.result()
+
+
+_WRITER: tuple = (None, None)  # (process id, executor): a forked child makes its own
+
+
+def _writer() -> ThreadPoolExecutor:
+    global _WRITER
+    pid, ex = _WRITER
+    if ex is None or pid != os.getpid():
+        ex = ThreadPoolExecutor(max_workers=1, thread_name_prefix="liganimate-writer")
+        _WRITER = (os.getpid(), ex)
+    return ex
+
+
 def draw_image(path, size, draws) -> None:
-    """Rasterize one image and write it atomically (runs in worker processes too).
+    """Rasterize one image and write it atomically."""
+    write_png(path, draw(size, draws))
+
+
+def draw(size, draws) -> np.ndarray:
+    """Rasterize one image from its draws: a list of (camera, parts).
 
     Consecutive draws seen by the same camera (the background and every tick
     of a still camera) are rasterized as one list of triangles: the
     triangles keep their numbers, so the depth test and the tie rule give
     exactly the image separate draws give, with one pass of fixed costs.
     """
-    fb = Framebuffer(size, 255)
-    merged: list = []  # [camera, [parts]]
+    merged: list = []  # [(camera, [parts])]
     for camera, parts in draws:
         if not parts:
             continue
@@ -224,16 +335,26 @@ def draw_image(path, size, draws) -> None:
             merged[-1][1].extend(parts)
         else:
             merged.append((camera, list(parts)))
-    for camera, parts in merged:
-        cam = _camera(camera, size)
-        if len(parts) == 1:
-            tris, grey, cull = parts[0]
-        else:
-            tris = np.concatenate([p[0] for p in parts])
-            grey = np.concatenate([p[1] for p in parts])
-            cull = np.concatenate([p[2] for p in parts])
-        fb.draw(tris, grey, cam, cull)
-    write_png(path, fb.image)
+    if len(merged) == 1:
+        # The usual case: a fresh image, whose depth buffer need only cover what is drawn.
+        camera, parts = merged[0]
+        tris, grey, cull = _joined(parts)
+        image = rasterize(tris, grey, _camera(camera, size), 255, cull)
+    else:
+        fb = Framebuffer(size, 255)
+        for camera, parts in merged:
+            tris, grey, cull = _joined(parts)
+            fb.draw(tris, grey, _camera(camera, size), cull)
+        image = fb.image
+    return image
+
+
+def _joined(parts):
+    """One (triangles, grey, cull) from several."""
+    if len(parts) == 1:
+        return parts[0]
+    return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
+            np.concatenate([p[2] for p in parts]))
 
 
 _cameras: dict = {}
