@@ -354,12 +354,15 @@ class GoalStack:
         Parameters
         ----------
         idx : numpy.ndarray of int, shape (B',)
+            Sorted and without repeats.
 
         Returns
         -------
         GoalStack
             Sharing every unbatched array with this one.
         """
+        if len(idx) == self.batch:
+            return self  # every element, in order: the sub-batches are sorted and unique
         out = object.__new__(GoalStack)
         out.__dict__.update(self.__dict__)
         out.batch = len(idx)
@@ -479,14 +482,13 @@ class GoalStack:
         v = self.model.to_world_vectors(v)
         return np.swapaxes(v, -1, -2)
 
-    def report(self, R, p, t) -> np.ndarray:
+    def report(self, dist: np.ndarray) -> np.ndarray:
         """Each goal's residual in its natural unit, for messages.
 
         Parameters
         ----------
-        R, p : numpy.ndarray
-            From :meth:`IKModel.forward`.
-        t : numpy.ndarray, shape (B, 3), or None
+        dist : numpy.ndarray, shape (B, n_goals)
+            Distances from :meth:`evaluate`.
 
         Returns
         -------
@@ -495,9 +497,8 @@ class GoalStack:
             and a plane goal's distance to its plane (world units), an axis
             goal's angle to its direction in degrees.
         """
-        _, _, dist = self.evaluate(R, p, t)
-        out = dist.copy()
+        out = np.array(dist, dtype=float)
         if len(self.h_link):
             cols = self.order[len(self.p_link) + len(self.q_link):]
-            out[:, cols] = np.rad2deg(dist[:, cols] / self.h_ell)
+            out[:, cols] = np.rad2deg(out[:, cols] / self.h_ell)
         return out

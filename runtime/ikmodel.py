@@ -18,6 +18,7 @@ steps are well scaled.
 from __future__ import annotations
 
 import weakref
+from collections import OrderedDict
 
 import numpy as np
 
@@ -71,6 +72,11 @@ def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 _lengths_cache: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+# (id(figure), movable mask, translate) -> (figure, model).  The model holds
+# its figure, so a weak-keyed cache would never let go; this one is bounded
+# (least recently used out), and the stored figure keeps the id valid.
+_model_cache: "OrderedDict" = OrderedDict()
+_MODEL_CACHE_MAX = 32
 
 
 def link_lengths(figure: Figure) -> np.ndarray:
@@ -236,6 +242,34 @@ class IKModel:
         self.moves = moves  # (J, n_links): every joint, variable or not
         self.parent_link = parent_of  # per link, the next link toward the main link (-1 for it)
         self.into_joint = into  # per link, the joint joining it to parent_link (-1 for the main link)
+
+    @classmethod
+    def cached(cls, figure: Figure, movable, translate: bool = False) -> "IKModel":
+        """An :class:`IKModel`, reused while the same figure is solved with the same options.
+
+        Figures are immutable values, so a model built for one stays right;
+        a script or a DO loop solving one figure many times builds it once.
+
+        Parameters
+        ----------
+        figure, movable, translate
+            As for the constructor.
+
+        Returns
+        -------
+        IKModel
+        """
+        mask = np.broadcast_to(np.asarray(movable, dtype=bool), (figure.n_joints, 3))
+        key = (id(figure), mask.tobytes(), bool(translate))
+        hit = _model_cache.get(key)
+        if hit is not None and hit[0] is figure:
+            _model_cache.move_to_end(key)
+            return hit[1]
+        model = cls(figure, mask, translate)
+        _model_cache[key] = (figure, model)
+        while len(_model_cache) > _MODEL_CACHE_MAX:
+            _model_cache.popitem(last=False)
+        return model
 
     # ------------------------------------------------------------ angles
 

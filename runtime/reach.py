@@ -330,7 +330,7 @@ def solve_pose(
     base = np.deg2rad(start_deg).reshape(B_start or 1, figure.n_joints, 3)  # (1 or B, J, 3)
     start_deg = np.broadcast_to(start_deg, (B, figure.n_joints, 3))
 
-    model = IKModel(figure, _movable_mask(figure, goals, movable), translate=translate)
+    model = IKModel.cached(figure, _movable_mask(figure, goals, movable), translate)
     stack = GoalStack(model, goals, B)
     x0 = np.zeros((B, model.n_params))
     x0[:, : model.n_vars] = np.deg2rad(start_deg).reshape(B, -1)[:, model.var_flat]
@@ -343,8 +343,8 @@ def solve_pose(
     flat[:, model.var_flat] = np.rad2deg(q)
     angles = K.clamp(figure, flat.reshape(B, figure.n_joints, 3))
     t = result.x[:, model.n_vars:] * model.length if translate else np.zeros((B, 3))
-    R, p = model.forward(np.deg2rad(angles))
-    residuals = stack.report(R, p, t if translate else None)
+    # Wrapping free axes changes no link, so the solver's last distances are the pose's.
+    residuals = stack.report(result.dist)
     sol = PoseSolution(
         angles=angles,
         translation=t,

@@ -453,7 +453,9 @@ def _dls(prob: _Problem, st: _State) -> None:
         idx = st.running()
         if idx.size == 0:
             break
-        xs, rs, Js, fs, mus = st.x[idx], st.r[idx], st.J[idx], st.f[idx], mu[idx]
+        # All running (always so for a single solve): views instead of gathered copies.
+        sel = slice(None) if idx.size == B else idx
+        xs, rs, Js, fs, mus = st.x[sel], st.r[sel], st.J[sel], st.f[sel].copy(), mu[sel]
         # Hold the variables at a limit that the descent direction pushes
         # against, then those the step still pushes against, solving again
         # without them (an active-set projection; rarely more than once).
@@ -501,7 +503,8 @@ def _transpose(prob: _Problem, st: _State) -> None:
         idx = st.running()
         if idx.size == 0:
             break
-        xs, rs, Js, fs = st.x[idx], st.r[idx], st.J[idx], st.f[idx]
+        sel = slice(None) if idx.size == B else idx
+        xs, rs, Js, fs = st.x[sel], st.r[sel], st.J[sel], st.f[sel].copy()
         g = np.einsum("bmp,bm->bp", Js, rs)  # gradient of f
         free = ~_held(prob, xs, -g)
         g = np.where(free, g, 0.0)
