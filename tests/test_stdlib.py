@@ -31,7 +31,7 @@ TUTORIAL = ROOT / "docs" / "tutorial.md"
 
 #: The libraries, each with its models and, per model, the motions made for it.
 MADE_FOR = {
-    "humanoid": {"HUMANOID": ["WALK", "RUN", "HOP", "SKIP", "JUMP", "SQUAT", "WAVE", "REACH"]},
+    "humanoid": {"HUMANOID": ["WALK", "RUN", "HOP", "SKIP", "JUMP", "SQUAT", "WAVE", "REACH", "SIT"]},
     "human": {"HUMAN": ["HUMAN_SQUAT"]},
     "robot": {"ROBOT": ["ROBOT_SQUAT", "ROBOT_WALK"]},
     "arm": {"ARM": ["GRASP", "POINT"]},
@@ -43,7 +43,7 @@ CYCLIC = {"WALK", "RUN", "ROBOT_WALK", "CLOCK_TIME"}
 #: Start and end standing in the neutral pose, so any may follow any other.
 FROM_NEUTRAL = {"HOP", "SKIP", "JUMP", "SQUAT", "WAVE", "REACH", "ROBOT_SQUAT", "GRASP", "POINT"}
 #: Motions that are neither (the thesis' own squat goes down only).
-ONE_WAY = {"HUMAN_SQUAT"}
+ONE_WAY = {"HUMAN_SQUAT", "SIT"}
 
 ALL_MOTIONS = [(lib, model, m) for lib, models in MADE_FOR.items() for model, ms in models.items() for m in ms]
 
@@ -360,6 +360,22 @@ def test_squat_rooted_at_a_foot_keeps_both_feet_planted():
         top = world[..., 1].max(axis=(1, 2))
         assert top[len(times) // 2] < top[0] - 0.25
         assert top[-1] == pytest.approx(top[0])
+
+
+def test_sit_made_with_goals_seats_the_pelvis_and_keeps_the_feet():
+    v = values("LOAD HUMANOID, SIT FROM 'humanoid'\nFIGURE HUMANOID MAIN LINK R_FOOT\n")["variables"]
+    fig, sit = v["HUMANOID"], v["SIT"]
+    times = np.array([0.0, sit.length])
+    angles = P.joint_angles(fig, sit, times)
+    X = K.pose_transforms(fig, angles)
+    link = {l.name: i for i, l in enumerate(fig.links)}
+    # Standing, the pelvis is 0.9 m over the ankle; seated it is on the seat.
+    np.testing.assert_allclose(X[0, link["TOP"], :3, 3], [0.0, 0.9, -0.144], atol=1e-9)
+    np.testing.assert_allclose(X[1, link["TOP"], :3, 3], [-0.405, 0.495, -0.144], atol=2e-3)
+    for name in ("L_FOOT", "R_FOOT"):
+        np.testing.assert_allclose(X[1, link[name]], X[0, link[name]], atol=2e-3, err_msg=name)
+    # The back stays upright: the spine's Y axis is the world's.
+    assert X[1, link["SPINE"], 1, 1] > 0.999
 
 
 # ------------------------------------------------------------- shapes
