@@ -74,6 +74,8 @@ GIVEUP_FLOOR = 100.0
 # unrestarted solves on the benchmark's limited chains).
 MU0 = 1e-1
 MAXSTEP = 0.8
+# Up to this many trials at once, the Jacobian is computed with the residuals.
+SMALL_BATCH = 4
 
 
 @dataclass
@@ -154,9 +156,15 @@ class _Problem:
         r : numpy.ndarray, shape (B', M)
         dist : numpy.ndarray, shape (B', n_goals)
         kept : tuple
-            The angles' cosines and sines, link frames and translation.
+            The angles' cosines and sines, link frames and translation; or,
+            for a handful of trials, their Jacobian already.
         """
         (c, s), R, p, t = self.frames(idx, x)
+        if len(idx) <= SMALL_BATCH:
+            # Few trials are nearly all kept, and then one evaluation with
+            # the Jacobian costs less than two numpy passes.
+            r, J, dist = stack.evaluate(R, p, t, *self.model.axes_trig(c, s, R, p))
+            return r, dist, (J,)
         r, _, dist = stack.evaluate(R, p, t)
         return r, dist, (c, s, R, p, t)
 
@@ -167,6 +175,8 @@ class _Problem:
         -------
         numpy.ndarray, shape (n_true, M, P)
         """
+        if len(kept) == 1:
+            return kept[0][which]
         if not which.any():
             return np.zeros((0, stack.n_rows, self.model.n_params))
         if not which.all():
