@@ -180,8 +180,10 @@ def main(argv=None) -> int:
         fig, chain, tips = setup[n]
         k = ikpy_count[n]
         chunks = np.array_split(np.arange(k), rounds)
-        ours_best = plain_best = 0.0
+        singles = np.array_split(np.arange(single_count), rounds)
+        ours_best = plain_best = single_best = 0.0
         ours_err = plain_err = None
+        single_err = np.empty(single_count)
         ikpy_err = np.empty(k)
         ikpy_best = 0.0
         for r in range(rounds):
@@ -192,12 +194,15 @@ def main(argv=None) -> int:
                 ours_best, ours_err = max(ours_best, len(tips) / dt), e
                 e, dt = solve_ours(fig, n, tips, **OURS_PLAIN)
                 plain_best, plain_err = max(plain_best, len(tips) / dt), e
+            idx = singles[r]
+            e, dt = solve_ours_one_by_one(fig, n, tips[idx], **OURS)
+            single_err[idx] = e
+            single_best = max(single_best, len(idx) / dt)
             idx = chunks[r]
             e, dt = solve_ikpy(chain, n, tips[idx])
             ikpy_err[idx] = e
             ikpy_best = max(ikpy_best, len(idx) / dt)
-        single_err, dt = solve_ours_one_by_one(fig, n, tips[:single_count], **OURS)
-        single_rate = single_count / dt
+        single_rate = single_best
         res = {
             "liganimate": summary(ours_err, ours_best),
             "liganimate_on_ikpy_targets": summary(ours_err[:k], ours_best),
@@ -222,6 +227,8 @@ def main(argv=None) -> int:
         "success_at_least_ikpy": all(results[n]["success_ratio"] >= 1.0 for n in CHAINS),
         "ten_times_ikpy_speed": all(results[n]["speed_ratio"] >= 10 for n in CHAINS),
         "batched_6_joint_20000_per_s": results[6]["liganimate"]["solves_per_s"] >= 20000,
+        # Not asked for, reported for the scripter who solves one pose at a time.
+        "ten_times_ikpy_speed_one_per_call": all(results[n]["speed_ratio_one_per_call"] >= 10 for n in CHAINS),
     }
     print("\ngoals: " + ", ".join(f"{k} {'yes' if v else 'NO'}" for k, v in goals.items()))
     print(json.dumps({"chains": {str(n): results[n] for n in CHAINS}, "goals": goals,
