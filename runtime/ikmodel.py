@@ -149,8 +149,9 @@ class IKModel:
     var_joint, var_axis : numpy.ndarray of int, shape (V,)
         Joint index (in joint order) and axis (0 = X, 1 = Y, 2 = Z) of each
         angle variable, ordered from the joints farthest from the main link
-        to the nearest, X before Y before Z within a joint (the order CCD
-        visits them; see :meth:`IKModel.__init__`).
+        to the nearest, X before Y before Z within a joint (Z, Y, X within a
+        joint walked backwards): the order CCD visits them, in which no turn
+        moves the axis of a variable still to come in the sweep.
     lower, upper : numpy.ndarray, shape (V,)
         Bounds of the angle variables in radians; ``-inf``/``inf`` on free
         axes (extremes spanning 360 degrees or more).
@@ -194,13 +195,17 @@ class IKModel:
                 cur = parent_of[cur]
 
         # Variables: deepest joints first (stable within a depth, in joint
-        # order), X, Y, Z within a joint.  CCD relies on this order: turning
-        # a variable changes neither the axis nor the pivot of any variable
-        # visited after it in the same sweep.
+        # order), then X, Y, Z within a joint -- Z, Y, X for a joint walked
+        # backwards.  CCD relies on this order: turning a variable changes
+        # neither the axis nor the pivot of any variable visited after it in
+        # the same sweep.  (Forward, ax turns about Rz Ry e_x, which ay and az
+        # change; walked backwards the axes are -Rs e_x, -Rs Rx^T e_y and
+        # -Rs Rx^T Ry^T e_z, Rs the near link's rotation.)
+        rev = figure.reversed_joints
         order = sorted(range(J), key=lambda k: (-depth[k], k))
         vj, va = [], []
         for k in order:
-            for a in range(3):
+            for a in ((2, 1, 0) if rev[k] else (0, 1, 2)):
                 if is_var[k, a]:
                     vj.append(k)
                     va.append(a)
@@ -215,7 +220,6 @@ class IKModel:
         self.lower = np.where(free, -np.inf, np.deg2rad(lo[self.var_joint, self.var_axis]) if V else 0.0)
         self.upper = np.where(free, np.inf, np.deg2rad(hi[self.var_joint, self.var_axis]) if V else 0.0)
         self.downstream = moves[self.var_joint] if V else np.zeros((0, figure.n_links), dtype=bool)
-        rev = figure.reversed_joints
         self.sign = np.where(rev[self.var_joint], -1.0, 1.0) if V else np.zeros(0)
         self.var_primary = np.array([figure.joints[k].primary for k in vj], dtype=np.intp)
         loc1, loc2 = figure.locations

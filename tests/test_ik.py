@@ -119,6 +119,29 @@ def test_analytic_jacobian_matches_central_differences(seed):
     np.testing.assert_allclose(J, numeric, atol=1e-7 * max(1.0, np.abs(J).max()))
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_turning_a_variable_never_moves_the_axis_of_a_later_one(seed):
+    """The variable order CCD sweeps in: each turn leaves the axes and pivots still to come alone."""
+    rng = np.random.default_rng(seed)
+    fig = random_tree(rng, 8).with_main(7)  # re-rooted at a leaf: some joints are walked backwards
+    model = IKModel(fig, np.ones((fig.n_joints, 3), dtype=bool))
+    assert fig.reversed_joints.any() and not fig.reversed_joints.all()
+    base = rng.uniform(-2.5, 2.5, size=(1, fig.n_joints, 3))
+    q = base.reshape(1, -1)[:, model.var_flat]
+
+    def axes(q):
+        angles = model.full_angles(q, base)
+        return model.axes(angles, *model.forward(angles))
+
+    omega, pivot = axes(q)
+    for v in range(model.n_vars):
+        turned = q.copy()
+        turned[0, v] += 0.7
+        o2, p2 = axes(turned)
+        np.testing.assert_allclose(o2[0, v + 1:], omega[0, v + 1:], atol=1e-12)
+        np.testing.assert_allclose(p2[0, v + 1:], pivot[0, v + 1:], atol=1e-12)
+
+
 # ------------------------------------------------------------------ solvers reach
 
 
