@@ -114,10 +114,16 @@ def loop(setup, n_links: int, frames) -> np.ndarray:
             Ry = np.array([[cy, 0, sy, 0], [0, 1, 0, 0], [-sy, 0, cy, 0], [0, 0, 0, 1.0]])
             Rz = np.array([[cz, -sz, 0, 0], [sz, cz, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
             T1, T2 = np.eye(4), np.eye(4)
-            T1[:3, 3] = loc1[k]
-            T2[:3, 3] = -loc2[k]
-            A = T1 @ Rz @ Ry @ Rx @ T2
-            X[child] = X[parent] @ (np.linalg.inv(A) if rev else A)
+            if rev:
+                # Walked from the secondary: the inverse, Trans(L2) Rx^T Ry^T Rz^T Trans(-L1).
+                T1[:3, 3] = loc2[k]
+                T2[:3, 3] = -loc1[k]
+                A = T1 @ Rx.T @ Ry.T @ Rz.T @ T2
+            else:
+                T1[:3, 3] = loc1[k]
+                T2[:3, 3] = -loc2[k]
+                A = T1 @ Rz @ Ry @ Rx @ T2
+            X[child] = X[parent] @ A
         for link in range(n_links):
             out[i, link] = X[link]
             out[i, link, :3, :3] *= scales[link]

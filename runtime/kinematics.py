@@ -197,28 +197,70 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     the order a 4x4 product would.  Only elementwise operations are used,
     never BLAS, so the result is the same on every machine.
     """
-    B, L = angles.shape[0], figure.n_links
+    B, J, L = angles.shape[0], figure.n_joints, figure.n_links
     # Component-major storage: buf[i, j, link] holds entry (i, j) of that
     # link's transform for every frame, contiguous; the result is a
     # transposed view of it, so nothing is copied into frame-major order.
     buf = np.empty((4, 4, L, B))
     buf[3, :3] = 0.0
     buf[3, 3] = 1.0
+    if B == 0:
+        return buf.transpose(3, 2, 0, 1)
     if root is not None:
         root = np.asarray(root, dtype=np.float64)
+    # Joints whose angles hold still over the batch (not driven, or pinned
+    # by their extremes) have one local transform, computed once.
+    flat = angles.reshape(B, -1)
+    moving = np.flatnonzero((flat.min(axis=0) != flat.max(axis=0)).reshape(J, 3).any(axis=1))
+    R0, T0 = _local_transforms(figure, np.arange(J), np.deg2rad(angles[:1].transpose(2, 1, 0)))
+    rad = np.deg2rad(angles[:, moving].transpose(2, 1, 0))  # (3, moving, B), contiguous
     # Blocks of frames small enough for the intermediates to stay in cache.
     for lo in range(0, B, _BLOCK):
         hi = min(lo + _BLOCK, B)
-        _placed_block(figure, angles[lo:hi], None if root is None else root[lo:hi], buf[:, :, :, lo:hi])
+        R = np.empty((3, 3, J, hi - lo))
+        T = np.empty((3, J, hi - lo))
+        R[...] = R0
+        T[...] = T0
+        if len(moving):
+            R[:, :, moving], T[:, moving] = _local_transforms(figure, moving, rad[:, :, lo:hi])
+        _compose(figure, R, T, None if root is None else root[lo:hi], buf[:, :, :, lo:hi])
     return buf.transpose(3, 2, 0, 1)
 
 
 _BLOCK = 1024
 
 
-def _placed_block(figure: Figure, angles: np.ndarray, root, buf: np.ndarray) -> None:
-    """Fill ``buf`` (4, 4, n_links, B) with the transforms of a block of B poses."""
-    B, J = angles.shape[0], figure.n_joints
+def _local_transforms(figure: Figure, joints: np.ndarray, rad: np.ndarray):
+    """Rotations (3, 3, k, B) and translations (3, k, B) of some joints, as walked from the main link.
+
+    ``rad`` (3, k, B) holds the joints' angles in radians, axis first.
+    """
+    (cx, cy, cz), (sx, sy, sz) = _cos_sin(rad)
+    # Entry by entry as in matrix_from_euler_zyx.
+    R = np.empty((3, 3) + rad.shape[1:])
+    R[0, 0] = cy * cz
+    R[0, 1] = cz * sy * sx - sz * cx
+    R[0, 2] = cz * sy * cx + sz * sx
+    R[1, 0] = cy * sz
+    R[1, 1] = sz * sy * sx + cz * cx
+    R[1, 2] = sz * sy * cx - cz * sx
+    np.negative(sy, out=R[2, 0])
+    R[2, 1] = cy * sx
+    R[2, 2] = cy * cx
+    rev = figure.reversed_joints[joints]
+    loc1, loc2 = figure.locations
+    loc1, loc2 = loc1[joints], loc2[joints]
+    if rev.any():
+        # Walked from the secondary: R^T, and L2 - R^T L1.
+        R[:, :, rev] = R[:, :, rev].transpose(1, 0, 2, 3)
+    near = np.where(rev[:, None], loc2, loc1).T[:, :, None]  # (3, k, 1)
+    far = np.where(rev[:, None], loc1, loc2).T[:, :, None]
+    T = near - (R[:, 0] * far[0] + R[:, 1] * far[1] + R[:, 2] * far[2])
+    return R, T
+
+
+def _compose(figure: Figure, R: np.ndarray, T: np.ndarray, root, buf: np.ndarray) -> None:
+    """Walk the tree: fill ``buf`` (4, 4, n_links, B) from the joints' local transforms."""
     main = figure.main
     XR = buf[:3, :3]  # XR[i, j, link]: entry (i, j) of the link's rotation, over the frames
     Xt = buf[:3, 3]
@@ -228,39 +270,34 @@ def _placed_block(figure: Figure, angles: np.ndarray, root, buf: np.ndarray) -> 
     else:
         XR[:, :, main] = root[:, :3, :3].transpose(1, 2, 0)
         Xt[:, main] = root[:, :3, 3].T
-    if J:
-        comp = np.deg2rad(angles.transpose(2, 1, 0))  # (3, J, B), contiguous
-        (cx, cy, cz), (sx, sy, sz) = _cos_sin(comp)
-        # Each joint's rotation, entry by entry as in matrix_from_euler_zyx.
-        R = np.empty((3, 3, J, B))
-        R[0, 0] = cy * cz
-        R[0, 1] = cz * sy * sx - sz * cx
-        R[0, 2] = cz * sy * cx + sz * sx
-        R[1, 0] = cy * sz
-        R[1, 1] = sz * sy * sx + cz * cx
-        R[1, 2] = sz * sy * cx - cz * sx
-        np.negative(sy, out=R[2, 0])
-        R[2, 1] = cy * sx
-        R[2, 2] = cy * cx
-        rev = figure.reversed_joints
-        loc1, loc2 = figure.locations
-        if rev.any():
-            # Walked from the secondary: R^T, and L2 - R^T L1.
-            R[:, :, rev] = R[:, :, rev].transpose(1, 0, 2, 3)
-        near = np.where(rev[:, None], loc2, loc1).T[:, :, None]  # (3, J, 1)
-        far = np.where(rev[:, None], loc1, loc2).T[:, :, None]
-        T = near - (R[:, 0] * far[0] + R[:, 1] * far[1] + R[:, 2] * far[2])  # (3, J, B)
-        for level in figure.traversal:
-            ks, ps, cs = level.joints, level.parents, level.children
-            if len(ks) == 1:
-                # One joint (every level of a chain): slices keep the operands views.
-                ks, ps, cs = (slice(int(v[0]), int(v[0]) + 1) for v in (ks, ps, cs))
-            P = XR[:, :, ps]
-            Rj = R[:, :, ks]
-            tj = T[:, ks]
-            # R = P Rj and t = P tj + tp, summed in the order of a 4x4 product.
-            XR[:, :, cs] = P[:, 0, None] * Rj[0] + P[:, 1, None] * Rj[1] + P[:, 2, None] * Rj[2]
-            Xt[:, cs] = P[:, 0] * tj[0] + P[:, 1] * tj[1] + P[:, 2] * tj[2] + Xt[:, ps]
+    for k, p, c in _walk_order(figure):
+        # Link c = link p through joint k: R = P Rj and t = P tj + tp, each
+        # entry summed over m = 0, 1, 2 in order, as a 4x4 product would
+        # (einsum without optimize: no BLAS).  Slices keep every operand a view.
+        P = XR[:, :, p]
+        np.einsum("imkb,mjkb->ijkb", P, R[:, :, k], out=XR[:, :, c])
+        t = np.einsum("imkb,mkb->ikb", P, T[:, k], out=Xt[:, c])
+        t += Xt[:, p]
+
+
+def _walk_order(figure: Figure) -> list:
+    """(joint, parent link, child link) as one-element slices, parents placed before children."""
+    levels = figure.traversal
+    hit = _WALKS.get(id(levels))
+    if hit is not None and hit[0] is levels:
+        return hit[1]
+    order = [
+        tuple(slice(int(v), int(v) + 1) for v in row)
+        for level in levels
+        for row in zip(level.joints, level.parents, level.children)
+    ]
+    if len(_WALKS) >= 256:
+        _WALKS.clear()
+    _WALKS[id(levels)] = (levels, order)
+    return order
+
+
+_WALKS: dict = {}  # id(figure.traversal) -> (traversal, walk order); the stored traversal keeps the id valid
 
 
 def _cos_sin(a: np.ndarray):

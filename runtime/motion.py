@@ -437,7 +437,12 @@ class Motion:
         ndarray, shape (T, J, 3)
             Degrees about X, Y, Z.
         """
-        return self.evaluate_full(times, joints)[0]
+        t = self._times(times)
+        js = self._joint_list(joints)
+        out = np.empty((len(t), len(js), 3))
+        for i, j in enumerate(js):
+            out[:, i] = self._tracks[j].sample_x(t)
+        return out
 
     def evaluate_full(self, times, joints: Iterable[int] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint angles with their analytic velocity and acceleration.

@@ -57,7 +57,8 @@ def joint_angles(fig: F.Figure, motion: Motion, frames: np.ndarray, full: bool =
     """
     frames = np.asarray(frames, dtype=np.float64).reshape(-1)
     ids = fig.joint_ids
-    driven = [j for j in ids if j in set(motion.joints)]
+    drives = set(motion.joints)
+    driven = [j for j in ids if j in drives]
     angles = np.zeros((len(frames), len(ids), 3))
     vel = np.zeros_like(angles)
     acc = np.zeros_like(angles)
@@ -68,7 +69,10 @@ def joint_angles(fig: F.Figure, motion: Motion, frames: np.ndarray, full: bool =
             a, v, c = bound.evaluate_full(frames, driven)
             angles[:, cols], vel[:, cols], acc[:, cols] = a, v, c
         else:
-            angles[:, cols] = bound.evaluate(frames, driven)
+            if np.isnan(frames).any():
+                bound.evaluate(frames, driven)  # raises the motion's error
+            for j, col in zip(driven, cols):
+                angles[:, col] = bound.track(j).sample_x(frames)
     clamped = K.clamp(fig, angles)
     if full:
         # A clamped axis is held by its stop: it neither moves nor accelerates.

@@ -87,6 +87,19 @@ class Track:
         """
         raise NotImplementedError
 
+    def sample_x(self, t: np.ndarray) -> np.ndarray:
+        """The angles alone: ``sample(t).x``, without computing the derivatives.
+
+        Parameters
+        ----------
+        t : ndarray, shape (N,)
+
+        Returns
+        -------
+        ndarray, shape (N, 3)
+        """
+        return self.sample(t).x
+
     def children(self) -> tuple["Track", ...]:
         """Nodes this one evaluates (for inspection).
 
@@ -217,9 +230,17 @@ class Leaf(Track):
         return self._prep
 
     def sample(self, t: np.ndarray) -> Samples:
+        return self._sample(t, True)
+
+    def sample_x(self, t: np.ndarray) -> np.ndarray:
+        return self._sample(t, False).x
+
+    def _sample(self, t: np.ndarray, full: bool) -> Samples:
         p = self._prepare()
-        out = _empty(len(t))
         K = len(p.T)
+        if not full and len(t) > 8 * K and (t[1:] >= t[:-1]).all():
+            return Samples(self._sample_sorted_x(p, t), None, None)
+        out = _empty(len(t)) if full else Samples(np.empty((len(t), 3)), None, None)
         idx = np.searchsorted(p.F, t, side="right" if self.right else "left")
         out.x[idx == 0] = self.start
         out.x[idx > K] = p.V[K]
@@ -234,11 +255,36 @@ class Leaf(Track):
             rows, s = inside[sel], seg[sel]
             ts = t[rows]
             if m.name == "LINEAR":
-                x, v, a = _trapezoid(p, s, ts)
+                x, v, a = _trapezoid(p, s, ts, full)
             else:
-                x, v, a = _fixed(p, m, s, ts)
-            out.x[rows], out.v[rows], out.a[rows] = x, v, a
+                x, v, a = _fixed(p, m, s, ts, full)
+            out.x[rows] = x
+            if full:
+                out.v[rows], out.a[rows] = v, a
         return out
+
+    def _sample_sorted_x(self, p: _Prepared, t: np.ndarray) -> np.ndarray:
+        """Angles at increasing times: each segment's times are one slice, its values scalars.
+
+        The same arithmetic as the general path, value for value, without
+        gathering every row's segment data.
+        """
+        K = len(p.T)
+        x = np.empty((len(t), 3))
+        # Rows b[i] .. b[i+1] lie in segment i (knot i to knot i+1).
+        b = np.searchsorted(t, p.F, side="left" if self.right else "right").tolist()
+        x[: b[0]] = self.start
+        x[b[K]:] = p.V[K]
+        for k in range(K):
+            lo, hi = b[k], b[k + 1]
+            if hi <= lo:
+                continue
+            m = p.kinds[p.code[k]]
+            if m.name == "LINEAR":
+                x[lo:hi] = _trapezoid(p, k, t[lo:hi], False)[0]
+            else:
+                x[lo:hi] = _fixed(p, m, k, t[lo:hi], False)[0]
+        return x
 
     def _reversed(self, length, memo):
         rev = _cached(memo, ("leaf-rev",), self, self._mirror)
@@ -274,36 +320,49 @@ class Leaf(Track):
             out.add(offset + f, v, m.name, r)
 
 
-def _gather(p: _Prepared, s: np.ndarray, ts: np.ndarray):
+def _col(a):
+    """A per-row array as a column; a scalar (one segment for every row) as it is."""
+    return a[:, None] if np.ndim(a) else a
+
+
+def _gather(p: _Prepared, s, ts: np.ndarray):
+    """Segment data for rows at times ``ts``: ``s`` is each row's segment, or one segment for all."""
     tau = (ts - p.F[s])[:, None]
     sig = (p.F[s + 1] - ts)[:, None]
     return tau, sig, p.V[s], p.V[s + 1]
 
 
-def _trapezoid(p: _Prepared, s: np.ndarray, ts: np.ndarray):
-    """LINEAR segments: ramp Vs -> c over r frames, cruise, ramp c -> Ve over r frames."""
+def _trapezoid(p: _Prepared, s: np.ndarray, ts: np.ndarray, full: bool = True):
+    """LINEAR segments: ramp Vs -> c over r frames, cruise, ramp c -> Ve over r frames.
+
+    Returns (x, v, a); v and a are None unless ``full``.
+    """
     tau, sig, v0, v1 = _gather(p, s, ts)
-    r = p.r[s][:, None]
+    r = _col(p.r[s])
     Vs, Ve, c = p.Vs[s], p.Ve[s], p.c[s]
     # Each half is measured from its own keyframe so that the mirrored segment
     # performs the mirrored arithmetic and keyframes are reached exactly.
     xs = np.where(tau < r, Vs * tau + (c - Vs) * tau * tau / (2.0 * r), r * (Vs + c) / 2.0 + c * (tau - r))
     xe = np.where(sig < r, Ve * sig + (c - Ve) * sig * sig / (2.0 * r), r * (Ve + c) / 2.0 + c * (sig - r))
     x = np.where(tau <= sig, v0 + xs, v1 - xe)
+    if not full:
+        return x, None, None
     v = np.where(tau < r, Vs + (c - Vs) * tau / r, np.where(sig < r, Ve + (c - Ve) * sig / r, c))
     a = np.where(tau < r, (c - Vs) / r, np.where(sig < r, -(c - Ve) / r, 0.0))
     return x, v, a
 
 
-def _fixed(p: _Prepared, m, s: np.ndarray, ts: np.ndarray):
-    """Fixed-shape segments: v0 + D e(u)."""
+def _fixed(p: _Prepared, m, s: np.ndarray, ts: np.ndarray, full: bool = True):
+    """Fixed-shape segments: v0 + D e(u).  Returns (x, v, a); v and a are None unless ``full``."""
     tau, sig, v0, v1 = _gather(p, s, ts)
-    T = p.T[s][:, None]
+    T = _col(p.T[s])
     D = p.D[s]
     u = np.clip(tau / T, 0.0, 1.0)
     e, de, d2e = m.ease(u[:, 0])
     e, de, d2e = e[:, None], de[:, None], d2e[:, None]
     x = np.where(u <= 0.5, v0 + D * e, v1 - D * (1.0 - e))
+    if not full:
+        return x, None, None
     return x, D / T * de, D / (T * T) * d2e
 
 
@@ -333,6 +392,11 @@ class Const(Track):
         out = _empty(len(t))
         out.x[:] = self.value
         return out
+
+    def sample_x(self, t):
+        x = np.empty((len(t), 3))
+        x[:] = self.value
+        return x
 
     def _reversed(self, length, memo):
         return Const(self.value, length)
@@ -382,6 +446,18 @@ class Pad(Track):
         if not held.all():
             out.x[~held], out.v[~held], out.a[~held] = self.inner.sample(t[~held])
         return out
+
+    def sample_x(self, t):
+        if self.hold_from is None:
+            return self.inner.sample_x(t)
+        held = t >= self.hold_from
+        if not held.any():
+            return self.inner.sample_x(t)
+        x = np.empty((len(t), 3))
+        x[held] = self.end_value
+        if not held.all():
+            x[~held] = self.inner.sample_x(t[~held])
+        return x
 
     def children(self):
         return (self.inner,)
@@ -433,18 +509,28 @@ class Concat(Track):
         return self.pieces
 
     def sample(self, t):
+        out = _empty(len(t))
+        for j, rows, local in self._split(t):
+            out.x[rows], out.v[rows], out.a[rows] = self.pieces[j].sample(local)
+        return out
+
+    def sample_x(self, t):
+        x = np.empty((len(t), 3))
+        for j, rows, local in self._split(t):
+            x[rows] = self.pieces[j].sample_x(local)
+        return x
+
+    def _split(self, t):
+        """(piece, rows of t it shows, their local times) for every piece that shows."""
         idx = np.searchsorted(self.pivots, t, side="right")
         # Pivots are strictly increasing, so at most the last passed pivot equals t.
         at = idx > 0
         at[at] = (t[at] == self.pivots[idx[at] - 1]) & ~self.rights[idx[at] - 1]
         idx[at] -= 1
         offsets = np.concatenate([[0.0], self.pivots])
-        out = _empty(len(t))
         for j in np.unique(idx):
             rows = idx == j
-            s = self.pieces[j].sample(t[rows] - offsets[j])
-            out.x[rows], out.v[rows], out.a[rows] = s
-        return out
+            yield j, rows, t[rows] - offsets[j]
 
     def _reversed(self, length, memo):
         bounds = np.concatenate([[0.0], self.pivots, [length]])
@@ -493,7 +579,8 @@ class Repeat(Track):
     def children(self):
         return (self.inner,)
 
-    def sample(self, t):
+    def _local(self, t):
+        """Times within the copy of the inner track that shows at each of ``t``."""
         P, last = self.period, self.n - 1
         with np.errstate(invalid="ignore"):
             k = np.floor(t / P) if self.right else np.ceil(t / P) - 1.0
@@ -507,7 +594,13 @@ class Repeat(Track):
         if down.any() or up.any():
             k = k - down + up
             local = t - k * P
-        return self.inner.sample(local)
+        return local
+
+    def sample(self, t):
+        return self.inner.sample(self._local(t))
+
+    def sample_x(self, t):
+        return self.inner.sample_x(self._local(t))
 
     def _reversed(self, length, memo):
         # The last copy (it absorbs any hold after the repeat) comes first, then n-1 mirrored periods.
