@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import sys
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import numpy as np
 
 from .camera import Camera
-from .imagefiles import read_png, write_gif, write_mp4, write_png
+from .imagefiles import find_ffmpeg, read_png, write_gif, write_mp4, write_png
 from .pose import joint_angles, mesh_table, static_triangles, world_transforms, world_triangles
 from .raster import Framebuffer, rasterize
 from .values import Graphical, grey_levels
@@ -57,6 +58,9 @@ class Renderer:
         self.out_dir = out_dir
         self.size = (int(size[0]), int(size[1]))
         self.gif, self.mp4, self.fps = gif, mp4, fps
+        if mp4:
+            # No ffmpeg, no render: say so before any file is written.
+            find_ffmpeg()
         self.poses_path = poses
         self.quiet = quiet
         self.workers = workers if workers is not None else min(os.cpu_count() or 1, 8)
@@ -264,7 +268,7 @@ class Renderer:
 
 
 def _worker_init() -> None:
-    """Set up a worker process: keep freed memory for reuse.
+    """Set up a worker process: leave Ctrl-C to the main process, keep freed memory for reuse.
 
     Each image allocates and frees the same few large arrays; by default
     glibc hands large blocks back to the kernel and gets them again as fresh
@@ -272,6 +276,10 @@ def _worker_init() -> None:
     the MALLOC_MMAP_THRESHOLD_ and MALLOC_TRIM_THRESHOLD_ environment
     variables do at start-up) keeps them in the heap.
     """
+    # Ctrl-C is the main process's business: it stops handing out work and
+    # waits for the images being drawn, so every file is whole; workers
+    # dying of KeyboardInterrupt mid-task would only print tracebacks.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         import ctypes
 
