@@ -253,8 +253,7 @@ def test_free_axes_turn_past_the_wrap_and_come_back_wrapped():
 
 def _scipy_best(fig, goals_fn, bounds, starts):
     """The best of scipy's bounded least squares from several starts (cost, x)."""
-    # scipy comes with the benchmark's ikpy, not with the test extra.
-    least_squares = pytest.importorskip("scipy.optimize").least_squares
+    from scipy.optimize import least_squares  # a test dependency (pyproject: test)
     best = None
     for x0 in starts:
         res = least_squares(goals_fn, x0, bounds=bounds, xtol=1e-14, ftol=1e-14, gtol=1e-14)
