@@ -170,7 +170,8 @@ def cmd_lib(args) -> int:
             if i:
                 print()
             print(f"{name}  ({lib.display})")
-            offered = lib.default_names()
+            order = {"PRIMITIVE": 0, "MODEL": 1, "MOTION": 2, "GRAPHICAL": 3}
+            offered = sorted(lib.default_names(), key=lambda n: (order.get(lib.kind_of(n), 4), n))
             width = max((len(n) for n in offered), default=0)
             for n in offered:
                 kind = lib.kind_of(n)
