@@ -364,3 +364,29 @@ def test_culling_leaves_the_appendix_a_picture_unchanged(tmp_path):
         culled = rasterize(tris, grey, cam, cull=np.ones(len(tris), dtype=bool))
         drawn = rasterize(tris, grey, cam)
         np.testing.assert_array_equal(culled, drawn)
+
+
+# --------------------------------------------------------------------------
+# PNG: runs of rows equal to the row above are spliced in precomputed
+
+
+@pytest.mark.parametrize("width", [1, 2, 13, 640])
+def test_png_with_blank_runs_is_a_valid_zlib_stream(width):
+    import zlib
+
+    rng = np.random.default_rng(width)
+    bands = [0, 7, 8, 9, 1, 16, 300, 3, 8]  # lengths of runs of equal rows, around the splicing threshold
+    rows = []
+    for n in bands:
+        rows.append(rng.integers(0, 256, (1, width)))
+        rows += [rows[-1]] * n
+    img = np.concatenate(rows).astype(np.uint8)
+    img[:9] = 255  # the first rows blank too
+    data = imagefiles.encode_png(img)
+    length = int.from_bytes(data[33:37], "big")
+    assert data[37:41] == b"IDAT"
+    raw = zlib.decompress(data[41:41 + length])  # checks the Adler-32 too
+    assert len(raw) == img.shape[0] * (width + 1)
+    with Image.open(__import__("io").BytesIO(data)) as im:
+        np.testing.assert_array_equal(np.asarray(im), img)
+    assert imagefiles.encode_png(img.copy()) == data
