@@ -358,12 +358,20 @@ def _fixed(p: _Prepared, m, s: np.ndarray, ts: np.ndarray, full: bool = True):
     T = _col(p.T[s])
     D = p.D[s]
     u = np.clip(tau / T, 0.0, 1.0)
+    if not full:
+        e = _ease_value(m, u[:, 0])[:, None]
+        return np.where(u <= 0.5, v0 + D * e, v1 - D * (1.0 - e)), None, None
     e, de, d2e = m.ease(u[:, 0])
     e, de, d2e = e[:, None], de[:, None], d2e[:, None]
     x = np.where(u <= 0.5, v0 + D * e, v1 - D * (1.0 - e))
-    if not full:
-        return x, None, None
     return x, D / T * de, D / (T * T) * d2e
+
+
+def _ease_value(m, u: np.ndarray) -> np.ndarray:
+    """``m.ease(u)[0]`` without the derivatives, for the built-in kind of method."""
+    if type(m) is interpolation.Method:
+        return np.broadcast_to(m._e(u), u.shape).astype(float)
+    return m.ease(u)[0]
 
 
 # ---------------------------------------------------------------------------
