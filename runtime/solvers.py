@@ -32,6 +32,7 @@ the iterations they take.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -76,6 +77,7 @@ MU0 = 1e-1
 MAXSTEP = 0.8
 # Up to this many trials at once, the Jacobian is computed with the residuals.
 SMALL_BATCH = 4
+_ONE = np.zeros(1, dtype=np.intp)
 
 
 @dataclass
@@ -139,6 +141,11 @@ class _Problem:
         c, s = self.model.trig(q, bc, bs)
         R, p = self.model.forward_trig(c, s)
         return (c, s), R, p, t
+
+    def one(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Residuals ``(M,)``, Jacobian ``(M, P)`` and distances ``(n_goals,)`` of a batch of one at ``x (P,)``."""
+        r, J, dist = self.evaluate(_ONE, self.stack, x[None])
+        return r[0], J[0], dist[0]
 
     def evaluate(self, idx, stack, x, jac=True):
         """``r (B', M)``, ``J (B', M, P)`` or None, ``dist (B', n_goals)``."""
@@ -237,6 +244,10 @@ def solve(model: IKModel, stack: GoalStack, x0: np.ndarray, base: np.ndarray, *,
     run = {"dls": _dls, "transpose": _transpose, "ccd": _ccd}[method]
     prob = _Problem(model, stack, base)
     x = np.clip(np.array(x0, dtype=float), prob.lower, prob.upper)
+    if method == "dls" and x.shape[0] == 1:
+        # One problem (the language's STARTREACH): the batch bookkeeping
+        # would cost more than the arithmetic; same iterates, scalar control.
+        return _dls_one(prob, x[0], float(tolerance), int(max_iterations), int(restarts), seed, trace)
     st = _State(prob, x, float(tolerance), trace, jac=method != "ccd", max_iter=int(max_iterations),
                 restarts=int(restarts), seed=seed)
     run(prob, st)
@@ -497,6 +508,166 @@ def _dls(prob: _Problem, st: _State) -> None:
         blown = mu[idx] > MU_MAX * np.maximum(curv[idx], 1e-300)
         st.status[idx[blown & (st.status[idx] == RUNNING)]] = STALLED
         st.end_iteration(idx)
+
+
+def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts: int, seed: int,
+             trace: bool) -> SolveResult:
+    """:func:`_dls` and :class:`_State` for a batch of one, with plain Python control.
+
+    A single solve is a few dozen iterations on arrays of a handful of
+    entries, where every numpy call costs far more than its arithmetic: the
+    batched loop's per-element status arrays, index gathers and masked
+    writes were most of its time.  This is the same algorithm step for step
+    -- hold, damped step, cap, projection, acceptance, Nielsen's update, the
+    stopping rules, the progress window, giving up, restarts and resuming --
+    so a batch of one gives what the batched loop gives (the tests compare
+    the two), with the bookkeeping in Python scalars.
+
+    Parameters
+    ----------
+    prob : _Problem
+        With a batch of one.
+    x : numpy.ndarray, shape (P,)
+        Start variables, within the bounds.
+    tol, max_iter, restarts, seed, trace
+        As for :func:`solve`.
+
+    Returns
+    -------
+    SolveResult
+        With a batch dimension of one, as :func:`solve` returns.
+    """
+    model = prob.model
+    V, P = model.n_vars, model.n_params
+    lower, upper = prob.lower, prob.upper
+    evaluate = prob.one
+    active = prob.stack.active[0]
+    all_active = bool(active.all())
+
+    def converged(dist):
+        ok = dist <= tol
+        return bool(ok.all() if all_active else (ok | ~active).all())
+
+    def reset(J):
+        # The first damping: a fraction of the largest curvature (see _dls).
+        c = float((J * J).sum(axis=0).max(initial=0.0))
+        return c, MU0 * (c if c > 0 else 1.0), 2.0
+
+    x0 = x.copy()
+    r, J, dist = evaluate(x)
+    f = 0.5 * float(r @ r)
+    status = CONVERGED if converged(dist) else RUNNING
+    if max_iter <= 0 and status == RUNNING:
+        status = LIMIT
+    history = [np.array([f])] if trace else None
+    iterations = attempt_iter = 0
+    window_f = fast_f = f
+    attempts_left = restarts if V else 0
+    rng = None
+    saved = None  # the first attempt, set aside by a restart
+    gave_up = resumed = False
+    n_active = max(int(active.sum()), 1)
+    giveup_floor = GIVEUP_FLOOR * 0.5 * tol * tol * n_active
+    curv, mu, nu = reset(J)
+    if status == RUNNING and curv == 0.0:
+        status = STALLED
+    eye = np.eye(min(r.size, P))
+
+    while status == RUNNING:
+        # Hold variables at a limit the descent direction, then the step, pushes against.
+        g = J.T @ r
+        free = ~(((x <= lower) & (g > 0)) | ((x >= upper) & (g < 0)))
+        for _pass in range(3):
+            Jf = J * free
+            if r.size < P:
+                y = np.linalg.solve(Jf @ Jf.T + mu * eye, -r)
+                dx = Jf.T @ y
+            else:
+                dx = -np.linalg.solve(Jf.T @ Jf + mu * eye, Jf.T @ r)
+            out = (((x <= lower) & (dx < 0)) | ((x >= upper) & (dx > 0))) & free
+            if not out.any():
+                break
+            free &= ~out
+        big = float(np.abs(dx[:V]).max(initial=0.0))
+        if big > MAXSTEP:
+            dx = dx * (MAXSTEP / big)
+        dx = np.clip(x + np.where(free, dx, 0.0), lower, upper) - x
+        xn = x + dx
+        rn, Jn, dn = evaluate(xn)
+        fn = 0.5 * float(rn @ rn)
+        lin = r + J @ dx
+        predicted = f - 0.5 * float(lin @ lin)
+        gain = f - fn
+        accept = gain > 0 and predicted > 0
+        f_old = f
+        if accept:
+            rho = gain / predicted
+            mu = mu * max(1 / 3, 1 - (2 * rho - 1) ** 3)
+            nu = 2.0
+            x, r, J, dist, f = xn, rn, Jn, dn, fn
+        else:
+            mu = mu * nu
+            nu = nu * 2.0
+        # Stopping rules (see _State.stop_checks).
+        if converged(dist):
+            status = CONVERGED
+        elif (accept and gain <= FTOL * f_old) or (
+                math.sqrt(float(dx @ dx)) <= XTOL * (XTOL + math.sqrt(float(x @ x)))):
+            status = STALLED
+        if status == RUNNING and mu > MU_MAX * max(curv, 1e-300):
+            status = STALLED
+        # _State.end_iteration, for one element.
+        iterations += 1
+        attempt_iter += 1
+        if trace:
+            history.append(np.array([f]))
+        if status == RUNNING:
+            k = attempt_iter
+            if k % WINDOW == 0:
+                if window_f - f <= WINDOW_FTOL * window_f:
+                    status = STALLED
+                window_f = f
+            if k >= max_iter:
+                status = LIMIT
+            if k % GIVEUP_EVERY == 0 and attempts_left > 0 and status == RUNNING:
+                if k >= GIVEUP_FROM and f > giveup_floor and f > 0.5 * fast_f:
+                    status = STALLED
+                    gave_up = True
+                fast_f = f
+        if status in (STALLED, LIMIT):
+            if attempts_left > 0:
+                if saved is None:
+                    saved = dict(x=x, r=r, J=J, f=f, dist=dist, status=status, attempt_iter=attempt_iter,
+                                 window_f=window_f, gave_up=gave_up, fast_f=fast_f, curv=curv, mu=mu, nu=nu)
+                if rng is None:
+                    rng = np.random.default_rng(seed)
+                lo = np.where(np.isfinite(lower[:V]), lower[:V], -np.pi)
+                hi = np.where(np.isfinite(upper[:V]), upper[:V], np.pi)
+                x = x0.copy()
+                # Drawn as a batch of one, so the angles are the batched loop's.
+                x[:V] = rng.uniform(lo, hi, size=(1, V))[0]
+                r, J, dist = evaluate(x)
+                f = 0.5 * float(r @ r)
+                window_f = fast_f = f
+                attempt_iter = 0
+                attempts_left -= 1
+                gave_up = False
+                status = CONVERGED if converged(dist) else RUNNING
+                curv, mu, nu = reset(J)
+                if status == RUNNING and curv == 0.0:
+                    status = STALLED
+            if saved is not None and attempts_left == 0 and saved["gave_up"] and not resumed:
+                # Every restart used: take the first attempt up where it was given up.
+                # (As the batched loop does, this also happens right after the last restart is drawn.)
+                x, r, J, f, dist = saved["x"], saved["r"], saved["J"], saved["f"], saved["dist"]
+                attempt_iter, window_f, fast_f = saved["attempt_iter"], saved["window_f"], saved["fast_f"]
+                curv, mu, nu = saved["curv"], saved["mu"], saved["nu"]
+                status, gave_up, resumed = RUNNING, False, True
+
+    if saved is not None and status != CONVERGED and not resumed:
+        x, f, dist, status = saved["x"], saved["f"], saved["dist"], saved["status"]
+    return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None],
+                       history or [])
 
 
 def _transpose(prob: _Problem, st: _State) -> None:
