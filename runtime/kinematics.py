@@ -211,7 +211,7 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     # Joints whose angles hold still over the batch (not driven, or pinned
     # by their extremes) have one local transform, computed once.
     flat = angles.reshape(B, -1)
-    moving = np.flatnonzero((flat.min(axis=0) != flat.max(axis=0)).reshape(J, 3).any(axis=1))
+    moving = np.flatnonzero((flat != flat[0]).any(axis=0).reshape(J, 3).any(axis=1))
     R0, T0 = _local_transforms(figure, np.arange(J), np.deg2rad(angles[:1].transpose(2, 1, 0)))
     rad = np.deg2rad(angles[:, moving].transpose(2, 1, 0))  # (3, moving, B), contiguous
     # Blocks of frames small enough for the intermediates to stay in cache.
@@ -227,7 +227,7 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     return buf.transpose(3, 2, 0, 1)
 
 
-_BLOCK = 1024
+_BLOCK = 4096
 
 
 def _local_transforms(figure: Figure, joints: np.ndarray, rad: np.ndarray):
@@ -416,7 +416,7 @@ def free_axes(figure: Figure) -> dict[int, tuple[bool, bool, bool]]:
     return {jid: tuple(bool(f) for f in row) for jid, row in zip(figure.joint_ids, free)}
 
 
-def clamp(figure: Figure, angles) -> np.ndarray:
+def clamp(figure: Figure, angles, out=None) -> np.ndarray:
     """Enforce each joint's extremes over the motion's angles.
 
     Parameters
@@ -424,6 +424,8 @@ def clamp(figure: Figure, angles) -> np.ndarray:
     figure : Figure
     angles : array_like, shape (..., n_joints, 3)
         Degrees, in the figure's joint order.
+    out : numpy.ndarray, optional
+        Where to write the result (may be ``angles`` itself).
 
     Returns
     -------
@@ -439,7 +441,11 @@ def clamp(figure: Figure, angles) -> np.ndarray:
     lo, hi = ext[..., 0], ext[..., 1]
     free = hi - lo >= 360.0
     if not free.any():
-        return np.clip(a, lo, hi)
+        return np.clip(a, lo, hi, out=out)
     turns = np.mod(a - lo, 360.0)
     turns = np.where(turns >= 360.0, 0.0, turns)  # np.mod(-1e-17, 360) rounds to 360
-    return np.where(free, lo + turns, np.clip(a, lo, hi))
+    result = np.where(free, lo + turns, np.clip(a, lo, hi))
+    if out is None:
+        return result
+    out[...] = result
+    return out

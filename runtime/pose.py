@@ -60,8 +60,9 @@ def joint_angles(fig: F.Figure, motion: Motion, frames: np.ndarray, full: bool =
     drives = set(motion.joints)
     driven = [j for j in ids if j in drives]
     angles = np.zeros((len(frames), len(ids), 3))
-    vel = np.zeros_like(angles)
-    acc = np.zeros_like(angles)
+    if full:
+        vel = np.zeros_like(angles)
+        acc = np.zeros_like(angles)
     if driven:
         bound = _bound_motion(fig, motion)
         cols = [fig.joint_index(j) for j in driven]
@@ -73,7 +74,7 @@ def joint_angles(fig: F.Figure, motion: Motion, frames: np.ndarray, full: bool =
                 bound.evaluate(frames, driven)  # raises the motion's error
             for j, col in zip(driven, cols):
                 angles[:, col] = bound.track(j).sample_x(frames)
-    clamped = K.clamp(fig, angles)
+    clamped = K.clamp(fig, angles, out=None if full else angles)
     if full:
         # A clamped axis is held by its stop: it neither moves nor accelerates.
         held = clamped != angles
