@@ -238,6 +238,11 @@ def batch_size(goals: Sequence[Goal]) -> int | None:
     return sizes.pop() if sizes else None
 
 
+# Cross products by index permutation: (a x b)_i = a_P1 b_P2 - a_P2 b_P1.
+_P1 = np.array([1, 2, 0])
+_P2 = np.array([2, 0, 1])
+
+
 class GoalStack:
     """A list of goals packed into arrays, evaluated for a batch of poses.
 
@@ -345,6 +350,10 @@ class GoalStack:
         self._downstream_p = model.downstream[:, self.p_link].T.astype(float)  # (G, V)
         self._downstream_q = model.downstream[:, self.q_link].T.astype(float)
         self._downstream_h = model.downstream[:, self.h_link].T.astype(float)
+        # For evaluate_one: point goals only (then the packed order is the
+        # user's), and their link points in homogeneous coordinates.
+        self._points_only = Q == 0 and H == 0
+        self._p_local_h = np.concatenate((self.p_local, np.ones((G, 1))), axis=1)[:, :, None]
 
     # ------------------------------------------------------------ batches
 
@@ -472,6 +481,52 @@ class GoalStack:
         dist = np.empty_like(packed)
         dist[:, self.order] = packed
         return r, jac, dist
+
+    def evaluate_one(self, X, t, omega, c):
+        """:meth:`evaluate` with the Jacobian, for a batch of one, from 4x4 link transforms.
+
+        Parameters
+        ----------
+        X : numpy.ndarray, shape (n_links, 4, 4)
+            From :meth:`IKModel.forward_one`.
+        t : numpy.ndarray, shape (3,), or None
+        omega, c : numpy.ndarray, shape (V, 3)
+
+        Returns
+        -------
+        r : numpy.ndarray, shape (M,)
+        jac : numpy.ndarray, shape (M, n_params)
+        dist : numpy.ndarray, shape (n_goals,)
+
+        Notes
+        -----
+        Point goals alone (what a reach asks) are evaluated here in a few
+        numpy calls on (G, V, 3) arrays; plane and axis goals go through
+        :meth:`evaluate` with a batch dimension of one.
+        """
+        m = self.model
+        if not self._points_only:
+            R, p = X[None, :, :3, :3], X[None, :, :3, 3]
+            r, jac, dist = self.evaluate(R, p, None if t is None else t[None], omega[None], c[None])
+            return r[0], jac[0], dist[0]
+        V = m.n_vars
+        y = (X[self.p_link] @ self._p_local_h)[:, :3, 0]  # (G, 3), model frame
+        res = m.to_world(y[None], None if t is None else t[None])[0] - self.p_target[0]
+        d = y[:, None, :] - c  # (G, V, 3)
+        # omega x d, written with index permutations: two gathers per factor
+        # cost less than cross3's six views and a stack on arrays this small.
+        v = (omega[:, _P1] * d[..., _P2] - omega[:, _P2] * d[..., _P1]) * self._downstream_p[:, :, None]
+        v = m.to_world_vectors(v)
+        G = len(self.p_link)
+        w = self.row_weight[0]
+        if m.translate:
+            jac = np.zeros((G, 3, m.n_params))
+            jac[..., :V] = v.transpose(0, 2, 1)
+            jac[..., V:] = np.eye(3) * m.length
+            jac = jac.reshape(3 * G, -1)
+        else:
+            jac = v.transpose(0, 2, 1).reshape(3 * G, V)
+        return res.reshape(-1) * w, jac * w[:, None], np.sqrt((res * res).sum(axis=1))
 
     def _point_jacobian(self, y, omega, c, down):
         """World velocity of link points per radian of each variable, shape (B, N, 3, V)."""

@@ -71,6 +71,28 @@ def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0), axis=-1)
 
 
+# The products of cosines and sines that make up ``Rz Ry Rx`` and the local
+# axes (see IKModel.forward_one): columns of [cx, cy, cz, sx, sy, sz, 1],
+# three per product.
+_TERMS = np.array([
+    (1, 2, 6), (2, 4, 3), (5, 0, 6), (2, 4, 0), (5, 3, 6), (1, 5, 6), (5, 4, 3), (2, 0, 6),
+    (5, 4, 0), (2, 3, 6), (4, 6, 6), (1, 3, 6), (1, 0, 6), (5, 6, 6), (2, 6, 6), (6, 6, 6),
+]).T
+# Which products, with which signs, add up to each entry: R row-major, then
+# the local X axis Rz Ry e_x, Y axis Rz e_y and Z axis e_z.
+_TERM_SUMS = np.zeros((16, 18))
+for _col, _terms in enumerate([
+    {0: 1}, {1: 1, 2: -1}, {3: 1, 4: 1},
+    {5: 1}, {6: 1, 7: 1}, {8: 1, 9: -1},
+    {10: -1}, {11: 1}, {12: 1},
+    {0: 1}, {5: 1}, {10: -1},
+    {13: -1}, {14: 1}, {},
+    {}, {}, {15: 1},
+]):
+    for _k, _sign in _terms.items():
+        _TERM_SUMS[_k, _col] = _sign
+del _col, _terms, _k, _sign
+
 _lengths_cache: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 # (id(figure), movable mask, translate) -> (figure, model).  The model holds
 # its figure, so a weak-keyed cache would never let go; this one is bounded
@@ -243,6 +265,18 @@ class IKModel:
         ]
         self.lengths = link_lengths(figure)
         self.length = figure_length(figure)
+        # For :meth:`forward_one`: the rotation entries and local axes as
+        # sums of products of the cosines and sines (see _TERMS).
+        self._half_turn = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])  # row-major 3x3 -> its transpose
+        T1 = np.zeros((J, 4, 4))
+        T1[:, 3, 3] = 1.0
+        self._T_one = T1
+        # Each variable's local axis in column 0, its pivot in column 1
+        # (homogeneous): one product with the primary's 4x4 gives both.
+        M = np.zeros((V, 4, 2))
+        M[:, :3, 1] = self.var_loc1
+        M[:, 3, 1] = 1.0
+        self._axis_pivot = M
         self.moves = moves  # (J, n_links): every joint, variable or not
         self.parent_link = parent_of  # per link, the next link toward the main link (-1 for it)
         self.into_joint = into  # per link, the joint joining it to parent_link (-1 for the main link)
@@ -402,6 +436,56 @@ class IKModel:
                 X[children] = X[parents] @ T[joints]
         X = X.swapaxes(0, 1)
         return X[..., :3, :3], X[..., :3, 3]
+
+    def forward_one(self, c: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`forward_trig` and :meth:`axes_trig` for one pose, as 4x4 link transforms.
+
+        Parameters
+        ----------
+        c, s : numpy.ndarray, shape (n_joints, 3)
+            Cosines and sines of the angles.
+
+        Returns
+        -------
+        X : numpy.ndarray, shape (n_links, 4, 4)
+            Each link's transform in the model frame (``X[l, :3, :3]`` is
+            :meth:`forward`'s ``R``, ``X[l, :3, 3]`` its ``p``).
+        omega, pivot : numpy.ndarray, shape (V, 3)
+            As :meth:`axes` returns them.
+
+        Notes
+        -----
+        A single solve calls this once an iteration on arrays of a few
+        entries, where the cost is the number of numpy calls, not their
+        size.  Every entry of ``Rz Ry Rx`` and of the three local axes is a
+        signed sum of products of at most three cosines and sines, so one
+        gather, two products and one matrix product (:data:`_TERMS`,
+        :data:`_TERM_SUMS`) give them all, exactly as the formulas written
+        out in :meth:`forward_trig` do (the sums only add zeros and flip
+        signs).
+        """
+        fig = self.figure
+        cs = np.concatenate((c, s, np.ones((c.shape[0], 1))), axis=1)  # (J, 7)
+        t = cs[:, _TERMS[0]] * cs[:, _TERMS[1]] * cs[:, _TERMS[2]]
+        e = t @ _TERM_SUMS  # (J, 18): R row-major, then the X, Y and Z axes
+        R9 = e[:, :9]
+        if self._any_reversed:
+            R9 = np.where(self._rev[:, None], R9[:, self._half_turn], R9)
+        T = self._T_one.copy()
+        Rj = R9.reshape(-1, 3, 3)
+        T[:, :3, :3] = Rj
+        T[:, :3, 3] = self._near - (Rj @ self._far[:, :, None])[:, :, 0]
+        X = np.empty((fig.n_links, 4, 4))
+        X[fig.main] = np.eye(4)
+        for joints, parents, children in self._levels:
+            if isinstance(joints, int):
+                np.matmul(X[parents], T[joints], out=X[children])
+            else:
+                X[children] = X[parents] @ T[joints]
+        M = self._axis_pivot.copy()
+        M[:, :3, 0] = e[:, 9:].reshape(-1, 3, 3)[self.var_joint, self.var_axis]
+        op = X[self.var_primary] @ M  # (V, 4, 2)
+        return X, op[:, :3, 0] * self.sign[:, None], op[:, :3, 1]
 
     def axes(self, angles: np.ndarray, R: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Each variable's signed rotation axis and pivot in the model frame.
