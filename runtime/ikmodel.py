@@ -265,18 +265,44 @@ class IKModel:
         ]
         self.lengths = link_lengths(figure)
         self.length = figure_length(figure)
-        # For :meth:`forward_one`: the rotation entries and local axes as
-        # sums of products of the cosines and sines (see _TERMS).
-        self._half_turn = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])  # row-major 3x3 -> its transpose
-        T1 = np.zeros((J, 4, 4))
-        T1[:, 3, 3] = 1.0
-        self._T_one = T1
+        # For :meth:`forward_one`: each joint's 4x4 transform and local axes
+        # are linear in the products of its cosines and sines (_TERMS), so a
+        # (16, 25) matrix per joint maps the products to them, with the
+        # joint's locations, and its direction (R or R^T), folded in.
+        SJ = np.zeros((J, 16, 25))
+        for k in range(J):
+            near, far = self._near[k], self._far[k]
+            for i in range(3):
+                for j in range(3):
+                    src = 3 * j + i if rev[k] else 3 * i + j
+                    SJ[k, :, 4 * i + j] = _TERM_SUMS[:, src]
+                # t_i = near_i - sum_j R_ij far_j; the constant rides on the product "1".
+                SJ[k, :, 4 * i + 3] = -(SJ[k, :, 4 * i: 4 * i + 3] @ far)
+                SJ[k, 15, 4 * i + 3] += near[i]
+            SJ[k, 15, 15] = 1.0
+            SJ[k, :, 16:] = _TERM_SUMS[:, 9:]
+        self._term_maps = SJ
+        self._term_index = (np.arange(J)[:, None] * 7 + _TERMS[:, None, :]) if J else np.zeros((3, 0, 16), dtype=np.intp)
+        # Where the variables' cosines and sines go among [c, s, 1] per joint.
+        self._cos_at = self.var_joint * 7 + self.var_axis
+        self._sin_at = self._cos_at + 3
+        # A chain from the main link (every level one joint, each hanging
+        # from the last): its link transforms are prefix products, computed
+        # in log2(J) batched products instead of J single ones.
+        chain = all(isinstance(lv[0], int) for lv in self._levels)
+        prev = figure.main
+        for lv in self._levels if chain else ():
+            chain = chain and lv[1] == prev
+            prev = lv[2]
+        self._chain = (np.array([lv[0] for lv in self._levels], dtype=np.intp),
+                       np.array([lv[2] for lv in self._levels], dtype=np.intp)) if chain and J else None
         # Each variable's local axis in column 0, its pivot in column 1
         # (homogeneous): one product with the primary's 4x4 gives both.
         M = np.zeros((V, 4, 2))
         M[:, :3, 1] = self.var_loc1
         M[:, 3, 1] = 1.0
         self._axis_pivot = M
+        self._eye4 = np.eye(4)
         self.moves = moves  # (J, n_links): every joint, variable or not
         self.parent_link = parent_of  # per link, the next link toward the main link (-1 for it)
         self.into_joint = into  # per link, the joint joining it to parent_link (-1 for the main link)
@@ -437,13 +463,38 @@ class IKModel:
         X = X.swapaxes(0, 1)
         return X[..., :3, :3], X[..., :3, 3]
 
-    def forward_one(self, c: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def cos_sin_one(self, q: np.ndarray, base: np.ndarray) -> np.ndarray:
+        """Per joint ``[cos x, cos y, cos z, sin x, sin y, sin z, 1]`` for one pose, flattened.
+
+        Parameters
+        ----------
+        q : numpy.ndarray, shape (V,)
+            The variables, radians.
+        base : numpy.ndarray, shape (n_joints * 7,)
+            The same of the start angles (:meth:`cos_sin_base`): the axes
+            that are not variables keep them.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n_joints * 7,)
+        """
+        cs = base.copy()
+        cs[self._cos_at] = np.cos(q)
+        cs[self._sin_at] = np.sin(q)
+        return cs
+
+    @staticmethod
+    def cos_sin_base(angles: np.ndarray) -> np.ndarray:
+        """:meth:`cos_sin_one`'s layout for all the angles ``(n_joints, 3)`` (radians), flattened."""
+        return np.concatenate((np.cos(angles), np.sin(angles), np.ones((angles.shape[0], 1))), axis=1).ravel()
+
+    def forward_one(self, cs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`forward_trig` and :meth:`axes_trig` for one pose, as 4x4 link transforms.
 
         Parameters
         ----------
-        c, s : numpy.ndarray, shape (n_joints, 3)
-            Cosines and sines of the angles.
+        cs : numpy.ndarray, shape (n_joints * 7,)
+            From :meth:`cos_sin_one`.
 
         Returns
         -------
@@ -458,32 +509,39 @@ class IKModel:
         A single solve calls this once an iteration on arrays of a few
         entries, where the cost is the number of numpy calls, not their
         size.  Every entry of ``Rz Ry Rx`` and of the three local axes is a
-        signed sum of products of at most three cosines and sines, so one
-        gather, two products and one matrix product (:data:`_TERMS`,
-        :data:`_TERM_SUMS`) give them all, exactly as the formulas written
-        out in :meth:`forward_trig` do (the sums only add zeros and flip
-        signs).
+        signed sum of products of at most three cosines and sines
+        (:data:`_TERMS`, :data:`_TERM_SUMS`), so one gather, two products
+        and one batched product with per-joint matrices give every joint's
+        4x4 transform (locations and reversal folded in) and local axes.
+        The same values as :meth:`forward_trig` and :meth:`axes_trig` up to
+        rounding.
         """
         fig = self.figure
-        cs = np.concatenate((c, s, np.ones((c.shape[0], 1))), axis=1)  # (J, 7)
-        t = cs[:, _TERMS[0]] * cs[:, _TERMS[1]] * cs[:, _TERMS[2]]
-        e = t @ _TERM_SUMS  # (J, 18): R row-major, then the X, Y and Z axes
-        R9 = e[:, :9]
-        if self._any_reversed:
-            R9 = np.where(self._rev[:, None], R9[:, self._half_turn], R9)
-        T = self._T_one.copy()
-        Rj = R9.reshape(-1, 3, 3)
-        T[:, :3, :3] = Rj
-        T[:, :3, 3] = self._near - (Rj @ self._far[:, :, None])[:, :, 0]
+        J = fig.n_joints
+        ia, ib, ic = self._term_index
+        t = cs[ia] * cs[ib] * cs[ic]  # (J, 16)
+        e = np.matmul(t[:, None, :], self._term_maps)[:, 0]  # (J, 25)
+        T = e[:, :16].reshape(J, 4, 4)
         X = np.empty((fig.n_links, 4, 4))
-        X[fig.main] = np.eye(4)
-        for joints, parents, children in self._levels:
-            if isinstance(joints, int):
-                np.matmul(X[parents], T[joints], out=X[children])
-            else:
-                X[children] = X[parents] @ T[joints]
+        X[fig.main] = self._eye4
+        if self._chain is not None:
+            joints, children = self._chain
+            # Hillis-Steele scan: after the step of span d, P[k] is the
+            # product of T[k-2d+1 .. k] (clipped at 0), left to right.
+            P = T[joints]
+            d = 1
+            while d < J:
+                P[d:] = P[:-d] @ P[d:]
+                d *= 2
+            X[children] = P
+        else:
+            for joints, parents, children in self._levels:
+                if isinstance(joints, int):
+                    np.matmul(X[parents], T[joints], out=X[children])
+                else:
+                    X[children] = X[parents] @ T[joints]
         M = self._axis_pivot.copy()
-        M[:, :3, 0] = e[:, 9:].reshape(-1, 3, 3)[self.var_joint, self.var_axis]
+        M[:, :3, 0] = e[:, 16:].reshape(J, 3, 3)[self.var_joint, self.var_axis]
         op = X[self.var_primary] @ M  # (V, 4, 2)
         return X, op[:, :3, 0] * self.sign[:, None], op[:, :3, 1]
 

@@ -119,6 +119,8 @@ class _Problem:
         # (1 or B, J * 3): an unbatched start pose is shared, not copied B times.
         flat = base.reshape(base.shape[0], -1)
         self.base_cos, self.base_sin = np.cos(flat), np.sin(flat)
+        # For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint.
+        self.base_cs = model.cos_sin_base(base[0]) if base.shape[0] == 1 else None
         P = model.n_params
         V = model.n_vars
         self.lower = np.full(P, -np.inf)
@@ -151,8 +153,7 @@ class _Problem:
         model = self.model
         V = model.n_vars
         t = x[V:] * model.length if model.translate else None
-        c, s = model.trig(x[None, :V], self.base_cos, self.base_sin)
-        X, omega, pivot = model.forward_one(c[0], s[0])
+        X, omega, pivot = model.forward_one(model.cos_sin_one(x[:V], self.base_cs))
         return self.stack.evaluate_one(X, t, omega, pivot)
 
     def evaluate(self, idx, stack, x, jac=True):
