@@ -100,11 +100,16 @@ class Program:
         """Run every statement and every scene tick without drawing; return the warnings."""
         return self.execute("check", stdout=io.StringIO()).warnings
 
-    def render(self, out_dir: str, **options) -> "Runtime":
-        """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`)."""
+    def render(self, out_dir: str, checked: bool = False, **options) -> "Runtime":
+        """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`).
+
+        ``checked=True`` says the caller has just run :meth:`check` itself
+        (the command line does, to show its warnings first), so it is not run twice.
+        """
         from .render import Renderer
 
-        self.check()
+        if not checked:
+            self.check()
         renderer = Renderer(out_dir, **options)
         try:
             rt = self.execute("render", renderer=renderer, stdout=options.get("stdout"))

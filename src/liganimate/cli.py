@@ -62,7 +62,7 @@ def _render(program, warnings, args, stem: str) -> int:
     _print_diagnostics(warnings)
     warnings_run = program.check()
     _print_diagnostics(warnings_run)
-    program.render(out, size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps,
+    program.render(out, checked=True, size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps,
                    quiet=args.quiet)
     if not args.quiet:
         sys.stderr.write(f"frames written to {out}\n")
