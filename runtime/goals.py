@@ -20,6 +20,7 @@ once.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -189,6 +190,9 @@ def _unit(v: np.ndarray, what: str) -> np.ndarray:
 
 
 def _weights(value, what: str) -> np.ndarray:
+    if type(value) is float and 0.0 <= value < math.inf:
+        # The usual case, checked without numpy's calls (a single solve pays for each).
+        return np.array(value)
     try:
         w = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -238,9 +242,10 @@ def batch_size(goals: Sequence[Goal]) -> int | None:
     return sizes.pop() if sizes else None
 
 
-# Cross products by index permutation: (a x b)_i = a_P1 b_P2 - a_P2 b_P1.
-_P1 = np.array([1, 2, 0])
-_P2 = np.array([2, 0, 1])
+# (a x b)_i = eps_ijk a_j b_k.
+_LEVI_CIVITA = np.zeros((3, 3, 3))
+_LEVI_CIVITA[0, 1, 2] = _LEVI_CIVITA[1, 2, 0] = _LEVI_CIVITA[2, 0, 1] = 1.0
+_LEVI_CIVITA[0, 2, 1] = _LEVI_CIVITA[2, 1, 0] = _LEVI_CIVITA[1, 0, 2] = -1.0
 
 
 class GoalStack:
@@ -280,8 +285,7 @@ class GoalStack:
         pts = {"link": [], "local": [], "target": [], "w": [], "index": []}
         pls = {"link": [], "local": [], "origin": [], "normal": [], "w": [], "index": []}
         axs = {"link": [], "local": [], "dir": [], "ell": [], "w": [], "index": []}
-        positive = model.lengths[model.lengths > 0]
-        mean_length = float(positive.mean()) if positive.size else model.length
+        mean_length = None  # only axis goals need it
         for i, g in enumerate(self.goals):
             if not isinstance(g, (PointGoal, PlaneGoal, AxisGoal)):
                 raise GoalError(f"goal {i + 1} is not a point, plane or axis goal.")
@@ -298,6 +302,9 @@ class GoalStack:
                 axs["local"].append(_unit(a, f"the axis of {what}") * np.sign(scale[link]))
                 axs["dir"].append(np.broadcast_to(_unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)))
                 ell = model.lengths[link]
+                if mean_length is None:
+                    positive = model.lengths[model.lengths > 0]
+                    mean_length = float(positive.mean()) if positive.size else model.length
                 axs["ell"].append(ell if ell > 0 else mean_length)
                 d = axs
             else:
@@ -347,12 +354,14 @@ class GoalStack:
         self._active_packed = wn > 0
         rows_per_goal = np.array([3] * G + [1] * Q + [3] * H, dtype=np.intp)
         self.row_weight = np.repeat(np.sqrt(wn), rows_per_goal, axis=1)  # (B, M)
-        self._downstream_p = model.downstream[:, self.p_link].T.astype(float)  # (G, V)
-        self._downstream_q = model.downstream[:, self.q_link].T.astype(float)
-        self._downstream_h = model.downstream[:, self.h_link].T.astype(float)
+        moved_by = model.moved_by  # (n_links, V), as floats
+        self._downstream_p = moved_by[self.p_link]  # (G, V)
+        self._downstream_q = moved_by[self.q_link]
+        self._downstream_h = moved_by[self.h_link]
         # For evaluate_one: point goals only (then the packed order is the
         # user's), and their link points in homogeneous coordinates.
         self._points_only = Q == 0 and H == 0
+        self._unit_rows = B == 1 and bool(np.all(self.row_weight == 1.0))
         self._p_local_h = np.concatenate((self.p_local, np.ones((G, 1))), axis=1)[:, :, None]
 
     # ------------------------------------------------------------ batches
@@ -513,20 +522,26 @@ class GoalStack:
         y = (X[self.p_link] @ self._p_local_h)[:, :3, 0]  # (G, 3), model frame
         res = m.to_world(y[None], None if t is None else t[None])[0] - self.p_target[0]
         d = y[:, None, :] - c  # (G, V, 3)
-        # omega x d, written with index permutations: two gathers per factor
-        # cost less than cross3's six views and a stack on arrays this small.
-        v = (omega[:, _P1] * d[..., _P2] - omega[:, _P2] * d[..., _P1]) * self._downstream_p[:, :, None]
-        v = m.to_world_vectors(v)
+        # omega x d, straight into the Jacobian's (G, 3, V) layout: one
+        # einsum with the Levi-Civita symbol costs less than cross3's views
+        # and stack on arrays this small (and adds the same two products).
+        v = np.einsum("ijk,vj,gvk->giv", _LEVI_CIVITA, omega, d) * self._downstream_p[:, None, :]
+        if not m.placement_is_identity:
+            v = np.einsum("ij,gjv->giv", m.A, v)
         G = len(self.p_link)
-        w = self.row_weight[0]
         if m.translate:
             jac = np.zeros((G, 3, m.n_params))
-            jac[..., :V] = v.transpose(0, 2, 1)
+            jac[..., :V] = v
             jac[..., V:] = np.eye(3) * m.length
             jac = jac.reshape(3 * G, -1)
         else:
-            jac = v.transpose(0, 2, 1).reshape(3 * G, V)
-        return res.reshape(-1) * w, jac * w[:, None], np.sqrt((res * res).sum(axis=1))
+            jac = v.reshape(3 * G, V)
+        r = res.reshape(-1)
+        dist = np.sqrt((res * res).sum(axis=1))
+        if self._unit_rows:
+            return r, jac, dist  # every weight the largest: multiplying by 1 changes nothing
+        w = self.row_weight[0]
+        return r * w, jac * w[:, None], dist
 
     def _point_jacobian(self, y, omega, c, down):
         """World velocity of link points per radian of each variable, shape (B, N, 3, V)."""

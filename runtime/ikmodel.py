@@ -242,6 +242,8 @@ class IKModel:
         self.lower = np.where(free, -np.inf, np.deg2rad(lo[self.var_joint, self.var_axis]) if V else 0.0)
         self.upper = np.where(free, np.inf, np.deg2rad(hi[self.var_joint, self.var_axis]) if V else 0.0)
         self.downstream = moves[self.var_joint] if V else np.zeros((0, figure.n_links), dtype=bool)
+        # Per link, 1.0 for each variable that moves it: the goals' Jacobian masks.
+        self.moved_by = self.downstream.T.astype(float)
         self.sign = np.where(rev[self.var_joint], -1.0, 1.0) if V else np.zeros(0)
         self.var_primary = np.array([figure.joints[k].primary for k in vj], dtype=np.intp)
         loc1, loc2 = figure.locations

@@ -554,8 +554,9 @@ def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts:
     all_active = bool(active.all())
 
     def converged(dist):
-        ok = dist <= tol
-        return bool(ok.all() if all_active else (ok | ~active).all())
+        if all_active:
+            return bool(dist.max(initial=0.0) <= tol)
+        return bool(((dist <= tol) | ~active).all())
 
     def reset(J):
         # The first damping: a fraction of the largest curvature (see _dls).
@@ -580,27 +581,40 @@ def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts:
     curv, mu, nu = reset(J)
     if status == RUNNING and curv == 0.0:
         status = STALLED
-    eye = np.eye(min(r.size, P))
+    small = r.size < P
+    diagonal = slice(None, None, min(r.size, P) + 1)  # of the flattened normal matrix
 
     while status == RUNNING:
-        # Hold variables at a limit the descent direction, then the step, pushes against.
-        g = J.T @ r
-        free = ~(((x <= lower) & (g > 0)) | ((x >= upper) & (g < 0)))
+        # Hold variables at a limit the descent direction, then the step,
+        # pushes against.  Only a variable at a limit can be held, so while
+        # none is (most iterations) there is nothing to check.
+        at_lower, at_upper = x <= lower, x >= upper
+        at_limit = bool(at_lower.any() or at_upper.any())
+        if at_limit:
+            g = J.T @ r
+            free = ~((at_lower & (g > 0)) | (at_upper & (g < 0)))
         for _pass in range(3):
-            Jf = J * free
-            if r.size < P:
-                y = np.linalg.solve(Jf @ Jf.T + mu * eye, -r)
-                dx = Jf.T @ y
+            Jf = J * free if at_limit else J
+            if small:
+                A = Jf @ Jf.T
+                A.flat[diagonal] += mu
+                dx = Jf.T @ np.linalg.solve(A, -r)
             else:
-                dx = -np.linalg.solve(Jf.T @ Jf + mu * eye, Jf.T @ r)
-            out = (((x <= lower) & (dx < 0)) | ((x >= upper) & (dx > 0))) & free
+                A = Jf.T @ Jf
+                A.flat[diagonal] += mu
+                dx = -np.linalg.solve(A, Jf.T @ r)
+            if not at_limit:
+                break
+            out = ((at_lower & (dx < 0)) | (at_upper & (dx > 0))) & free
             if not out.any():
                 break
             free &= ~out
         big = float(np.abs(dx[:V]).max(initial=0.0))
         if big > MAXSTEP:
             dx = dx * (MAXSTEP / big)
-        dx = np.clip(x + np.where(free, dx, 0.0), lower, upper) - x
+        # The projection (np.minimum/maximum: np.clip's wrapper costs more than the clipping).
+        xn = x + (np.where(free, dx, 0.0) if at_limit else dx)
+        dx = np.minimum(np.maximum(xn, lower), upper) - x
         xn = x + dx
         rn, Jn, dn = evaluate(xn)
         fn = 0.5 * float(rn @ rn)
