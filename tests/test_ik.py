@@ -480,6 +480,75 @@ def test_restarts_find_poses_the_start_cannot_and_leave_unreachable_goals_alone(
     np.testing.assert_array_equal(solve_pose(fig, far).angles, solve_pose(fig, far, restarts=3).angles)
 
 
+# ------------------------------------------------------------------ single solves
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_one_pose_evaluation_equals_the_batched_one(seed):
+    """The single solve's kinematics and goals (IKModel.forward_one, GoalStack.evaluate_one) against
+    the batched ones: trees with random main links, chains, placements, translation, every goal kind."""
+    from liganimate.runtime import solvers as S
+
+    rng = np.random.default_rng(seed)
+    fig = random_tree(rng, int(rng.integers(2, 9))) if seed % 3 else chain(int(rng.integers(1, 8)))
+    if seed % 2:
+        Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        P = np.eye(4)
+        P[:3, :3] = 1.7 * Q
+        P[:3, 3] = rng.normal(size=3)
+        fig = fig.with_placement(P)
+    translate = seed % 4 == 1
+    model = IKModel(fig, rng.uniform(size=(fig.n_joints, 3)) < 0.7, translate=translate)
+    link = lambda: int(rng.integers(fig.n_links))  # noqa: E731
+    for kinds in ("point", "points", "all"):
+        goals = [PointGoal(link(), rng.normal(size=3), point=rng.normal(size=3), weight=2.0)]
+        if kinds != "point":
+            goals.append(PointGoal(link(), rng.normal(size=3), weight=0.5))
+        if kinds == "all":
+            goals += [PlaneGoal(link(), rng.normal(size=3), rng.normal(size=3), point=rng.normal(size=3)),
+                      AxisGoal(link(), rng.normal(size=3), rng.normal(size=3), weight=0.7)]
+        stack = GoalStack(model, goals, 1)
+        base = rng.uniform(-2.5, 2.5, size=(1, fig.n_joints, 3))
+        prob = S._Problem(model, stack, base)
+        x = np.concatenate([base.reshape(-1)[model.var_flat], rng.normal(size=3) if translate else []])
+        one = prob.one(x)
+        batched = prob.evaluate(np.zeros(1, dtype=np.intp), stack, x[None])
+        for a, b in zip(one, batched):
+            np.testing.assert_allclose(a, b[0], rtol=0, atol=1e-13)
+
+
+def test_single_dls_solves_take_the_batched_loops_steps(monkeypatch):
+    """A batch of one runs its own loop (solvers._dls_one); with restarts, given-up attempts,
+    iteration limits and unreachable goals it ends where the batched loop ends a batch of one."""
+    from liganimate.runtime import solvers as S
+
+    def batched_loop(prob, x, tol, max_iter, restarts, seed, trace):
+        st = S._State(prob, x[None].copy(), tol, trace, jac=True, max_iter=max_iter, restarts=restarts, seed=seed)
+        S._dls(prob, st)
+        return st.finish()
+
+    fig = bench_chain(10)
+    rng = np.random.default_rng(3)
+    lo, hi = fig.extremes[..., 0], fig.extremes[..., 1]
+    targets = tip(fig, rng.uniform(lo, hi, size=(60, 10, 3)), 10, (0, 0.1, 0))
+    targets[::4] *= 3.0  # some out of reach
+    fast = S._dls_one
+    options = [dict(tolerance=1e-4, max_iterations=30, restarts=3), dict(tolerance=1e-4, restarts=1, trace=True),
+               dict(tolerance=1e-4, max_iterations=12, restarts=2)]
+    restarted = 0
+    for opts in options:
+        for t in targets:
+            goals = [PointGoal(10, t, point=(0, 0.1, 0))]
+            monkeypatch.setattr(S, "_dls_one", fast)
+            a = solve_pose(fig, goals, **opts)
+            monkeypatch.setattr(S, "_dls_one", batched_loop)
+            b = solve_pose(fig, goals, **opts)
+            assert (a.status, a.iterations, len(a.history)) == (b.status, b.iterations, len(b.history))
+            np.testing.assert_allclose(a.angles, b.angles, atol=1e-6)
+            restarted += a.iterations != solve_pose(fig, goals, **{**opts, "restarts": 0}).iterations
+    assert restarted > 0, "restarts were exercised"
+
+
 # ------------------------------------------------------------------ errors
 
 
