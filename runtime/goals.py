@@ -204,6 +204,17 @@ def _weights(value, what: str) -> np.ndarray:
     return w
 
 
+def _batched(v: np.ndarray, shape: tuple) -> np.ndarray:
+    """``np.broadcast_to(v, shape)``; an unbatched value for a batch of one is only given its axis.
+
+    A single solve builds its goals on every call, and broadcast_to's
+    checks cost more than the rest of a goal's packing.
+    """
+    if shape[0] == 1 and v.ndim == len(shape) - 1:
+        return v[None]
+    return np.broadcast_to(v, shape)
+
+
 def batch_size(goals: Sequence[Goal]) -> int | None:
     """The batch size the goals' data imply (None when nothing is batched).
 
@@ -293,14 +304,14 @@ class GoalStack:
             link, warning = resolve_link(model.figure, g.link)
             if warning:
                 self.warnings.append(f"{what}: {warning}")
-            w = np.broadcast_to(_weights(g.weight, f"the weight of {what}"), (B,))
+            w = _batched(_weights(g.weight, f"the weight of {what}"), (B,))
             if isinstance(g, AxisGoal):
                 a = _vectors(g.axis, f"the axis of {what}", None)
                 if a.ndim != 1:
                     raise GoalError(f"the axis of {what} is a direction in the link and cannot be batched.")
                 # A mirrored link (negative scale) turns its own directions round.
                 axs["local"].append(_unit(a, f"the axis of {what}") * np.sign(scale[link]))
-                axs["dir"].append(np.broadcast_to(_unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)))
+                axs["dir"].append(_batched(_unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)))
                 ell = model.lengths[link]
                 if mean_length is None:
                     positive = model.lengths[model.lengths > 0]
@@ -313,11 +324,11 @@ class GoalStack:
                     raise GoalError(f"the link point of {what} cannot be batched.")
                 local = point * scale[link]  # shape coordinates to link frame
                 if isinstance(g, PointGoal):
-                    pts["target"].append(np.broadcast_to(_vectors(g.target, f"the target of {what}", B), (B, 3)))
+                    pts["target"].append(_batched(_vectors(g.target, f"the target of {what}", B), (B, 3)))
                     d = pts
                 else:
-                    pls["origin"].append(np.broadcast_to(_vectors(g.origin, f"the plane point of {what}", B), (B, 3)))
-                    pls["normal"].append(np.broadcast_to(_unit(_vectors(g.normal, f"the plane normal of {what}", B), f"the plane normal of {what}"), (B, 3)))
+                    pls["origin"].append(_batched(_vectors(g.origin, f"the plane point of {what}", B), (B, 3)))
+                    pls["normal"].append(_batched(_unit(_vectors(g.normal, f"the plane normal of {what}", B), f"the plane normal of {what}"), (B, 3)))
                     d = pls
                 d["local"].append(local)
             d["link"].append(link)

@@ -328,7 +328,7 @@ def solve_pose(
     batched = B_goals is not None or B_start is not None
     B = B_goals or B_start or 1
     base = np.deg2rad(start_deg).reshape(B_start or 1, figure.n_joints, 3)  # (1 or B, J, 3)
-    start_deg = np.broadcast_to(start_deg, (B, figure.n_joints, 3))
+    start_deg = start_deg[None] if start_deg.ndim == 2 and B == 1 else np.broadcast_to(start_deg, (B, figure.n_joints, 3))
 
     model = IKModel.cached(figure, _movable_mask(figure, goals, movable), translate)
     stack = GoalStack(model, goals, B)
