@@ -84,6 +84,12 @@ def _guarded(fn):
         if exc.hint:
             sys.stderr.write(f"  hint: {exc.hint}\n")
         return EXIT_USER_ERROR
+    except BrokenPipeError:
+        # The reader went away (liganimate lib | head): not an error of ours.
+        # Point stdout at nothing so the interpreter's final flush stays quiet.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
     except OSError as exc:
         sys.stderr.write(f"liganimate: error: {exc.strerror or exc}: {exc.filename or ''}\n")
         return EXIT_USER_ERROR
