@@ -363,14 +363,17 @@ class _State:
             self.gave_up[check[hopeless]] = True
             self.fast_f[check] = self.f[check]
         ended = idx[(self.status[idx] == STALLED) | (self.status[idx] == LIMIT)]
-        again = ended[self.attempts_left[ended] > 0]
-        if again.size:
-            self._restart(again)
+        # Decide who resumes before restarting: an element that has just drawn
+        # its last restart has no restarts left either, but must run it.
+        back = ended[:0]
         if self.saved is not None:
             back = ended[(self.attempts_left[ended] == 0) & self.saved["mask"][ended]]
             back = back[self.saved["gave_up"][back] & ~self.resumed[back]]
-            if back.size:
-                self._resume(back)
+        again = ended[self.attempts_left[ended] > 0]
+        if again.size:
+            self._restart(again)
+        if back.size:
+            self._resume(back)
 
     _SAVED = ("x", "r", "f", "dist", "status", "attempt_iter", "window_f", "gave_up")
 
@@ -679,9 +682,8 @@ def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts:
                 curv, mu, nu = reset(J)
                 if status == RUNNING and curv == 0.0:
                     status = STALLED
-            if saved is not None and attempts_left == 0 and saved["gave_up"] and not resumed:
-                # Every restart used: take the first attempt up where it was given up.
-                # (As the batched loop does, this also happens right after the last restart is drawn.)
+            elif saved is not None and saved["gave_up"] and not resumed:
+                # Every restart used and ended: take the first attempt up where it was given up.
                 x, r, J, f, dist = saved["x"], saved["r"], saved["J"], saved["f"], saved["dist"]
                 attempt_iter, window_f, fast_f = saved["attempt_iter"], saved["window_f"], saved["fast_f"]
                 curv, mu, nu = saved["curv"], saved["mu"], saved["nu"]
