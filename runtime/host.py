@@ -496,21 +496,15 @@ class Runtime:
                     where = gat
             self.fail(where, _sentence(exc.message), exc.hint)
         sol = result.solution
-        for w in sol.warnings:
+        # Ambiguous link names, then unmet goals, in the solver's own words
+        # and by its own test of "met"; each is shown at its GOAL line.
+        for w in list(sol.warnings) + R.residual_warnings(fig, built, sol):
             m = re.match(r"goal (\d+): ", w)
             where = goals[int(m.group(1)) - 1][-1] if m and 0 < int(m.group(1)) <= len(goals) else at
-            self.warn(where, _sentence(w[m.end():] if m else w))
-        for i, ((kind, link, joint, *_r, gat), g) in enumerate(zip(goals, built)):
-            res = float(sol.residuals[i])
-            if float(sol.weights[i]) == 0:
-                continue
-            if kind == "axis":
-                if res > 0.01:
-                    self.warn(gat, f"this goal is missed: the axis ends {res:.3g} degrees from its direction",
-                              "the model cannot turn that far within its extremes, or other goals pull it away")
-            elif res > sol.tolerance:
-                self.warn(gat, f"this goal is missed by {res:.4g} (the tolerance is {sol.tolerance:.3g})",
-                          "the model cannot reach it within its extremes, or other goals pull it away")
+            hint = None
+            if m and w.rstrip(".").endswith(("target", "plane", "direction")):
+                hint = "the model cannot get there within its extremes, or other goals pull it away"
+            self.warn(where, _sentence(w[m.end():] if m else w), hint)
         t = np.asarray(result.translation, dtype=float).reshape(3)
         return result.motion, Vec(float(t[0]), float(t[1]), float(t[2]))
 
