@@ -15,24 +15,12 @@ The run is derandomized (the same cases every time) and takes about 15 s.
 
 from __future__ import annotations
 
-import importlib.util
-import os
-
 from hypothesis import HealthCheck, event, given, settings
-from hypothesis import strategies as st
+from mutations import SOURCES, example, fuzz, mutated, mutations
 
 from liganimate.lang.diagnostics import LigDiagnostics
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-_spec = importlib.util.spec_from_file_location("liganimate_fuzz_compile", os.path.join(ROOT, "benchmarks", "fuzz_compile.py"))
-fuzz = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(fuzz)
-
-SOURCES = fuzz.example_sources()
 EXAMPLES = 600
-
-unit = st.floats(min_value=0.0, max_value=1.0, exclude_max=True, allow_nan=False)
-mutation = st.tuples(st.sampled_from(fuzz.MUTATIONS), unit, unit, st.integers(0, 1 << 16))
 
 
 def test_the_examples_are_there_and_pass_unmutated():
@@ -65,15 +53,13 @@ def test_a_crash_is_reported_as_a_crash():
 
 @settings(max_examples=EXAMPLES, derandomize=True, deadline=None, database=None, print_blob=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
-@given(example=st.integers(0, len(SOURCES) - 1), mutations=st.lists(mutation, min_size=1, max_size=3))
-def test_mutated_programs_compile_or_are_diagnosed(example, mutations):
-    name, text = SOURCES[example]
-    for kind, u, v, pick in mutations:
-        text = fuzz.mutate(text, kind, u, v, pick)
+@given(index=example, steps=mutations)
+def test_mutated_programs_compile_or_are_diagnosed(index, steps):
+    name, text = mutated(index, steps)
     outcome, exc = fuzz.classify(text, limit=3.0)
     event(outcome)
     if outcome == "crash":
         raise AssertionError(
-            f"{name} mutated by {mutations} raised {type(exc).__name__}: {exc}\n--- program ---\n{text}"
+            f"{name} mutated by {steps} raised {type(exc).__name__}: {exc}\n--- program ---\n{text}"
         ) from exc
     assert outcome in ("ok", "diagnostics", "slow")

@@ -11,24 +11,17 @@ from __future__ import annotations
 
 import functools
 import re
-import importlib.util
 import os
 from importlib import resources
 
 from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 from lark import Lark
 from lark.exceptions import UnexpectedInput
 
 from liganimate.lang import parser as P
 from liganimate.lang.source import prepare
 from liganimate.lang.transform import ToAst
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-_spec = importlib.util.spec_from_file_location("liganimate_fuzz_compile_lexer", os.path.join(ROOT, "benchmarks", "fuzz_compile.py"))
-fuzz = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(fuzz)
-SOURCES = fuzz.example_sources()
+from mutations import ROOT, SOURCES, example, mutated, mutations
 
 
 @functools.lru_cache(maxsize=1)
@@ -92,15 +85,9 @@ def test_contextual_words_and_operators():
         assert outcome(P.build_parser(), text) == outcome(stock_parser(), text), text
 
 
-unit = st.floats(min_value=0.0, max_value=1.0, exclude_max=True, allow_nan=False)
-mutation = st.tuples(st.sampled_from(fuzz.MUTATIONS), unit, unit, st.integers(0, 1 << 16))
-
-
 @settings(max_examples=300, derandomize=True, deadline=None, database=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
-@given(example=st.integers(0, len(SOURCES) - 1), mutations=st.lists(mutation, min_size=1, max_size=3))
-def test_mutated_programs_agree(example, mutations):
-    name, text = SOURCES[example]
-    for kind, u, v, pick in mutations:
-        text = fuzz.mutate(text, kind, u, v, pick)
+@given(index=example, steps=mutations)
+def test_mutated_programs_agree(index, steps):
+    _, text = mutated(index, steps)
     assert outcome(P.build_parser(), text) == outcome(stock_parser(), text)
