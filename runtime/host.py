@@ -469,11 +469,14 @@ class Runtime:
             self.fail(at, f"the solved pose's frame cannot be negative ({frames:g})")
         built = []
         for kind, link, joint, point, target, normal, weight, gat in goals:
+            # The goal's link is settled here, so that an unknown or ambiguous
+            # name is reported at its own GOAL line.
             if link is None:
-                try:
-                    link = fig.joint(int(joint)).secondary
-                except LigError as exc:
-                    self.fail(gat, _sentence(exc.message), exc.hint)
+                link = self._guard(gat, fig.joint, int(joint)).secondary
+            else:
+                link, ambiguous = self._guard(gat, R.resolve_link, fig, link)
+                if ambiguous:
+                    self.warn(gat, _sentence(ambiguous))
             w = 1.0 if weight is None else float(weight)
             p = (0.0, 0.0, 0.0) if point is None else tuple(point)
             if kind == "point":
@@ -484,27 +487,18 @@ class Runtime:
                 built.append(R.AxisGoal(link, tuple(normal), tuple(target), w))
         if movable is not None:
             movable = list(movable[1]) if movable[0] == "joints" else int(movable[1])
-        try:
-            result = R.reach(fig, built, float(frames), method, start=start_motion, movable=movable,
-                             translate=bool(translate), solver=solver, tolerance=tolerance,
-                             max_iterations=iterations)
-        except LigError as exc:
-            # A goal's own problem (an unknown link, a zero normal) is shown at that goal.
-            where = at
-            for g, (_, link, *_rest, gat) in zip(built, goals):
-                if link is not None and str(link).upper() in exc.message.upper():
-                    where = gat
-            self.fail(where, _sentence(exc.message), exc.hint)
-        sol = result.solution
-        # Ambiguous link names, then unmet goals, in the solver's own words
-        # and by its own test of "met"; each is shown at its GOAL line.
-        for w in list(sol.warnings) + R.residual_warnings(fig, built, sol):
+        result = self._guard(at, lambda: R.reach(
+            fig, built, float(frames), method, start=start_motion, movable=movable, translate=bool(translate),
+            solver=solver, tolerance=tolerance, max_iterations=iterations))
+        # Unmet goals, in the solver's own words and by its own test of "met",
+        # each shown at its GOAL line.
+        for w in R.residual_warnings(fig, built, result.solution):
             m = re.match(r"goal (\d+): ", w)
-            where = goals[int(m.group(1)) - 1][-1] if m and 0 < int(m.group(1)) <= len(goals) else at
-            hint = None
-            if m and w.rstrip(".").endswith(("target", "plane", "direction")):
-                hint = "the model cannot get there within its extremes, or other goals pull it away"
-            self.warn(where, _sentence(w[m.end():] if m else w), hint)
+            if m is None:
+                self.warn(at, _sentence(w))
+                continue
+            self.warn(goals[int(m.group(1)) - 1][-1], _sentence(w[m.end():]),
+                      "the model cannot get there within its extremes, or other goals pull it away")
         t = np.asarray(result.translation, dtype=float).reshape(3)
         return result.motion, Vec(float(t[0]), float(t[1]), float(t[2]))
 
