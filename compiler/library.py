@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from liganimate import __version__
-from liganimate.lang.diagnostics import LigDiagnostics
 
 from . import types as T
 
@@ -303,7 +302,6 @@ __all__ = [
     "Library",
     "LibraryNotFound",
     "LibraryCycle",
-    "LigDiagnostics",
     "stdlib_dir",
     "stdlib_names",
     "resolve",

@@ -155,7 +155,6 @@ class LigLexer(Lexer):
         scan = _SCAN.match
         tables = self.tables
         choice = self._choice
-        length = len(text)
         while True:
             m = scan(text, pos)
             start = m.start(m.lastindex) if m and m.lastindex else -1
@@ -192,7 +191,7 @@ class LigLexer(Lexer):
                 key = (state, value)
                 ttype = choice.get(key)
                 if ttype is None:
-                    ttype, value, end = self._operator(text, start, parser_state)
+                    ttype, value, end = self._operator(value, start, parser_state)
             elif kind == "s":
                 ttype = "STRING"
             else:
@@ -202,8 +201,6 @@ class LigLexer(Lexer):
             lexer_state.last_token = tok
             yield tok
             pos = end
-            if pos > length:
-                return
 
     def _pick(self, candidates, parser_state, cache=None) -> str:
         acc = self._accepted(parser_state)
@@ -216,17 +213,20 @@ class LigLexer(Lexer):
             self._choice[cache] = c
         return c
 
-    def _operator(self, text: str, start: int, parser_state):
+    def _operator(self, greedy: str, start: int, parser_state):
+        """The token for the operator ``greedy`` (the longest spelling) at ``start``.
+
+        The longest spelling the state accepts wins; a choice for the whole
+        spelling is remembered for the state.
+        """
         acc = self._accepted(parser_state)
-        for width in (3, 2, 1):
-            spelling = text[start:start + width]
+        for width in range(len(greedy), 0, -1):
+            spelling = greedy[:width]
             for ttype in _OPERATORS.get(spelling, ()):
                 if ttype in acc:
-                    if width == len(_SCAN.match(text, start).group("o")):
+                    if width == len(greedy):
                         self._choice[(parser_state.position, spelling)] = ttype
                     return ttype, spelling, start + width
-        spelling = _SCAN.match(text, start).group("o")
-        return _OPERATORS[spelling][0], spelling, start + len(spelling)
-
+        return _OPERATORS[greedy][0], greedy, start + len(greedy)
 
 __all__ = ["LigLexer", "UnexpectedToken"]
