@@ -16,11 +16,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from liganimate.lang import ast as A
+from liganimate.lang import numbers
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
 from liganimate.runtime import interpolation
 
 from . import types as T
-from .primitives import Signature, builtin_signatures, signature_from_pattern
+from .primitives import builtin_signatures, signature_from_pattern
 
 MAX_ERRORS = 20
 # REACH solvers: the language's word -> the runtime's name (runtime/solvers.py).
@@ -128,6 +129,8 @@ class Checker:
         try:
             # First passes settle implicit types; the final pass reports.
             for p in prog.primitives:
+                if self.primitives.get(p.name.name, (None,))[0] is None:
+                    continue  # it has no pattern, which is already reported
                 scope = self._primitive_scope(p)
                 for _ in range(3):
                     self._check_scope(p.body, scope, primitive=p)
@@ -418,6 +421,8 @@ class Checker:
         pass
 
     def _s_Do(self, s, context):
+        if isinstance(s.label, numbers.BadLiteral):
+            self.err(s, f"the label {numbers.shown(s.label.text)} is too large", "a label is a small number such as 10")
         types = [self.expr(e) for e in (s.start, s.stop, s.step) if e is not None]
         for e, t in zip([e for e in (s.start, s.stop, s.step) if e is not None], types):
             if t is not None and not T.is_numeric(t):
@@ -440,7 +445,7 @@ class Checker:
         for j in s.joints:
             args = j.args
             self._joint_args(args, j, in_block=True)
-            if args and isinstance(args[0], A.Num) and isinstance(args[0].value, int):
+            if args and _const(args[0]) is not None and isinstance(args[0].value, int):
                 if args[0].value in ids:
                     self.err(args[0], f"joint {args[0].value} appears twice in model {s.name.name}",
                              f"the first is at line {ids[args[0].value].line}; joint identifiers must be unique")
@@ -495,7 +500,7 @@ class Checker:
         seen = {}
         for j in s.joints:
             self._want(j.joint, T.INTEGER, "a joint identifier")
-            if isinstance(j.joint, A.Num):
+            if _const(j.joint) is not None and isinstance(j.joint, A.Num):
                 if j.joint.value in seen:
                     self.err(j.joint, f"joint {j.joint.value} appears twice in motion {s.name.name}",
                              f"the first is at line {seen[j.joint.value].line}; put all its keyframes under one JOINT")
@@ -700,6 +705,9 @@ class Checker:
         return t
 
     def _e_Num(self, e):
+        problem = numbers.literal_problem(e.value)
+        if problem is not None:
+            self.err(e, *problem)
         return T.INTEGER if isinstance(e.value, int) else T.REAL
 
     def _e_Var(self, e):
@@ -916,10 +924,12 @@ def _plain_name(e):
 
 
 def _const(e):
-    if isinstance(e, A.Num):
+    """The value of a literal (or a negated one), or None; a literal out of range is reported elsewhere."""
+    if isinstance(e, A.Neg):
+        c = _const(e.operand) if isinstance(e.operand, A.Num) else None
+        return -c if c is not None else None
+    if isinstance(e, A.Num) and not isinstance(e.value, numbers.BadLiteral):
         return e.value
-    if isinstance(e, A.Neg) and isinstance(e.operand, A.Num):
-        return -e.operand.value
     return None
 
 

@@ -12,8 +12,10 @@ Python's keywords, builtins or the generated machinery.
 
 from __future__ import annotations
 
-from liganimate import __version__
 from liganimate.lang import ast as A
+from liganimate.lang import numbers as N
+
+from liganimate import __version__
 
 from . import types as T
 from .check import _SOLVERS, Checked
@@ -26,6 +28,13 @@ _ZERO = {
     T.MOTION: "rt.NO_MOTION",
     T.MODEL: "None",
 }
+
+# Inline range tests of + - * results (lang/numbers.py): a chained comparison,
+# false for NaN, costs a fraction of a call; only a result out of range calls
+# the runtime, which reports it at the operation.
+_BOUND = {T.INTEGER: repr(N.INT_MAX), T.REAL: repr(N.REAL_MAX)}
+_CHECKED = (T.INTEGER, T.REAL, T.VECTOR)
+_ARITH = ("+", "-", "*")
 
 _CMP = {"=": "==", "<>": "!=", "/=": "!=", "<": "<", ">": ">", "<=": "<=", ">=": ">="}
 
@@ -121,7 +130,6 @@ class Lowerer:
         self.emit(f"def _prim_{name}(rt, {', '.join(p + '=None' for p in params)}):")
         self.indent += 1
         self.emit(repr(f"PRIMITIVE {name}: {sig.usage()}."))
-        saved_types, saved_scope = self.c.types, None
         for p in params:
             self.emit(f"if {p} is None:")
             self.indent += 1
@@ -129,7 +137,10 @@ class Lowerer:
             if default is None:
                 self.emit(f"{p} = {_ZERO[scope.types.get(p, T.REAL)]}")
             else:
-                self.emit(f"{p} = {self.expr(default)}")
+                code = self.expr(default)
+                if scope.types.get(p) == T.REAL and not isinstance(default, tuple) and self.type_of(default) == T.INTEGER:
+                    code = f"float({code})"  # a REAL parameter holds a REAL
+                self.emit(f"{p} = {code}")
             self.indent -= 1
         for var, t in sorted(scope.types.items()):
             if var not in params:
@@ -190,7 +201,10 @@ class Lowerer:
 
     def s_Do(self, s, where):
         step = self.expr(s.step) if s.step is not None else "1"
-        self.emit(f"for {s.var.name} in rt.do_range({self.expr(s.start)}, {self.expr(s.stop)}, {step}, {self.at(s)}):")
+        start = self.expr(s.start)
+        if self.var_type(s.var.name) == T.REAL and self.type_of(s.start) == T.INTEGER:
+            start = f"float({start})"  # a REAL variable counts in REALs
+        self.emit(f"for {s.var.name} in rt.do_range({start}, {self.expr(s.stop)}, {step}, {self.at(s)}):")
         self.indent += 1
         self.block(s.body, where)
         self.indent -= 1
@@ -378,6 +392,24 @@ class Lowerer:
         return f"(-{self.expr(e.operand)})"
 
     def e_BinOp(self, e):
+        return self._binop(e, root=True)
+
+    def _binop(self, e, root: bool) -> str:
+        t = self.type_of(e)
+        if e.op in _ARITH and t in _CHECKED:
+            # A chain of + - * of one type is checked once, at its root: a
+            # REAL that overflows stays infinite or NaN through + - *, and
+            # INTEGER arithmetic inside an expression is exact (Python ints).
+            left, right = self._chained(e.left, t), self._chained(e.right, t)
+            text = f"{left} {e.op} {right}"
+            if not root:
+                return f"({text})"
+            single = not (_in_chain(e.left, t, self) or _in_chain(e.right, t, self))
+            kind = t + (e.op if single else "")
+            if t == T.VECTOR:
+                return f"rt.vector_ok({text}, {self.at(e)}, {kind!r})"
+            b = _BOUND[t]
+            return f"(_n if -{b} <= (_n := {text}) <= {b} else rt.overflow(_n, {kind!r}, {self.at(e)}))"
         left, right = self.expr(e.left), self.expr(e.right)
         if e.op == "/":
             return f"rt.div({left}, {right}, {self.at(e.op_pos)})"
@@ -388,6 +420,14 @@ class Lowerer:
         if e.op == "+" and self.type_of(e.left) == T.MOTION:
             return f"rt.concat({left}, {right}, {self.at(e)})"
         return f"({left} {e.op} {right})"
+
+    def _chained(self, e, t) -> str:
+        """An operand inside a checked chain of type ``t``: unchecked if it continues the chain."""
+        if isinstance(e, A.BinOp) and _in_chain(e, t, self):
+            return self._binop(e, root=False)
+        if isinstance(e, A.Neg) and _in_chain(e, t, self):
+            return f"(-{self._chained(e.operand, t)})"
+        return self.expr(e)
 
     def e_Call(self, e):
         args = "".join(self.expr(a) + ", " for a in e.args)
@@ -410,7 +450,11 @@ class Lowerer:
         args = []
         for slot in sig.slots:
             if slot.keyword in given:
-                args.append(f"{slot.param}={self.expr(given[slot.keyword])}")
+                value = given[slot.keyword]
+                code = self.expr(value)
+                if sig.param_types.get(slot.keyword) == T.REAL and self.type_of(value) == T.INTEGER:
+                    code = f"float({code})"  # a REAL parameter holds a REAL
+                args.append(f"{slot.param}={code}")
         pdef = self.c.primitives[e.name][0]
         own = pdef is not None or e.name in self.c.loaded_primitives
         fn = f"_prim_{e.name}" if own else f"rt.prim_{e.name}"
@@ -438,6 +482,15 @@ class Lowerer:
         if isinstance(c, A.Not):
             return f"(not {self.cond(c.operand)})"
         return f"({self.expr(c.left)} {_CMP[c.op]} {self.expr(c.right)})"
+
+
+def _in_chain(e, t, lowerer) -> bool:
+    """Does ``e`` continue a chain of + - * (through unary minus) of type ``t``?"""
+    if lowerer.type_of(e) != t:
+        return False
+    if isinstance(e, A.Neg):
+        return _in_chain(e.operand, t, lowerer)
+    return isinstance(e, A.BinOp) and e.op in _ARITH
 
 
 def _plain_name(e):

@@ -10,6 +10,7 @@ from __future__ import annotations
 from lark import Token, Transformer
 
 from . import ast as A
+from .numbers import literal
 
 
 def _tpos(tok: Token) -> A.Pos:
@@ -58,12 +59,9 @@ def _name(tok: Token) -> A.Name:
 
 
 def _number(tok: Token) -> A.Num:
-    text = tok.value.rstrip("°")
-    if any(ch in text for ch in ".eE"):
-        value = float(text)
-    else:
-        value = int(text)
-    return A.Num(_tpos(tok), value, tok.value)
+    # lang/numbers.py decides what a literal means; one outside the
+    # language's numbers comes back marked, and the checker reports it.
+    return A.Num(_tpos(tok), literal(tok.value.rstrip("°")), tok.value)
 
 
 class ToAst(Transformer):

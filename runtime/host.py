@@ -14,15 +14,14 @@ import io
 import math
 import re
 import sys
-from typing import Iterable
 
 import numpy as np
-
 from liganimate.lang.ast import Pos
-from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 
 from . import figure as F
 from . import motion as M
+from .arithmetic import Arithmetic
 from .errors import LigError
 from .library import Library  # noqa: F401  (generated modules name it _host.Library)
 from .values import EMPTY, ZERO, Canvas, Graphical, Vec, box
@@ -33,7 +32,7 @@ _StopProgram = type("_StopProgram", (Exception,), {})
 class Posed:
     """A model as ANIMATE hands it to the host for one tick: a figure, a motion and a frame."""
 
-    __slots__ = ("figure", "motion", "frame", "statement")
+    __slots__ = ("figure", "frame", "motion", "statement")
 
     def __init__(self, figure: F.Figure, motion: M.Motion, frame: float, statement: int):
         self.figure = figure
@@ -41,7 +40,7 @@ class Posed:
         self.frame = frame
         self.statement = statement
 
-    def with_figure(self, figure: F.Figure) -> "Posed":
+    def with_figure(self, figure: F.Figure) -> Posed:
         """The same pose on a changed figure (placement, main link...)."""
         return Posed(figure, self.motion, self.frame, self.statement)
 
@@ -53,7 +52,7 @@ class KeyframeEdits:
     so a DO loop writing n keyframes costs O(n), not O(n^2).
     """
 
-    __slots__ = ("base", "edit", "parent", "_cache")
+    __slots__ = ("_cache", "base", "edit", "parent")
 
     def __init__(self, base, edit, parent):
         self.base = base
@@ -83,7 +82,7 @@ class Program:
         self.main = main
         self.source = source
 
-    def execute(self, mode: str = "check", renderer=None, stdout=None) -> "Runtime":
+    def execute(self, mode: str = "check", renderer=None, stdout=None) -> Runtime:
         """Run the program; return the runtime, whose ``variables`` hold its final values."""
         rt = Runtime(self, mode, renderer, stdout)
         try:
@@ -100,7 +99,7 @@ class Program:
         """Run every statement and every scene tick without drawing; return the warnings."""
         return self.execute("check", stdout=io.StringIO()).warnings
 
-    def render(self, out_dir: str, checked: bool = False, **options) -> "Runtime":
+    def render(self, out_dir: str, checked: bool = False, **options) -> Runtime:
         """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`).
 
         ``checked=True`` says the caller has just run :meth:`check` itself
@@ -126,8 +125,8 @@ def main(program: Program, argv=None) -> int:
     return run_program_cli(program, argv)
 
 
-class Runtime:
-    """The ``rt`` object generated code calls."""
+class Runtime(Arithmetic):
+    """The ``rt`` object generated code calls (numbers and functions: :class:`~.arithmetic.Arithmetic`)."""
 
     ZERO = ZERO
     EMPTY = EMPTY
@@ -167,113 +166,6 @@ class Runtime:
             return fn(*args)
         except LigError as exc:
             self.fail(at, _sentence(exc.message), exc.hint)
-
-    # ------------------------------------------------------------- numbers
-    @staticmethod
-    def vec(x, y, z) -> Vec:
-        return Vec(x, y, z)
-
-    def div(self, a, b, at):
-        if isinstance(b, Vec):
-            self.fail(at, "cannot divide by a vector")
-        if b == 0:
-            self.fail(at, "division by zero", "check the divisor's value before dividing")
-        if isinstance(a, Vec):
-            return Vec(a[0] / b, a[1] / b, a[2] / b)
-        return a / b
-
-    def mod(self, a, b, at):
-        if b == 0:
-            self.fail(at, "MOD by zero")
-        # Floored, so angles wrap into [0, 360) even when negative.
-        r = a - b * math.floor(a / b)
-        return int(r) if isinstance(a, int) and isinstance(b, int) else r
-
-    def do_range(self, start, stop, step, at):
-        if step == 0:
-            self.fail(at, "a DO loop's step cannot be 0")
-        if all(isinstance(v, int) for v in (start, stop, step)):
-            return range(start, stop + (1 if step > 0 else -1), step)
-        count = max(0, int(math.floor((stop - start + step) / step + 1e-9)))
-        return [start + i * step for i in range(count)]
-
-    def _math(self, at, name, fn, x):
-        try:
-            return fn(x)
-        except (ValueError, OverflowError):
-            self.fail(at, f"{name} of {x:g} is not defined")
-
-    def f_SIN(self, x, at):
-        return math.sin(math.radians(x))
-
-    def f_COS(self, x, at):
-        return math.cos(math.radians(x))
-
-    def f_TAN(self, x, at):
-        return math.tan(math.radians(x))
-
-    def f_ASIN(self, x, at):
-        return math.degrees(self._math(at, "ASIN", math.asin, x))
-
-    def f_ACOS(self, x, at):
-        return math.degrees(self._math(at, "ACOS", math.acos, x))
-
-    def f_ATAN(self, x, at):
-        return math.degrees(math.atan(x))
-
-    def f_ATAN2(self, y, x, at):
-        return math.degrees(math.atan2(y, x))
-
-    def f_SQRT(self, x, at):
-        return self._math(at, "SQRT", math.sqrt, x)
-
-    def f_EXP(self, x, at):
-        return self._math(at, "EXP", math.exp, x)
-
-    def f_LOG(self, x, at):
-        return self._math(at, "LOG", math.log, x)
-
-    def f_ABS(self, x, at):
-        return abs(x)
-
-    def f_INT(self, x, at):
-        return int(x)
-
-    def f_NINT(self, x, at):
-        # FORTRAN's NINT, which the thesis' host language had: halves away from zero.
-        return int(math.copysign(math.floor(abs(x) + 0.5), x))
-
-    def f_REAL(self, x, at):
-        return float(x)
-
-    f_FLOAT = f_REAL
-
-    def f_MIN(self, a, b, at):
-        return min(a, b)
-
-    def f_MAX(self, a, b, at):
-        return max(a, b)
-
-    def f_MOD(self, a, b, at):
-        return self.mod(a, b, at)
-
-    def f_DOT(self, a, b, at):
-        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-    def f_CROSS(self, a, b, at):
-        return Vec(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-    def f_NORM(self, a, at):
-        return a.norm()
-
-    def f_X(self, a, at):
-        return a[0]
-
-    def f_Y(self, a, at):
-        return a[1]
-
-    def f_Z(self, a, at):
-        return a[2]
 
     def f_LEN(self, m, at):
         return float(self._motion(m, at).length)
@@ -395,7 +287,7 @@ class Runtime:
             return self._apply_edits(value, value.edit[5])
         return value
 
-    def for_program(self, program: "Program") -> "Runtime":
+    def for_program(self, program: Program) -> Runtime:
         """This runtime, reporting positions in ``program`` (a library's primitive runs with it)."""
         view = self.__dict__.get("_views", {}).get(id(program))
         if view is None:
