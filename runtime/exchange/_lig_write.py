@@ -1,0 +1,293 @@
+"""BVH import: a capture as a LIG library, a MODEL whose joints follow the BVH hierarchy and a MOTION.
+
+The model (``docs/exchange.md`` has the whole mapping):
+
+* its main link is ``ORIGIN``, an empty segment at the origin;
+* BVH joint number ``n`` (1-based, in the order the file lists them, ROOT
+  first) becomes ``JOINT n``: its secondary is a segment named after the BVH
+  joint, its primary the segment of the BVH parent (``ORIGIN`` for the
+  ROOT), at the BVH OFFSET (the ROOT at the origin); every axis is free,
+  extremes ``(-180, 180)``;
+* each segment is drawn as thin boxes from its joint to each child joint and
+  to its End Site.
+
+The motion has the captured frames as keyframes: frame ``f`` of the file is
+``FRAME f`` (frame 0 the starting position), LINEAR.  Rotation channels in
+the order ``Zrotation Yrotation Xrotation`` (or any part of it) are the
+joint convention ``Rz Ry Rx`` already and are copied; any other order is
+turned into a rotation matrix and back into ``Rz Ry Rx`` angles, exactly.
+The ROOT's position channels are its path, written as a table in a comment
+(see :func:`read_root_path`): motions hold angles only.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+
+import numpy as np
+from liganimate.compiler.types import BUILTINS
+
+from ._numbers import format_rows
+from ._rotations import euler_zyx_from_matrix, matrix_from_axes
+
+__all__ = ["ROOT_PATH_MARK", "clip_angles", "lig_library", "read_root_path"]
+
+ROOT_PATH_MARK = "ROOT PATH"
+DECIMALS = 7
+_RESERVED = set(BUILTINS) | {
+    "AND", "ANIMATE", "AXIS", "BACKGROUND", "BEGIN", "BY", "CONTINUE", "DO", "DRAW", "ELSE", "END", "ENDJOINT",
+    "ENDMODEL", "ENDMOTION", "ENDSCENE", "ENDREACH", "FIGURE", "FRAME", "FRAMES", "FROM", "IF", "INITIALIZE",
+    "INTERPOLATE", "INTERPOLATION", "JOINT", "JOINTS", "LENGTH", "LIGHTNESS", "LINK", "MAIN", "MODEL", "NOT", "OR",
+    "POINT", "POLY", "POSITION", "PRIMITIVE", "REPEAT", "RETURN", "ROT", "SAMEFRAME", "SCALE", "SCENE", "STARTMODEL",
+    "STARTMOTION", "STARTSCENE", "STARTREACH", "STOP", "STRIP", "THEN", "TO", "TRANS", "USING", "VIEW", "WIDTH",
+    "WITH", "REAL", "INTEGER", "VECTOR", "GRAPHICAL", "MOTION", "SHOOTSCENE", "SHOOTSCENES", "SYNCHRONIZE",
+    "SYNCHRONISE", "LOAD", "PRINT", "EXTREME", "EXTREMES", "GOAL", "WEIGHT", "NORMAL", "MOVE", "CHAIN", "TRANSLATE",
+    "INTO", "SOLVER", "TOLERANCE", "ITERATIONS", "ON", "PLANE", "ALONG", "AT", "HEIGHT", "DEPTH", "BOX", "ORIGIN",
+}
+
+
+def _identifier(name: str, taken: set) -> str:
+    """A LIG name for a BVH joint name: letters, digits and _, starting with a letter, unique, not a keyword."""
+    base = re.sub(r"[^A-Za-z0-9_]", "_", name).upper().strip("_") or "JOINT"
+    if not base[0].isalpha():
+        base = "J_" + base
+    if base in _RESERVED:
+        base += "_"
+    candidate, n = base, 1
+    while candidate in taken or candidate in _RESERVED:
+        n += 1
+        candidate = f"{base}_{n}"
+    taken.add(candidate)
+    return candidate
+
+
+def _subsequence(order: str, of: str = "ZYX") -> bool:
+    it = iter(of)
+    return all(ch in it for ch in order)
+
+
+def clip_angles(clip):
+    """The joint convention's angles, the root path and the rest offsets of a BVH clip.
+
+    Returns
+    -------
+    angles : ndarray, shape (F, J, 3)
+        ``(ax, ay, az)`` per frame and BVH joint, ``R = Rz Ry Rx`` equal to
+        the product of the joint's rotation channels in file order; each
+        axis unwrapped along the frames (no jumps of 360).
+    rotating : ndarray of bool, shape (J,)
+        Joints with rotation channels.
+    path : ndarray, shape (F, 3)
+        The ROOT's position: its position channels, or its OFFSET for the
+        components it has no channel for.
+    offsets : ndarray, shape (J, 3)
+        Each joint's offset from its parent; for joints with constant
+        position channels, those values.
+
+    Raises
+    ------
+    LigDiagnostics
+        When a joint other than the ROOT moves along position channels: a
+        LIG joint only turns.
+    """
+    F = clip.data.shape[0]
+    J = len(clip.names)
+    angles = np.zeros((F, J, 3))
+    rotating = np.zeros(J, dtype=bool)
+    offsets = clip.offsets.copy()
+    path = np.broadcast_to(clip.offsets[0], (F, 3)).copy()
+    size = _size(clip.parents, clip.offsets)
+    for j in range(J):
+        cols = clip.first[j] + np.arange(len(clip.channels[j]))
+        rot = [(c[0], col) for c, col in zip(clip.channels[j], cols) if c.endswith("rotation")]
+        pos = [("XYZ".index(c[0]), col) for c, col in zip(clip.channels[j], cols) if c.endswith("position")]
+        if rot:
+            rotating[j] = True
+            order = "".join(a for a, _ in rot)
+            values = clip.data[:, [col for _, col in rot]]
+            if _subsequence(order):
+                for (axis, _), n in zip(rot, range(len(rot))):
+                    angles[:, j, "XYZ".index(axis)] = values[:, n]
+            else:
+                angles[:, j] = euler_zyx_from_matrix(matrix_from_axes(order, values))
+        for axis, col in pos:
+            v = clip.data[:, col]
+            if j == 0:
+                path[:, axis] = v
+            elif np.ptp(v) > 1e-9 * size:
+                raise clip.error(
+                    clip.channel_pos[j],
+                    f"joint {clip.names[j]} moves along its {'XYZ'[axis]}position channel, but a LIG joint only turns",
+                    "liganimate imports the ROOT's translation only; fix the other joints' lengths in the capture",
+                )
+            else:
+                offsets[j, axis] = v[0]
+    angles = np.unwrap(angles, period=360.0, axis=0)
+    return angles, rotating, path, offsets
+
+
+def _size(parents, offsets) -> float:
+    """The skeleton's extent at rest (largest coordinate range of its joints), 1 if it has none."""
+    rest = np.zeros_like(offsets)
+    for j in range(1, len(parents)):
+        rest[j] = rest[parents[j]] + offsets[j]
+    ext = float(np.ptp(rest, axis=0).max()) if len(rest) else 0.0
+    return ext if ext > 0 else 1.0
+
+
+def _num(x: float) -> str:
+    x = float(x) + 0.0
+    return repr(x)
+
+
+def _bone(tip: np.ndarray, width: float) -> str:
+    """A BOX from the segment's origin to ``tip``: along +Y, turned about Z then Y onto the tip."""
+    length = float(np.linalg.norm(tip))
+    d = tip / length
+    alpha = -math.degrees(math.acos(max(-1.0, min(1.0, float(d[1])))))
+    h = math.hypot(float(d[0]), float(d[2]))
+    beta = math.degrees(math.atan2(-float(d[2]), float(d[0]))) if h > 1e-12 else 0.0
+    return (f"(BOX AT (0.0, {_num(length / 2)}, 0.0), WIDTH {_num(width)}, HEIGHT {_num(length)}, "
+            f"DEPTH {_num(width)}) <ROT Z {_num(alpha)}, ROT Y {_num(beta)}>")
+
+
+def _comment_text(text: str) -> str:
+    """Text safe inside a brace comment and on one line."""
+    return re.sub(r"[{}\x00-\x1f\x7f]", "?", text)
+
+
+def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_name: str | None = None) -> bytes:
+    """The text of a LIG library holding a BVH clip's skeleton as a MODEL and its frames as a MOTION.
+
+    Parameters
+    ----------
+    clip : BvhClip
+    model, motion : str
+        The variable names (valid LIG names, checked by the caller).
+    source_name : str, optional
+        The BVH file's name as the comments mention it.
+
+    Returns
+    -------
+    bytes
+        UTF-8 text that ``LOAD model, motion FROM 'file.lig'`` takes.
+    """
+    angles, rotating, path, offsets = clip_angles(clip)
+    F, J = angles.shape[:2]
+    src = _comment_text(source_name or os.path.basename(clip.filename))
+    taken = {model.upper(), motion.upper()}
+    links = [_identifier(n, taken) for n in clip.names]
+    size = _size(clip.parents, offsets)
+    fps = 1.0 / clip.frame_time
+    out = [
+        f"C {model}, {motion}: imported by liganimate from {src}",
+        f"C {J} joints, {F} frames at {fps:g} frames per second (frame time {clip.frame_time:g} s).",
+        "C",
+        "C The model's main link is ORIGIN, an empty segment at the origin. BVH joint n, in the",
+        "C order the file lists them (ROOT first), is JOINT n; its segment is named after it.",
+        "C Every axis of every joint is free, (-180, 180). Frame f of the file is FRAME f of the",
+        f"C motion (frame 0 is its starting position). Play it with ANIMATE ... USING {motion}; for",
+        "C real time render with --fps matching the capture.",
+        "C",
+        "C The ROOT's path is the table in the comment at the end: a MOTION holds joint angles",
+        "C only, so the figure turns as captured but does not travel (see docs/exchange.md).",
+        "C",
+        "C   joint  segment            BVH joint (channels)",
+    ]
+    for j in range(J):
+        out.append(f"C   {j + 1:<5}  {links[j]:<18} {_comment_text(clip.names[j])} ({' '.join(clip.channels[j]) or 'none'})")
+    out.append("")
+    out.append(f"{{@ {model}: the skeleton of {src}, {J} joints, every axis free }}")
+    out.append(f"{{@ {motion}: {F} frames of {src} at {fps:g} frames per second, one keyframe per frame }}")
+    out.append("")
+    out.append("      GRAPHICAL ORIGIN")
+    for k in range(0, J, 6):
+        out.append("      GRAPHICAL " + ", ".join(links[k:k + 6]))
+    out.append(f"      MODEL {model}")
+    out.append(f"      MOTION {motion}")
+    out.append("")
+    children: dict = {j: [] for j in range(J)}
+    for j in range(1, J):
+        children[int(clip.parents[j])].append(j)
+    for j in range(J):
+        tips = [offsets[c] for c in children[j]]
+        if clip.end_sites[j] is not None:
+            tips.append(clip.end_sites[j])
+        tips = [t for t in tips if np.linalg.norm(t) > 1e-9 * size]
+        if not tips:
+            continue
+        bones = [_bone(np.asarray(t, dtype=np.float64), 0.06 * float(np.linalg.norm(t)) + 0.01 * size) for t in tips]
+        out.append(f"      {links[j]} :- " + " +\n          ".join(bones))
+    out.append("")
+    out.append(f"      STARTMODEL {model}")
+    free = "(-180.0, 180.0), (-180.0, 180.0), (-180.0, 180.0)"
+    for j in range(J):
+        parent = "ORIGIN" if j == 0 else links[int(clip.parents[j])]
+        o = (0.0, 0.0, 0.0) if j == 0 else offsets[j]
+        out.append(f"        JOINT {j + 1}, {parent}, ({_num(o[0])}, {_num(o[1])}, {_num(o[2])}), "
+                   f"{links[j]}, (0.0, 0.0, 0.0), {free}")
+    out.append("      ENDMODEL")
+    out.append("")
+    head = ("\n".join(out) + "\n").encode("utf-8")
+    return head + _motion_text(motion, angles, rotating) + _path_table(path)
+
+
+def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray) -> bytes:
+    """STARTMOTION ... ENDMOTION with a keyframe per frame for every joint that moves."""
+    F, J = angles.shape[:2]
+    parts = [f"      STARTMOTION {name}\n".encode("ascii")]
+    moving = (angles != angles[:1]).any(axis=(0, 2)) if F > 1 else np.zeros(J, dtype=bool)
+    if F > 1 and not moving.any():
+        moving[0] = True  # keep the motion's length: one joint carries every frame
+    frames = np.arange(1, F, dtype=np.float64)
+    for j in range(J):
+        if not rotating[j] and not moving[j]:
+            continue
+        start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {j + 1} POSITION", suffix="\n")
+        parts.append(start)
+        if moving[j]:
+            table = np.column_stack([frames, angles[1:, j]])
+            parts.append(format_rows(table, [0, DECIMALS, DECIMALS, DECIMALS],
+                                     columns_prefix=["          FRAME", " POSITION", ",", ","], suffix="\n"))
+    parts.append(b"      ENDMOTION\n")
+    return b"".join(parts)
+
+
+def _path_table(path: np.ndarray) -> bytes:
+    """The ROOT's path as a comment: a header line, then ``frame x y z`` per frame."""
+    F = len(path)
+    head = (f"\n{{ {ROOT_PATH_MARK}: the BVH ROOT's position at each frame (frame, x, y, z). ANIMATE does not\n"
+            "  move a figure along it yet; liganimate.runtime.exchange.read_root_path reads it.\n")
+    table = np.column_stack([np.arange(F, dtype=np.float64), path])
+    return head.encode("ascii") + format_rows(table, [0, DECIMALS, DECIMALS, DECIMALS], prefix=" ") + b"}\n"
+
+
+def read_root_path(path: str) -> np.ndarray:
+    """The ROOT path table of a library written by ``liganimate import``.
+
+    Parameters
+    ----------
+    path : str
+        The ``.lig`` file.
+
+    Returns
+    -------
+    ndarray, shape (F, 3)
+        The root's position at frames 0 .. F-1.
+
+    Raises
+    ------
+    ValueError
+        If the file has no such table.
+    """
+    with open(path, encoding="utf-8") as fh:
+        text = fh.read()
+    at = text.find("{ " + ROOT_PATH_MARK + ":")
+    if at < 0:
+        raise ValueError(f"{path} has no {ROOT_PATH_MARK} table")
+    body = text[at:text.index("}", at)]
+    rows = body.split("\n")[2:]
+    table = np.array([[float(v) for v in r.split()] for r in rows if r.strip()], dtype=np.float64).reshape(-1, 4)
+    return table[np.argsort(table[:, 0], kind="stable"), 1:]
