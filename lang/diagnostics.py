@@ -8,10 +8,11 @@ Python traceback ever reaches the user.
 from __future__ import annotations
 
 import difflib
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Iterable, Optional
 
 from .ast import Pos
+from .display import at_end, escape_text, last_line, render_line, source_line
 
 
 @dataclass(slots=True)
@@ -21,9 +22,9 @@ class Diagnostic:
     filename: str
     pos: Pos
     message: str
-    hint: Optional[str] = None
+    hint: str | None = None
     severity: str = "error"
-    source: Optional[str] = None
+    source: str | None = None
     notes: list = field(default_factory=list)
 
 
@@ -45,7 +46,7 @@ def closest(name: str, candidates: Iterable[str], n: int = 3) -> list:
     return difflib.get_close_matches(name.upper(), sorted({c.upper() for c in candidates}), n=n, cutoff=0.6)
 
 
-def did_you_mean(name: str, candidates: Iterable[str]) -> Optional[str]:
+def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
     """A hint sentence naming the closest known names, or None."""
     near = closest(name, candidates)
     if not near:
@@ -56,22 +57,37 @@ def did_you_mean(name: str, candidates: Iterable[str]) -> Optional[str]:
 
 
 def format_diagnostic(d: Diagnostic, source: str | None = None) -> str:
-    """Render a diagnostic the way compilers do: location, sentence, line, caret, hint."""
+    """Render a diagnostic the way compilers do: location, sentence, line, caret, hint.
+
+    Everything program-derived (file name, message, source line, hint) is
+    escaped for the terminal (see :mod:`liganimate.lang.display`). A long
+    line is cut around the caret. A position at the end of the file (past
+    the last line, or on blank lines after it) shows the last line that is
+    not blank, with the caret just after its last character.
+    """
     src = d.source if d.source is not None else source
-    head = f"{d.filename}:{d.pos.line}:{d.pos.column}: {d.severity}: {d.message}"
+    head = f"{escape_text(d.filename)}:{d.pos.line}:{d.pos.column}: {d.severity}: {escape_text(d.message)}"
     lines = [head]
     if src is not None and d.pos.line >= 1:
-        text_lines = src.splitlines()
-        if d.pos.line <= len(text_lines):
-            line = text_lines[d.pos.line - 1].expandtabs(1)
-            lines.append(f"    {line}")
-            width = 1
-            if d.pos.end_line == d.pos.line and d.pos.end_column > d.pos.column:
-                width = d.pos.end_column - d.pos.column
-            width = max(1, min(width, max(1, len(line) - d.pos.column + 1)))
-            lines.append("    " + " " * max(0, d.pos.column - 1) + "^" + "~" * (width - 1))
+        lines.extend(_shown_source(src, d.pos))
     for note in d.notes:
-        lines.append(f"  note: {note}")
+        lines.append(f"  note: {escape_text(str(note))}")
     if d.hint:
-        lines.append(f"  hint: {d.hint}")
+        lines.append(f"  hint: {escape_text(d.hint)}")
     return "\n".join(lines)
+
+
+def _shown_source(src: str, pos: Pos) -> list:
+    """The source line and caret lines for ``pos`` (none for an empty source)."""
+    if at_end(src, pos.line):
+        last = last_line(src)
+        if last is None:
+            return []
+        shown, caret = render_line(last[1], len(last[1]) + 1)
+        return [f"    {shown}", f"    {caret} at the end of the file"]
+    line = source_line(src, pos.line)
+    width = 1
+    if pos.end_line == pos.line and pos.end_column > pos.column:
+        width = pos.end_column - pos.column
+    shown, caret = render_line(line, pos.column, width)
+    return [f"    {shown}", f"    {caret}"]

@@ -96,6 +96,7 @@ def _check_blocks(body: list, source) -> None:
 def _group_list(stmts: list, source) -> list:
     out: list = []
     open_dos: list = []  # (header, index in out where its body starts)
+    closed: dict = {}  # label -> (DO line, CONTINUE line) of the last loop it closed, for hints
     for stmt in stmts:
         _group_inner(stmt, source)
         if isinstance(stmt, A.DoHeader):
@@ -103,15 +104,20 @@ def _group_list(stmts: list, source) -> list:
             continue
         if isinstance(stmt, A.Continue):
             if not any(h.label == stmt.label for h, _ in open_dos):
+                if stmt.label in closed:
+                    do_line, end_line = closed[stmt.label]
+                    hint = (f"the DO {stmt.label} at line {do_line} was already closed "
+                            f"by the {stmt.label} CONTINUE at line {end_line}")
+                else:
+                    hint = f"a loop is opened with DO {stmt.label} var = first, last in the same block"
                 raise LigDiagnostics([Diagnostic(
-                    source.filename, stmt.pos,
-                    f"{stmt.label} CONTINUE closes no DO loop",
-                    f"a loop is opened with DO {stmt.label} var = first, last in the same block",
+                    source.filename, stmt.pos, f"{stmt.label} CONTINUE closes no DO loop", hint,
                     source=source.text,
                 )])
             # FORTRAN lets nested loops share one terminal label: close them all.
             while open_dos and open_dos[-1][0].label == stmt.label:
                 header, start = open_dos.pop()
+                closed[stmt.label] = (header.pos.line, stmt.pos.line)
                 loop = A.Do(header.pos, header.label, header.var, header.start, header.stop, header.step,
                             out[start:], stmt.pos)
                 del out[start:]
