@@ -15,11 +15,16 @@ the token is what the whole grammar would make of it, and the parser
 reports it as unexpected. Operators take the longest spelling the state
 accepts (``<=`` is RELOP in a condition but ``<`` then ``=`` in a modifier
 list).
+
+:class:`Scanner` does the work and yields light :class:`Tok` tuples to
+:mod:`liganimate.lang.lalr`'s loop; :class:`LigLexer` wraps it for Lark's
+own loop.
 """
 
 from __future__ import annotations
 
 import re
+from operator import itemgetter
 
 from lark import Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedToken
@@ -129,81 +134,123 @@ def _words_of(regex: str):
     return [o.upper() for o in options], lookahead
 
 
-class LigLexer(Lexer):
-    """A Lark lexer (``lexer=LigLexer``) that decides keywords by parser state."""
+class Tok(tuple):
+    """A token: a tuple with the attribute names of Lark's ``Token``.
 
-    __future_interface__ = 2
+    The parser makes millions of them for a big program, and a tuple is made
+    in C, where a Lark ``Token`` (a ``str`` with eight attributes set one by
+    one) costs several times as much. Tokens never outlive the parse: the
+    transformer turns them into positions and names.
+    """
 
-    def __init__(self, lexer_conf):
-        self.tables = GrammarTables(lexer_conf.terminals)
-        self.terminals_by_name = lexer_conf.terminals_by_name
+    __slots__ = ()
+    type = property(itemgetter(0))
+    value = property(itemgetter(1))
+    start_pos = property(itemgetter(2))
+    line = property(itemgetter(3))
+    column = property(itemgetter(4))
+    end_line = property(itemgetter(3))  # a token never spans lines
+    end_column = property(itemgetter(5))
+    end_pos = property(itemgetter(6))
+
+    def __repr__(self) -> str:
+        return f"Tok({self[0]!r}, {self[1]!r})"
+
+    def as_lark(self) -> Token:
+        """The same token as a Lark ``Token`` (for Lark's own parser and its exceptions)."""
+        return Token(self[0], self[1], self[2], self[3], self[4], self[3], self[5], self[6])
+
+
+_new_tok = tuple.__new__
+_NO_PRIMITIVES: frozenset = frozenset()
+
+
+class Scanner:
+    """Cuts text into :class:`Tok` tokens, asking the parser's state which terminal each word is.
+
+    ``states`` is the LALR table (state -> the symbols it accepts). The
+    parser shares its state stack with :meth:`tokens`, which reads the state
+    on top of it for each token, so the scanner always sees the state the
+    previous token left.
+    """
+
+    def __init__(self, terminals, states):
+        self.tables = GrammarTables(terminals)
+        self.states = states
         self._accepts: dict = {}  # parser state -> frozenset of terminal names
         self._choice: dict = {}  # (state, word or operator) -> token type
 
-    def _accepted(self, parser_state) -> frozenset:
-        state = parser_state.position
+    def accepted(self, state) -> frozenset:
+        """The symbols parser state ``state`` accepts."""
         acc = self._accepts.get(state)
         if acc is None:
-            acc = self._accepts[state] = frozenset(parser_state.parse_conf.parse_table.states[state])
+            acc = self._accepts[state] = frozenset(self.states[state])
         return acc
 
-    def lex(self, lexer_state, parser_state):
-        text = lexer_state.text
-        text = getattr(text, "text", text)  # Lark 1.3 hands over a TextSlice
+    def tokens(self, text: str, stack: list, primitives: frozenset = _NO_PRIMITIVES):
+        """Yield the tokens of ``text``; ``stack[-1]`` is the parser's state.
+
+        A NAME in ``primitives`` becomes PRIM_NAME (the post-lexer's rule,
+        done here when the caller has no post-lexer).
+        """
         pos = 0
         line, line_start = 1, 0
         scan = _SCAN.match
         tables = self.tables
+        contextual = tables.contextual
         choice = self._choice
+        count = text.count
         while True:
             m = scan(text, pos)
-            start = m.start(m.lastindex) if m and m.lastindex else -1
-            if m is None or start < 0:
+            if m is None or not m.lastindex:
                 # Nothing we know starts here: skip what can be skipped, report the character.
-                skipped = re.match(_SKIP, text[pos:]).end() + pos
-                line += text.count(_NEWLINE, pos, skipped)
+                skipped = re.compile(_SKIP).match(text, pos).end()
+                line += count(_NEWLINE, pos, skipped)
                 line_start = text.rfind(_NEWLINE, 0, skipped) + 1
                 raise UnexpectedCharacters(text, skipped, line, skipped - line_start + 1,
-                                           allowed=self._accepted(parser_state), state=parser_state)
-            nl = text.count(_NEWLINE, pos, start)
-            if nl:
-                line += nl
-                line_start = text.rfind(_NEWLINE, pos, start) + 1
+                                           allowed=self.accepted(stack[-1]))
+            start = m.start(m.lastindex)
+            if start != pos:
+                nl = count(_NEWLINE, pos, start)
+                if nl:
+                    line += nl
+                    line_start = text.rfind(_NEWLINE, pos, start) + 1
             kind = m.lastgroup
-            if kind == "end":
-                return
             end = m.end()
-            value = text[start:end]
-            state = parser_state.position
             if kind == "w":
+                value = text[start:end]
                 word = value.upper()
-                key = (state, word)
+                key = (stack[-1], word)
                 ttype = choice.get(key)
                 if ttype is None:
                     candidates = tables.word_candidates(word, text, end)
                     # A word such as MOTION may be a type or a variable depending on
                     # what follows it, so its choice is never remembered.
-                    ttype = self._pick(candidates, parser_state,
-                                       cache=None if word in tables.contextual else key)
+                    ttype = self._pick(candidates, stack[-1], cache=None if word in contextual else key)
+                if ttype == "NAME" and word in primitives:
+                    ttype = "PRIM_NAME"
             elif kind == "n":
+                value = text[start:end]
                 ttype = "NUMBER"
             elif kind == "o":
-                key = (state, value)
-                ttype = choice.get(key)
+                value = text[start:end]
+                ttype = choice.get((stack[-1], value))
                 if ttype is None:
-                    ttype, value, end = self._operator(value, start, parser_state)
+                    ttype, value, end = self._operator(value, start, stack[-1])
             elif kind == "s":
+                value = text[start:end]
                 ttype = "STRING"
-            else:
+            elif kind == "d":
+                value = text[start:end]
                 ttype = "DOLLAR_NAME"
+            else:
+                return
             column = start - line_start + 1
-            tok = Token(ttype, value, start, line, column, line, column + (end - start), end)
-            lexer_state.last_token = tok
-            yield tok
+            yield _new_tok(Tok, (ttype, value, start, line, column, column + end - start, end))
             pos = end
 
-    def _pick(self, candidates, parser_state, cache=None) -> str:
-        acc = self._accepted(parser_state)
+    def _pick(self, candidates, state, cache=None) -> str:
+        acc = self.accepted(state)
         for c in candidates:
             if c in acc:
                 break
@@ -213,20 +260,50 @@ class LigLexer(Lexer):
             self._choice[cache] = c
         return c
 
-    def _operator(self, greedy: str, start: int, parser_state):
+    def _operator(self, greedy: str, start: int, state):
         """The token for the operator ``greedy`` (the longest spelling) at ``start``.
 
         The longest spelling the state accepts wins; a choice for the whole
         spelling is remembered for the state.
         """
-        acc = self._accepted(parser_state)
+        acc = self.accepted(state)
         for width in range(len(greedy), 0, -1):
             spelling = greedy[:width]
             for ttype in _OPERATORS.get(spelling, ()):
                 if ttype in acc:
                     if width == len(greedy):
-                        self._choice[(parser_state.position, spelling)] = ttype
+                        self._choice[(state, spelling)] = ttype
                     return ttype, spelling, start + width
         return _OPERATORS[greedy][0], greedy, start + len(greedy)
 
-__all__ = ["LigLexer", "UnexpectedToken"]
+
+class LigLexer(Lexer):
+    """A Lark lexer (``lexer=LigLexer``) over :class:`Scanner`, for Lark's own LALR loop.
+
+    :func:`liganimate.lang.parser.parse` drives the scanner with its own
+    loop (:mod:`liganimate.lang.lalr`); this adapter keeps ``Lark.parse``
+    working with the same tokens, for tests and tools.
+    """
+
+    __future_interface__ = 2
+
+    def __init__(self, lexer_conf):
+        self.terminals = lexer_conf.terminals
+        self._scanner = None
+
+    def lex(self, lexer_state, parser_state):
+        text = lexer_state.text
+        text = getattr(text, "text", text)  # Lark 1.3 hands over a TextSlice
+        if self._scanner is None:
+            self._scanner = Scanner(self.terminals, parser_state.parse_conf.parse_table.states)
+        try:
+            for tok in self._scanner.tokens(text, parser_state.state_stack):
+                tok = tok.as_lark()
+                lexer_state.last_token = tok
+                yield tok
+        except UnexpectedCharacters as exc:
+            exc.state = parser_state
+            raise
+
+
+__all__ = ["LigLexer", "Scanner", "Tok", "UnexpectedToken"]

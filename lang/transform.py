@@ -10,15 +10,21 @@ from __future__ import annotations
 from lark import Token, Transformer
 
 from . import ast as A
+from .lexer import Tok
 from .numbers import literal
+
+#: What a terminal is in the children: our parser's Tok, or a Token from Lark's own loop.
+TOKENS = (Token, Tok)
 
 
 def _tpos(tok: Token) -> A.Pos:
+    if type(tok) is Tok:
+        return A.Pos(tok[3], tok[4], tok[3], tok[5])
     return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column)
 
 
 def _pos_of(x) -> A.Pos | None:
-    if isinstance(x, Token):
+    if isinstance(x, TOKENS):
         return _tpos(x)
     if isinstance(x, A.Node):
         return x.pos
@@ -42,6 +48,21 @@ def _last_pos_of(x) -> A.Pos | None:
 
 def span(children) -> A.Pos:
     """The span covering all positioned children."""
+    # The usual shapes first (a token or a node at each end), without
+    # making a position for each end only to join them.
+    if children:
+        first, last = children[0], children[-1]
+        if type(first) is Tok:
+            line, column = first[3], first[4]
+        elif isinstance(first, A.Node):
+            line, column = first.pos.line, first.pos.column
+        else:
+            line = None
+        if line is not None:
+            if type(last) is Tok:
+                return A.Pos(line, column, last[3], last[5])
+            if isinstance(last, A.Node):
+                return A.Pos(line, column, last.pos.end_line, last.pos.end_column)
     first = _pos_of(children)
     last = _last_pos_of(children)
     if first is None:
@@ -51,11 +72,26 @@ def span(children) -> A.Pos:
 
 def _nodes(children):
     """Children that are values (nodes or lists), dropping keyword tokens."""
-    return [c for c in children if not isinstance(c, Token)]
+    return [c for c in children if not isinstance(c, TOKENS)]
+
+
+#: One string per distinct upper-cased name: a million ``X = 1`` lines share one "X".
+_NAMES: dict = {}
+
+
+def upper_name(text: str) -> str:
+    """``text`` upper-cased, the same string object for every spelling of one name."""
+    name = _NAMES.get(text)
+    if name is None:
+        name = text.upper()
+        if len(_NAMES) < 1 << 16:  # a bound, for programs of endless distinct names
+            name = _NAMES.setdefault(name, name)
+            _NAMES[text] = name
+    return name
 
 
 def _name(tok: Token) -> A.Name:
-    return A.Name(_tpos(tok), tok.value.upper())
+    return A.Name(_tpos(tok), upper_name(tok.value))
 
 
 def _number(tok: Token) -> A.Num:
@@ -69,7 +105,7 @@ class ToAst(Transformer):
 
     # ------------------------------------------------------------ program
     def start(self, children):
-        return [c for c in children if not isinstance(c, Token)]
+        return [c for c in children if not isinstance(c, TOKENS)]
 
     def program_end(self, children):
         return A.ProgramEnd(span(children))
@@ -77,7 +113,7 @@ class ToAst(Transformer):
     # --------------------------------------------------------- statements
     def declaration(self, children):
         kw = children[0]
-        return A.Decl(span(children), kw.value.upper(), _nodes(children))
+        return A.Decl(span(children), upper_name(kw.value), _nodes(children))
 
     def decl_name(self, children):
         return _name(children[0])
@@ -109,10 +145,10 @@ class ToAst(Transformer):
             c = children[i]
             if isinstance(c, A.Name) and method is None and not items and start is None:
                 method = c
-            elif isinstance(c, Token) and c.type == "FROM":
+            elif isinstance(c, TOKENS) and c.type == "FROM":
                 start = children[i + 1]
                 i += 1
-            elif isinstance(c, tuple):
+            elif isinstance(c, tuple) and not isinstance(c, Tok):  # a reach item (a Tok is a tuple too)
                 items.append(c)
             i += 1
         block = A.ReachBlock(span(children), name, model, frames, method, start, [])
@@ -160,7 +196,7 @@ class ToAst(Transformer):
         return ("axis", None, children[3], children[1])
 
     def reach_move_joints(self, children):
-        return ("MOVE JOINTS", span(children), [c for c in children[2:] if not isinstance(c, Token)])
+        return ("MOVE JOINTS", span(children), [c for c in children[2:] if not isinstance(c, TOKENS)])
 
     def reach_move_chain(self, children):
         return ("MOVE CHAIN", span(children), children[2])
@@ -193,7 +229,7 @@ class ToAst(Transformer):
 
     def if_stmt(self, children):
         cond = children[1]
-        branches = [c for c in children[3:] if not isinstance(c, Token)]
+        branches = [c for c in children[3:] if not isinstance(c, TOKENS)]
         then = branches[0] if isinstance(branches[0], list) else [branches[0]]
         orelse = None
         if len(branches) > 1:
@@ -219,7 +255,7 @@ class ToAst(Transformer):
         i = 2
         while i < len(children):
             c = children[i]
-            if isinstance(c, Token) and c.type == "POSITION":
+            if isinstance(c, TOKENS) and c.type == "POSITION":
                 start = children[i + 1]
                 i += 2
                 continue
@@ -238,19 +274,19 @@ class ToAst(Transformer):
         return A.FigureStmt(span(children), model, "JOINT", joint=children[4])
 
     def scene_block(self, children):
-        at = next(i for i, c in enumerate(children) if isinstance(c, Token) and c.type == "STARTSCENE")
+        at = next(i for i, c in enumerate(children) if isinstance(c, TOKENS) and c.type == "STARTSCENE")
         init = _nodes(children[3:at])
         length = children[at + 2]
         rest = at + 3
         sameframe = None
-        if rest < len(children) and isinstance(children[rest], Token) and children[rest].type == "SAMEFRAME":
+        if rest < len(children) and isinstance(children[rest], TOKENS) and children[rest].type == "SAMEFRAME":
             sameframe = children[rest + 1]
             rest += 2
         body = _nodes(children[rest:])
         return A.Scene(span(children), children[2], init, length, sameframe, body, span(children[:3]))
 
     def animate_stmt(self, children):
-        repeat = isinstance(children[-1], Token) and children[-1].type == "REPEAT"
+        repeat = isinstance(children[-1], TOKENS) and children[-1].type == "REPEAT"
         return A.Animate(span(children), _name(children[1]), children[3], children[5], children[7], repeat)
 
     def background_stmt(self, children):
@@ -302,7 +338,7 @@ class ToAst(Transformer):
         name = _name(children[1])
         body, pattern = [], None
         for c in children[2:]:
-            if isinstance(c, Token):
+            if isinstance(c, TOKENS):
                 continue
             if isinstance(c, A.PatternDef):
                 pattern = c if pattern is None else pattern
@@ -312,7 +348,7 @@ class ToAst(Transformer):
         return A.PrimitiveDef(span(children), name, body, pattern)
 
     def pattern_def(self, children):
-        return A.PatternDef(span(children), children[0].value.upper(), children[1])
+        return A.PatternDef(span(children), upper_name(children[0].value), children[1])
 
     def pattern(self, children):
         return list(children)
@@ -323,7 +359,7 @@ class ToAst(Transformer):
 
     def pat_param(self, children):
         tok = children[0]
-        return A.PatParam(_tpos(tok), tok.value.upper())
+        return A.PatParam(_tpos(tok), upper_name(tok.value))
 
     def pat_optional(self, children):
         return A.PatOptional(span(children), children[0], list(children[1:]))
@@ -379,22 +415,22 @@ class ToAst(Transformer):
 
     def var(self, children):
         tok = children[0]
-        return A.Var(_tpos(tok), tok.value.upper())
+        return A.Var(_tpos(tok), upper_name(tok.value))
 
     def call(self, children):
         tok = children[0]
-        return A.Call(span(children), tok.value.upper(), list(children[1:]))
+        return A.Call(span(children), upper_name(tok.value), list(children[1:]))
 
     def tuple(self, children):
         return A.Tuple(span(children), list(children))
 
     def prim_call(self, children):
         tok = children[0]
-        return A.PrimCall(span(children), tok.value.upper(), list(children[1:]))
+        return A.PrimCall(span(children), upper_name(tok.value), list(children[1:]))
 
     def prim_clause(self, children):
         tok, value = children
-        return A.Clause(span(children), tok.value.upper(), value)
+        return A.Clause(span(children), upper_name(tok.value), value)
 
     def modlist(self, children):
         return list(children)
@@ -406,7 +442,7 @@ class ToAst(Transformer):
         return A.Modifier(span(children), "trans", children[1])
 
     def mod_rot(self, children):
-        return A.Modifier(span(children), "rot", children[2], children[1].value.upper())
+        return A.Modifier(span(children), "rot", children[2], upper_name(children[1].value))
 
     def mod_scale_model(self, children):
         return A.Modifier(span(children), "scale_model", children[2])
