@@ -1,26 +1,23 @@
 """Parsing: one cached LALR parser, syntax errors as diagnostics.
 
 :func:`parse` turns source text into a :class:`liganimate.lang.ast.Program`.
-The Lark parser is loaded once per process from tables shipped in the
-package (:mod:`.tables`); :mod:`.lalr` runs them with the transformer inside,
-and every Lark exception becomes a
-:class:`~liganimate.lang.diagnostics.LigDiagnostics`.
+The Lark parser is built once per process (and its tables cached on disk by
+Lark between processes), the transformer runs inside the parser, and every
+Lark exception becomes a :class:`~liganimate.lang.diagnostics.LigDiagnostics`.
 """
 
 from __future__ import annotations
 
 import contextvars
 import functools
-import gc
 import re
+from importlib import resources
 
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from . import ast as A
-from . import tables
 from .diagnostics import Diagnostic, LigDiagnostics
-from .lalr import Driver
 from .lexer import LigLexer
 from .source import Source, prepare
 from .structure import group_blocks
@@ -50,42 +47,31 @@ class _PrimitiveNames:
             yield tok
 
 
-def grammar_parts() -> tuple:
-    """The lexer class, post-lexer and transformer the parser is made with."""
-    return LigLexer, _PrimitiveNames(), ToAst()
-
-
 @functools.lru_cache(maxsize=1)
 def build_parser() -> Lark:
-    """The LALR parser with the AST transformer inside, once per process.
-
-    Its tables come from the package (lang/_tables.py, see
-    :mod:`liganimate.lang.tables`), never from a cache a user could write;
-    when they were not made from this lig.lark, from the grammar itself.
-    """
-    parts = grammar_parts()
-    return tables.load(*parts) or tables.build(*parts)
-
-
-@functools.lru_cache(maxsize=1)
-def _driver() -> Driver:
-    return Driver(build_parser())
+    """Build (once per process) the LALR parser with the AST transformer inside."""
+    grammar = resources.files("liganimate.lang").joinpath("lig.lark").read_text(encoding="utf-8")
+    return Lark(
+        grammar,
+        parser="lalr",
+        lexer=LigLexer,
+        postlex=_PrimitiveNames(),
+        transformer=ToAst(),
+        maybe_placeholders=False,
+        cache=True,
+    )
 
 
 def parse_source(source: Source, primitives: frozenset | set = frozenset()) -> A.Program:
     """Parse a prepared source; ``primitives`` are extra primitive names (e.g. from a library)."""
-    names = frozenset(set(BUILTIN_PRIMITIVES) | set(primitives) | source.primitive_names())
-    # The parse makes only trees, never cycles: the cyclic collector would
-    # walk the growing tree again and again for nothing.
-    collecting = gc.isenabled()
-    gc.disable()
+    names = set(BUILTIN_PRIMITIVES) | set(primitives) | source.primitive_names()
+    token = _primitive_names.set(frozenset(names))
     try:
-        body = _driver().parse(source.lexed, names)
+        body = build_parser().parse(source.lexed)
     except UnexpectedInput as exc:
         raise LigDiagnostics([_syntax_diagnostic(exc, source)]) from None
     finally:
-        if collecting:
-            gc.enable()
+        _primitive_names.reset(token)
     body = group_blocks(body, source)
     prims = [s for s in body if isinstance(s, A.PrimitiveDef)]
     return A.Program(A.Pos(1, 1, 1, 1), source.filename, source.text, body, prims)
@@ -98,6 +84,10 @@ def parse(text: str, filename: str = "<string>", primitives: frozenset | set = f
 
 # ------------------------------------------------------------ error messages
 
+# How the terminals the parser expects are named to the user. Keywords not
+# listed are named by their own spelling (see _terminal_text); the test
+# suite enumerates the grammar's terminals so that no internal name such as
+# __ANON_0 or $END can reach a message.
 _FRIENDLY = {
     "NAME": "a name",
     "PRIM_NAME": "a primitive such as BOX",
@@ -120,10 +110,14 @@ _FRIENDLY = {
     "STAR": "*",
     "DIV_OP": "/",
     "COLON": ":",
+    "__ANON_0": "::=",
     "TYPE_KW": "a type (REAL, INTEGER, VECTOR, GRAPHICAL, MODEL, MOTION)",
     "AXIS": "an axis X, Y or Z",
+    "AXIS_KW": "AXIS",
     "MODEL_KW": "MODEL",
     "WIDTH_KW": "WIDTH",
+    "WS": "a blank",
+    "BRACE_COMMENT": "a { comment }",
     "$END": "the end of the file",
 }
 
@@ -131,19 +125,32 @@ _EXPRESSION_STARTS = {"NAME", "NUMBER", "LPAR"}
 _STATEMENT_STARTS = {"TYPE_KW", "DO", "IF", "STARTMODEL", "STARTMOTION", "ANIMATE", "PRINT"}
 
 
+def _terminal_text(name: str) -> str:
+    """What the user would type (or a short description) for the terminal ``name``."""
+    friendly = _FRIENDLY.get(name)
+    if friendly is not None:
+        return friendly
+    term = build_parser().get_terminal(name) if name.isidentifier() else None
+    if term is not None and term.pattern.type == "str":
+        return term.pattern.value.upper()
+    if name.isalpha():
+        return name  # a keyword given by a regular expression, such as FRAMES
+    return "another symbol"
+
+
 def _describe_expected(expected: set) -> str:
     expected = {e for e in expected if e not in ("SEMICOLON",)}
     if len(expected & _STATEMENT_STARTS) >= 3:
         closers = sorted(e for e in expected if e.startswith("END") or e in ("STARTSCENE",))
         if closers:
-            return "a statement or " + " or ".join(closers)
+            return "a statement or " + " or ".join(_terminal_text(e) for e in closers)
         return "a statement"
     parts = []
     if _EXPRESSION_STARTS <= expected:
         parts.append("an expression")
         expected = expected - _EXPRESSION_STARTS - {"MINUS", "PLUS", "PRIM_NAME"}
     for e in sorted(expected):
-        parts.append(_FRIENDLY.get(e, e))
+        parts.append(_terminal_text(e))
     if not parts:
         return "something else"
     if len(parts) > 6:
@@ -158,31 +165,88 @@ def _describe_token(tok: Token) -> str:
         return "the end of the file"
     text = str(tok.value)
     if tok.type in ("NAME", "PRIM_NAME"):
-        return f"the name {text.upper()}"
+        shown = text.upper() if len(text) <= 40 else text[:40].upper() + "..."
+        return f"the name {shown}"
     if tok.type == "NUMBER":
-        return f"the number {text}"
+        return f"the number {text}" if len(text) <= 40 else f"the number {text[:40]}..."
     return repr(text) if len(text) <= 20 else repr(text[:20] + "...")
 
 
 _BLOCK_WORDS = re.compile(
-    r"\b(STARTMODEL|ENDMODEL|STARTMOTION|ENDMOTION|STARTREACH|ENDREACH|INITIALIZE|ENDSCENE|PRIMITIVE|BEGIN|END)\b", re.I
+    r"\b(STARTMODEL|ENDMODEL|STARTMOTION|ENDMOTION|STARTREACH|ENDREACH|INITIALIZE|ENDSCENE|PRIMITIVE|BEGIN|END"
+    r"|JOINT|ENDJOINT)\b", re.IGNORECASE
 )
-_CLOSER = {"STARTMODEL": "ENDMODEL", "STARTMOTION": "ENDMOTION", "STARTREACH": "ENDREACH", "INITIALIZE": "ENDSCENE", "PRIMITIVE": "END", "BEGIN": "END"}
+_CLOSER = {"STARTMODEL": "ENDMODEL", "STARTMOTION": "ENDMOTION", "STARTREACH": "ENDREACH", "INITIALIZE": "ENDSCENE",
+           "PRIMITIVE": "END", "BEGIN": "END", "JOINT": "ENDJOINT"}
+# Each closing word, what opens it (as the user would write it), and the opening words.
+_STRAY = {
+    "ENDMOTION": ("STARTMOTION", ("STARTMOTION",)),
+    "ENDMODEL": ("STARTMODEL", ("STARTMODEL",)),
+    "ENDREACH": ("STARTREACH", ("STARTREACH",)),
+    "ENDSCENE": ("INITIALIZE SCENE", ("INITIALIZE",)),
+    "ENDJOINT": ("JOINT", ("JOINT",)),
+    "END": ("BEGIN or PRIMITIVE", ("BEGIN", "PRIMITIVE")),
+}
 
 
-def _open_blocks(text: str, upto: int):
-    """The constructs still open at offset ``upto`` (a rough scan for hints)."""
-    cleaned = re.sub(r"\{[^}]*\}|'[^'\n]*'", lambda m: " " * len(m.group(0)), text[:upto])
-    stack = []
-    for m in _BLOCK_WORDS.finditer(cleaned):
+def _shown(word: str) -> str:
+    """An opening word as the user wrote it (a scene opens with INITIALIZE SCENE)."""
+    return "INITIALIZE SCENE" if word == "INITIALIZE" else word
+
+
+_BLANKED = re.compile(r"\{[^}]*\}|'[^'\n]*'")
+
+
+def _blanked(text: str, upto: int) -> str:
+    """``text[:upto]`` with comments and quoted words blanked (offsets kept)."""
+    return _BLANKED.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), text[:upto])
+
+
+def _scan_blocks(text: str, upto: int):
+    """A rough scan of the block words before offset ``upto``, for messages.
+
+    Returns the stack of open blocks ``[(word, offset), ...]`` and, for each
+    opening word, the last ``(open offset, close offset)`` pair seen. JOINT
+    counts as a block only directly inside STARTMOTION, where ENDJOINT may
+    close it; the next JOINT or the ENDMOTION closes it too.
+    """
+    stack: list = []
+    closed: dict = {}
+    for m in _BLOCK_WORDS.finditer(_blanked(text, upto)):
         word = m.group(1).upper()
-        if word in _CLOSER:
+        if word == "JOINT":
+            if stack and stack[-1][0] == "JOINT":
+                stack.pop()
+            if stack and stack[-1][0] == "STARTMOTION":
+                stack.append((word, m.start()))
+        elif word in _CLOSER:
             stack.append((word, m.start()))
         else:
             for i in range(len(stack) - 1, -1, -1):
                 if _CLOSER[stack[i][0]] == word:
+                    closed[stack[i][0]] = (stack[i][1], m.start())
                     del stack[i:]
                     break
+    return stack, closed
+
+
+def _open_blocks(text: str, upto: int):
+    """The constructs still open at offset ``upto`` (a rough scan for hints); a JOINT needs no closing."""
+    return [b for b in _scan_blocks(text, upto)[0] if b[0] != "JOINT"]
+
+
+_OPENING = {")": "(", "]": "["}
+
+
+def _open_brackets(text: str, upto: int):
+    """The ( and [ still open at offset ``upto``: ``[(bracket, offset), ...]``."""
+    stack: list = []
+    for m in re.finditer(r"[()\[\]]", _blanked(text, upto)):
+        ch = m.group(0)
+        if ch in "([":
+            stack.append((ch, m.start()))
+        elif stack and stack[-1][0] == _OPENING[ch]:
+            stack.pop()
     return stack
 
 
@@ -190,6 +254,83 @@ def _line_col(text: str, offset: int):
     line = text.count("\n", 0, offset) + 1
     col = offset - (text.rfind("\n", 0, offset) + 1) + 1
     return line, col
+
+
+def _token_pos(tok: Token) -> A.Pos:
+    return A.Pos(tok.line, tok.column, tok.end_line or tok.line, tok.end_column or tok.column + 1)
+
+
+def _word_taken_as_name(tok: Token, text: str, expected: set):
+    """The closing word the parser took for the start of an assignment, if that is what failed.
+
+    Where a statement may start, a closing word the state does not accept
+    (ENDMOTION after its block is closed) is lexed as a NAME, and the error
+    only shows at the next token, which is not ``=``. Only a NAME leads to a
+    state expecting ``=`` or ``[``, so the word is the last one before the
+    offending token (before its start; the end-of-file token borrows the
+    last token's position, so that token itself).
+    """
+    if not {"ASSIGN_OP", "LSQB"} <= expected:
+        return None
+    if tok.type == "$END":
+        start = tok.start_pos
+    else:
+        before = _blanked(text, tok.start_pos).rstrip()
+        m = _LAST_WORD.search(before, max(0, len(before) - 40))
+        if m is None:
+            return None
+        start = m.start()
+    m = _WORD.match(text, start or 0)
+    if m is None or m.group(0).upper() not in _STRAY and m.group(0).upper() != "CONTINUE":
+        return None
+    line, col = _line_col(text, m.start())
+    return Token("NAME", m.group(0), m.start(), line, col, line, col + len(m.group(0)), m.end())
+
+
+_WORD = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+_ASSIGNED = re.compile(r"[ \t]*(:-|:=|=|\[)")
+_LAST_WORD = re.compile(r"(?<![A-Za-z0-9_])[A-Za-z][A-Za-z0-9_]*\Z")
+
+
+def _stray_diagnostic(tok: Token, text: str, source: Source, as_name: bool):
+    """``ENDMOTION without STARTMOTION`` and its kind, at the stray word, or None if it is not stray."""
+    word = tok.value.upper()
+    pos = _token_pos(tok)
+    if not as_name and _ASSIGNED.match(text, tok.end_pos):
+        return Diagnostic(source.filename, pos, f"{word} cannot be a variable name here, after an expression",
+                          "choose another name, or start the statement with another one", source=source.text)
+    if word == "CONTINUE":
+        return Diagnostic(source.filename, pos, "CONTINUE needs the label of the DO loop it closes",
+                          "write the loop as DO 10 I = 1, 5 ... 10 CONTINUE", source=source.text)
+    opener_text, openers = _STRAY[word]
+    stack, closed = _scan_blocks(text, tok.start_pos)
+    if any(w in openers for w, _ in stack):
+        return None  # its block is open: the word is misplaced, not stray
+    others = [b for b in stack if b[0] != "JOINT"]
+    if others and not as_name and (word == "END" or word == "ENDJOINT" and others[-1][0] != "STARTMOTION"):
+        return None  # END inside another block: that block is what is unclosed
+    pairs = [(closed[w][1], closed[w][0], w) for w in openers if w in closed]
+    if pairs:
+        by, at, opened_word = max(pairs)
+        hint = (f"the {_shown(opened_word)} at line {_line_col(text, at)[0]} was already closed "
+                f"by the {word} at line {_line_col(text, by)[0]}")
+    else:
+        hint = f"no {opener_text} is open here"
+    # Name the block that is open instead, unless it is the JOINT's own STARTMOTION.
+    if others and not (word == "ENDJOINT" and others[-1][0] == "STARTMOTION"):
+        inner, at = others[-1]
+        hint += f"; the {_shown(inner)} opened at line {_line_col(text, at)[0]} is closed by {_CLOSER[inner]}"
+    return Diagnostic(source.filename, pos, f"{word} without {opener_text}", hint, source=source.text)
+
+
+def _bracket_hint(text: str, upto: int, after: int = -1):
+    """'the ( opened at 1:5 is never closed' for the innermost open bracket after offset ``after``."""
+    brackets = _open_brackets(text, upto)
+    if not brackets or brackets[-1][1] < after:
+        return None
+    ch, at = brackets[-1]
+    line, col = _line_col(text, at)
+    return f"the {ch} opened at {line}:{col} is never closed"
 
 
 def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
@@ -203,30 +344,28 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
             hint = "rename it; only PRINT $model uses a $"
         elif ch == "{":
             message = "this { comment is never closed with }"
+            hint = "a comment runs from { to the next }; add the }"
         elif ch == "'":
             message = "this quoted word is never closed with ' on the same line"
+            hint = "a quoted word ends with ' before the end of its line"
         else:
             message = f"unexpected character {ch!r}"
         return Diagnostic(source.filename, A.Pos(line, col, line, col + 1), message, hint, source=source.text)
     assert isinstance(exc, UnexpectedToken)
     tok = exc.token
     expected = set(exc.expected) if exc.expected else set()
-    if tok.type == "$END":
-        opened = _open_blocks(text, len(text))
-        lines = text.split("\n")
-        line = len(lines)
-        col = len(lines[-1]) + 1
-        if opened:
-            word, at = opened[-1]
-            oline, ocol = _line_col(text, at)
-            message = f"the file ends before {_CLOSER[word]} closes the {word} opened at line {oline}"
-            hint = f"add {_CLOSER[word]} after the last statement of the {word}"
-            pos = A.Pos(oline, ocol, oline, ocol + len(word))
-            d = Diagnostic(source.filename, pos, message, hint, source=source.text)
+    stray = _word_taken_as_name(tok, text, expected)
+    if stray is not None:
+        d = _stray_diagnostic(stray, text, source, as_name=True)
+        if d is not None:
             return d
-        message = f"the file ends too early; expected {_describe_expected(expected)}"
-        return Diagnostic(source.filename, A.Pos(line, col, line, col), message, hint, source=source.text)
-    pos = A.Pos(tok.line, tok.column, tok.end_line or tok.line, tok.end_column or tok.column + 1)
+    if tok.type != "$END" and tok.type not in expected and str(tok.value).upper() in _STRAY:
+        d = _stray_diagnostic(tok, text, source, as_name=False)
+        if d is not None:
+            return d
+    if tok.type == "$END":
+        return _end_of_file(tok, expected, text, source)
+    pos = _token_pos(tok)
     if tok.type == "DOLLAR_NAME":
         message = "names beginning with $ are reserved for liganimate"
         hint = "rename it; only PRINT $model uses a $"
@@ -241,5 +380,39 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
             if opened:
                 word, at = opened[-1]
                 oline, _ = _line_col(text, at)
-                hint = f"the {word} opened at line {oline} is not closed; add {_CLOSER[word]}"
+                hint = f"the {_shown(word)} opened at line {oline} is not closed; add {_CLOSER[word]}"
+        if hint is None and expected & {"RPAR", "RSQB"}:
+            hint = _bracket_hint(text, tok.start_pos)
     return Diagnostic(source.filename, pos, message, hint, source=source.text)
+
+
+# When the file ends inside a block the scan did not see, the closer to suggest.
+_CLOSING_ORDER = ("ENDMOTION", "ENDMODEL", "ENDREACH", "ENDSCENE", "END", "ENDJOINT")
+
+
+def _end_of_file(tok: Token, expected: set, text: str, source: Source) -> Diagnostic:
+    """The file ended inside something: say what is unclosed, at the end of the last token."""
+    opened = _open_blocks(text, len(text))
+    after = opened[-1][1] if opened else -1
+    bracket = _bracket_hint(text, len(text), after) if expected & {"RPAR", "RSQB"} else None
+    if opened and bracket is None:
+        word, at = opened[-1]
+        oline, ocol = _line_col(text, at)
+        message = f"the file ends before {_CLOSER[word]} closes the {_shown(word)} opened at line {oline}"
+        hint = f"add {_CLOSER[word]} after the last statement of the {_shown(word)}"
+        return Diagnostic(source.filename, A.Pos(oline, ocol, oline, ocol + len(word)), message, hint,
+                          source=source.text)
+    # Lark's end token borrows the position of the last real token: point just after it.
+    line, col = getattr(tok, "end_line", None), getattr(tok, "end_column", None)
+    if not line or not col:
+        lines = text.split("\n")
+        line, col = len(lines), len(lines[-1]) + 1
+    message = f"the file ends too early; expected {_describe_expected(expected)}"
+    closer = next((w for w in _CLOSING_ORDER if w in expected), None)
+    if bracket:
+        hint = bracket
+    elif closer:
+        hint = f"a block is still open; close it with {closer}"
+    else:
+        hint = "the last statement is not finished"
+    return Diagnostic(source.filename, A.Pos(line, col, line, col + 1), message, hint, source=source.text)
