@@ -1,23 +1,26 @@
 """Parsing: one cached LALR parser, syntax errors as diagnostics.
 
 :func:`parse` turns source text into a :class:`liganimate.lang.ast.Program`.
-The Lark parser is built once per process (and its tables cached on disk by
-Lark between processes), the transformer runs inside the parser, and every
-Lark exception becomes a :class:`~liganimate.lang.diagnostics.LigDiagnostics`.
+The Lark parser is loaded once per process from tables shipped in the
+package (:mod:`.tables`); :mod:`.lalr` runs them with the transformer inside,
+and every Lark exception becomes a
+:class:`~liganimate.lang.diagnostics.LigDiagnostics`.
 """
 
 from __future__ import annotations
 
 import contextvars
 import functools
+import gc
 import re
-from importlib import resources
 
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from . import ast as A
+from . import tables
 from .diagnostics import Diagnostic, LigDiagnostics
+from .lalr import Driver
 from .lexer import LigLexer
 from .source import Source, prepare
 from .structure import group_blocks
@@ -47,31 +50,42 @@ class _PrimitiveNames:
             yield tok
 
 
+def grammar_parts() -> tuple:
+    """The lexer class, post-lexer and transformer the parser is made with."""
+    return LigLexer, _PrimitiveNames(), ToAst()
+
+
 @functools.lru_cache(maxsize=1)
 def build_parser() -> Lark:
-    """Build (once per process) the LALR parser with the AST transformer inside."""
-    grammar = resources.files("liganimate.lang").joinpath("lig.lark").read_text(encoding="utf-8")
-    return Lark(
-        grammar,
-        parser="lalr",
-        lexer=LigLexer,
-        postlex=_PrimitiveNames(),
-        transformer=ToAst(),
-        maybe_placeholders=False,
-        cache=True,
-    )
+    """The LALR parser with the AST transformer inside, once per process.
+
+    Its tables come from the package (lang/_tables.py, see
+    :mod:`liganimate.lang.tables`), never from a cache a user could write;
+    when they were not made from this lig.lark, from the grammar itself.
+    """
+    parts = grammar_parts()
+    return tables.load(*parts) or tables.build(*parts)
+
+
+@functools.lru_cache(maxsize=1)
+def _driver() -> Driver:
+    return Driver(build_parser())
 
 
 def parse_source(source: Source, primitives: frozenset | set = frozenset()) -> A.Program:
     """Parse a prepared source; ``primitives`` are extra primitive names (e.g. from a library)."""
-    names = set(BUILTIN_PRIMITIVES) | set(primitives) | source.primitive_names()
-    token = _primitive_names.set(frozenset(names))
+    names = frozenset(set(BUILTIN_PRIMITIVES) | set(primitives) | source.primitive_names())
+    # The parse makes only trees, never cycles: the cyclic collector would
+    # walk the growing tree again and again for nothing.
+    collecting = gc.isenabled()
+    gc.disable()
     try:
-        body = build_parser().parse(source.lexed)
+        body = _driver().parse(source.lexed, names)
     except UnexpectedInput as exc:
         raise LigDiagnostics([_syntax_diagnostic(exc, source)]) from None
     finally:
-        _primitive_names.reset(token)
+        if collecting:
+            gc.enable()
     body = group_blocks(body, source)
     prims = [s for s in body if isinstance(s, A.PrimitiveDef)]
     return A.Program(A.Pos(1, 1, 1, 1), source.filename, source.text, body, prims)
