@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 from liganimate.lang.parser import parse_source
 from liganimate.lang.source import Source, load, prepare
 
@@ -20,16 +21,41 @@ class Compiled:
     checked: Checked
 
 
+class NotParsed(LigDiagnostics):
+    """The source does not parse.
+
+    ``syntax`` are the parser's diagnostics; ``loads`` report the LOADs that
+    failed before parsing (a primitive of a library that failed to load is
+    an unknown word to the parser, so its failure comes first).
+    """
+
+    def __init__(self, loads: list, syntax: list):
+        super().__init__(loads + syntax)
+        self.loads = loads
+        self.syntax = syntax
+
+
 def compile_source(source: Source, module_name: str | None = None, *, path: str | None = None,
                    stack: tuple = ()) -> Compiled:
-    """Parse, check and lower a prepared source. Raises LigDiagnostics on errors.
+    """Parse, check and lower a prepared source.
 
     ``path`` is the file the source came from: relative LOADs start there
     (default: the current folder). ``stack`` is the chain of libraries being
     loaded around this one (see :mod:`.library`).
+
+    Raises
+    ------
+    NotParsed
+        The source does not parse (a LigDiagnostics).
+    LigDiagnostics
+        Any other error.
     """
     path = path if path is not None else source.filename
-    program = parse_source(source, _loaded_primitive_names(source, path, stack))
+    names, failed = _scan_loads(source, path, stack)
+    try:
+        program = parse_source(source, names)
+    except LigDiagnostics as exc:
+        raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
     checked = check(program, path=path, stack=stack)
     python = lower(checked, module_name or source.filename)
     return Compiled(python, list(source.warnings) + checked.warnings, checked)
@@ -45,18 +71,48 @@ def compile_file(path: str) -> Compiled:
     return compile_source(load(path), path=path)
 
 
-def _loaded_primitive_names(source: Source, path: str, stack: tuple) -> set:
-    """Names of the primitives the source's LOAD statements bring, for the lexer.
+def _scan_loads(source: Source, path: str, stack: tuple) -> tuple:
+    """Load what the source's LOAD statements name, before parsing.
 
-    A LOAD that fails here is left for the checker, which reports it at its line.
+    Returns ``(names, failed)``: the names of the primitives they bring, for
+    the lexer, and ``[(library name, Pos, exception), ...]`` for each LOAD
+    that failed in one of the ways a LOAD reports at its line
+    (``library.FAILURES``). The checker loads again and reports those; if
+    parsing fails first, :func:`compile_source` reports them itself. Any
+    other exception is a bug and is not swallowed.
     """
+    import os
+
     from . import library
 
-    names = set()
-    for lib_name, wanted in source.load_requests():
+    names, failed = set(), []
+    requests = source.load_requests()
+    if not requests:
+        return names, failed
+    # The loading file joins the chain as the checker adds it, so a cycle is a LibraryCycle here too.
+    around = stack + ((os.path.abspath(path),) if path and not path.startswith("<") else ())
+    for lib_name, wanted, pos in requests:
         try:
-            lib = library.load(lib_name, library.resolve(lib_name, path), stack)
-        except Exception:
+            lib = library.load(lib_name, library.resolve(lib_name, path), around)
+        except library.FAILURES as exc:
+            failed.append((lib_name, pos, exc))
             continue
         names.update(n for n in (wanted if wanted is not None else lib.signatures) if n in lib.signatures)
-    return names
+    return names, failed
+
+
+def _loaded_primitive_names(source: Source, path: str, stack: tuple) -> set:
+    """Names of the primitives the source's LOAD statements bring (see :func:`_scan_loads`)."""
+    return _scan_loads(source, path, stack)[0]
+
+
+def _load_failures(source: Source, failed: list) -> list:
+    """The diagnostics of LOADs that failed, each at its library string, as the checker words them."""
+    from . import library
+
+    out = []
+    for lib_name, pos, exc in failed:
+        message, hint, inner = library.failure(exc, lib_name)
+        out.extend(inner)
+        out.append(Diagnostic(source.filename, pos, message, hint, source=source.text))
+    return out

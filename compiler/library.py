@@ -2,11 +2,16 @@
 
 A library is an ordinary program without scenes. ``LOAD 'humanoid'`` finds
 ``humanoid.lig`` in the standard library; a name holding a ``/`` or ending
-in ``.lig`` is a path relative to the loading file. A library is compiled
-once and kept twice over: in memory for this process, and on disk (see
-:func:`cache_dir`) keyed by the library's text, the texts of everything it
-loads in turn and the compiler's own source, so an edited library or a new
-compiler never meets a stale entry.
+in ``.lig`` is a path relative to the loading file (``.lig`` is added when
+missing). A path LOAD reads only a regular file whose real name ends in
+``.lig`` and that is LIG text (see lang/source.py); a library that does not
+parse is reported by position only, without its text, because a LOAD may
+name a file that is not LIG at all (docs/security.md).
+
+A library is compiled once and kept twice over: in memory for this
+process, and on disk (see :mod:`.library_cache`) keyed by the library's
+text, the texts of everything it loads in turn and the compiler's own
+source, so an edited library or a new compiler never meets a stale entry.
 
 What a library offers: every top-level variable it defines (not the names
 it loaded itself) and its own PRIMITIVEs. ``LOAD 'x'`` takes its models,
@@ -16,23 +21,29 @@ helpers, so they come only when named.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import os
-import pickle
 import re
-import tempfile
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from liganimate.lang.ast import Pos
+from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+from liganimate.lang.source import SourceFileError, lig_text, read_source_bytes
+
 from liganimate import __version__
 
+from . import library_cache
 from . import types as T
+from .library_cache import cache_dir
+from .primitives import Signature, Slot
 
 # Kinds that LOAD 'library' brings without naming them.
 DEFAULT_KINDS = (T.MODEL, T.MOTION, T.GRAPHICAL)
 
 _DOC = re.compile(r"\{@\s*([A-Za-z][A-Za-z0-9_]*)\s*:\s*([^}]*)\}")
-_CACHE_FORMAT = 1
 
 
 class LibraryNotFound(Exception):
@@ -61,7 +72,7 @@ class Library:
     display: str  # shown in diagnostics and in generated modules
     python: str  # its lowered module (see compiler/lower.py)
     types: dict  # exported NAME -> type
-    signatures: dict  # own PRIMITIVE NAME -> Signature
+    signatures: dict  # own PRIMITIVE NAME -> Signature (no defaults: they live in ``python``)
     descriptions: dict  # NAME -> one-line description from its {@ NAME: ...} comments
     warnings: list = field(default_factory=list)
     deps: tuple = ()  # ((absolute path, sha256 of its bytes), ...) of every file it loads, recursively
@@ -102,23 +113,60 @@ def is_path(name: str) -> bool:
 def resolve(name: str, loading_file: str) -> str:
     """The absolute path of the library ``name`` loaded from ``loading_file``.
 
+    A path may be relative (to the loading file's folder) or absolute, and
+    may leave the program's folder; ``.lig`` is added when it is missing.
+    The real file (symbolic links followed) must be a regular file whose
+    name ends in ``.lig``.
+
     Raises
     ------
     LibraryNotFound
         With the places looked at.
+    SourceFileError
+        The file is there but is not a ``.lig`` file or not a regular file.
+    OSError
+        It cannot be looked at (permissions, a loop of links).
     """
-    if is_path(name):
-        base = Path(loading_file).resolve().parent if loading_file and not loading_file.startswith("<") else Path.cwd()
-        candidate = (base / name).resolve()
-        if candidate.suffix.lower() != ".lig" and not candidate.exists():
-            candidate = candidate.with_name(candidate.name + ".lig")
-        if candidate.is_file():
-            return str(candidate)
-        raise LibraryNotFound(name, [str(candidate)])
-    candidate = stdlib_dir() / f"{name.lower()}.lig"
-    if candidate.is_file():
-        return str(candidate)
-    raise LibraryNotFound(name, [str(candidate)])
+    if not is_path(name):
+        return _existing(name, str(stdlib_dir() / f"{name.lower()}.lig"))
+    base = Path(loading_file).resolve().parent if loading_file and not loading_file.startswith("<") else Path.cwd()
+    written = os.path.join(base, name)
+    if _is_lig(written):
+        return _existing(name, written)
+    try:
+        return _existing(name, written + ".lig")
+    except LibraryNotFound:
+        if _there(written):
+            raise SourceFileError(_NOT_LIG, os.path.realpath(written)) from None
+        raise
+
+
+_NOT_LIG = "a LOAD reads only files whose names end in .lig"
+
+
+def _is_lig(path: str) -> bool:
+    return os.path.splitext(path)[1].lower() == ".lig"
+
+
+def _there(path: str) -> bool:
+    try:
+        os.lstat(path)
+    except (OSError, ValueError):
+        return False
+    return True
+
+
+def _existing(name: str, path: str) -> str:
+    real = os.path.realpath(path)
+    try:
+        st = os.stat(real)
+    except (FileNotFoundError, NotADirectoryError, ValueError):  # ValueError: a NUL in the name
+        raise LibraryNotFound(name, [real]) from None
+    if not _is_lig(real):
+        raise SourceFileError(_NOT_LIG + " (this one is a link to another kind of file)", real)
+    if not stat.S_ISREG(st.st_mode):
+        read_source_bytes(real)  # raises, saying what it is instead
+    return real
 
 
 def descriptions(text: str) -> dict:
@@ -129,19 +177,6 @@ def descriptions(text: str) -> dict:
 # ------------------------------------------------------------------ caching
 
 _memory: dict = {}  # (absolute path, name as loaded) -> Library (validated by its deps' hashes)
-
-
-def cache_dir() -> Path | None:
-    """Where compiled libraries are kept between runs, or None to keep nothing.
-
-    ``LIGANIMATE_CACHE`` names the folder (empty: no disk cache); otherwise
-    ``$XDG_CACHE_HOME/liganimate`` or ``~/.cache/liganimate``.
-    """
-    env = os.environ.get("LIGANIMATE_CACHE")
-    if env is not None:
-        return Path(env) if env else None
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "liganimate"
 
 
 def _sha(data: bytes) -> str:
@@ -170,43 +205,60 @@ def compiler_fingerprint() -> str:
 def _deps_fresh(deps) -> bool:
     for path, sha in deps:
         try:
-            if _sha(Path(path).read_bytes()) != sha:
+            if _sha(read_source_bytes(path, follow_symlinks=False)) != sha:
                 return False
-        except OSError:
+        except (OSError, ValueError):
             return False
     return True
 
 
-def _cache_file(path: str, name: str, data: bytes) -> Path | None:
-    folder = cache_dir()
-    if folder is None:
-        return None
-    key = _sha(b"\0".join([compiler_fingerprint().encode(), path.encode(), name.encode(), data]))
-    return folder / f"{key}.pickle"
+def _to_json(lib: Library) -> dict:
+    """A library as plain JSON values (the disk cache stores nothing else)."""
+    sources: list = []
+
+    def source_index(text):
+        if text is None:
+            return None
+        if text not in sources:
+            sources.append(text)
+        return sources.index(text)
+
+    return {
+        "name": lib.name, "path": lib.path, "display": lib.display, "python": lib.python,
+        "types": lib.types, "descriptions": lib.descriptions, "scenes": lib.scenes,
+        "deps": [list(d) for d in lib.deps],
+        "signatures": [{"name": s.name, "slots": [[x.keyword, x.param, x.group] for x in s.slots],
+                        "param_types": s.param_types} for s in lib.signatures.values()],
+        "warnings": [{"filename": w.filename, "pos": [w.pos.line, w.pos.column, w.pos.end_line, w.pos.end_column],
+                      "message": w.message, "hint": w.hint, "severity": w.severity,
+                      "source": source_index(w.source), "notes": list(w.notes)} for w in lib.warnings],
+        "sources": sources,
+    }
 
 
-def _read_cache(file: Path | None):
-    if file is None:
+def _from_json(obj: dict) -> Library:
+    """The inverse of :func:`_to_json`; raises KeyError, TypeError or ValueError on a foreign shape."""
+    sources = obj["sources"]
+    sigs = {}
+    for s in obj["signatures"]:
+        sigs[s["name"]] = Signature(s["name"], [Slot(k, p, g) for k, p, g in s["slots"]], {}, dict(s["param_types"]))
+    warnings = [Diagnostic(w["filename"], Pos(*w["pos"]), w["message"], w["hint"], w["severity"],
+                           None if w["source"] is None else sources[w["source"]], list(w["notes"]))
+                for w in obj["warnings"]]
+    return Library(name=obj["name"], path=obj["path"], display=obj["display"], python=obj["python"],
+                   types=dict(obj["types"]), signatures=sigs, descriptions=dict(obj["descriptions"]),
+                   warnings=warnings, deps=tuple((p, h) for p, h in obj["deps"]), scenes=bool(obj["scenes"]))
+
+
+def _from_disk(entry: str, name: str, path: str) -> Library | None:
+    obj = library_cache.read(entry)
+    if obj is None:
         return None
     try:
-        with open(file, "rb") as fh:
-            fmt, lib = pickle.load(fh)
-    except Exception:  # a missing, partial or foreign entry is just a miss
+        lib = _from_json(obj)
+    except (KeyError, TypeError, ValueError, IndexError):
         return None
-    return lib if fmt == _CACHE_FORMAT and isinstance(lib, Library) else None
-
-
-def _write_cache(file: Path | None, lib: Library) -> None:
-    if file is None:
-        return
-    try:
-        file.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=".tmp-")
-        with os.fdopen(fd, "wb") as fh:
-            pickle.dump((_CACHE_FORMAT, lib), fh, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, file)
-    except OSError:
-        pass  # a read-only home only costs a recompile next time
+    return lib if (lib.name, lib.path) == (name, path) else None
 
 
 # ------------------------------------------------------------------ loading
@@ -232,6 +284,8 @@ def load(name: str, path: str, stack: tuple = ()) -> Library:
     Raises
     ------
     LibraryCycle, LigDiagnostics, OSError
+        OSError includes SourceFileError: not a regular file, too large, or
+        not LIG text.
     """
     if path in stack:
         chain = [Path(p).name for p in stack[stack.index(path):]] + [Path(path).name]
@@ -241,28 +295,32 @@ def load(name: str, path: str, stack: tuple = ()) -> Library:
     known = _memory.get((path, name))
     if known is not None and _deps_fresh(known.deps):
         return known
-    data = Path(path).read_bytes()
-    file = _cache_file(path, name, data)
-    lib = _read_cache(file)
+    data = read_source_bytes(path, follow_symlinks=False)
+    entry = library_cache.entry_name(compiler_fingerprint().encode(), path.encode(), name.encode(), data)
+    lib = _from_disk(entry, name, path)
     if lib is None or not _deps_fresh(lib.deps):
         lib = _compile(name, path, data, stack)
-        _write_cache(file, lib)
+        library_cache.write(entry, _to_json(lib))
     _memory[(path, name)] = lib
     return lib
 
 
 def _compile(name: str, path: str, data: bytes, stack: tuple) -> Library:
-    from liganimate.lang.source import decode, prepare
+    from liganimate.lang.source import prepare
 
-    from . import compile_source
+    from . import NotParsed, compile_source
 
     display = display_name(name, path)
-    source = prepare(decode(data, display), display)
-    compiled = compile_source(source, display, path=path, stack=stack)
+    source = prepare(lig_text(data, path), display)
+    try:
+        compiled = compile_source(source, display, path=path, stack=stack)
+    except NotParsed as exc:
+        raise LigDiagnostics(exc.loads + [_withheld(d) for d in exc.syntax]) from None
     checked = compiled.checked
     loaded = set(checked.loaded_names)
     types = {n: t for n, t in checked.main.types.items() if n not in loaded}
-    sigs = {n: sig for n, (pdef, sig, _) in checked.primitives.items() if pdef is not None}
+    sigs = {n: dataclasses.replace(sig, defaults={}, param_types=dict(sig.param_types))
+            for n, (pdef, sig, _) in checked.primitives.items() if pdef is not None}
     deps = [(path, _sha(data))]
     for lib in checked.libraries:
         deps.extend(lib.deps)
@@ -278,6 +336,37 @@ def _compile(name: str, path: str, data: bytes, stack: tuple) -> Library:
         deps=tuple(dict.fromkeys(deps)),
         scenes=_has_scenes(checked.program.body),
     )
+
+
+def _withheld(d: Diagnostic) -> Diagnostic:
+    """A library's syntax error by position only: a file that does not parse may not be LIG at all."""
+    return Diagnostic(d.filename, Pos(d.pos.line, d.pos.column, d.pos.line, d.pos.column + 1),
+                      "the library does not parse as LIG here (a library that does not parse is not quoted)",
+                      "run liganimate check on the library itself to see its line and the full message")
+
+
+def failure(exc: Exception, name: str) -> tuple:
+    """``(message, hint, the library's own diagnostics)`` for a LOAD of ``name`` that raised ``exc``.
+
+    ``exc`` is one of LibraryNotFound, LibraryCycle, LigDiagnostics or
+    OSError, the failures a LOAD reports at its own line.
+    """
+    if isinstance(exc, LibraryNotFound):
+        hint = None
+        if not is_path(name):
+            hint = did_you_mean(name.lower(), stdlib_names()) or ("the standard libraries are " + ", ".join(stdlib_names()))
+            hint += "; a file of your own is named by a path such as 'lib/mine.lig'"
+        return f"there is no library '{name}' (looked for {exc.tried[0]})", hint, []
+    if isinstance(exc, LibraryCycle):
+        return ("libraries load each other in a circle: " + " -> ".join(exc.chain),
+                "move what both need into a third library", [])
+    if isinstance(exc, LigDiagnostics):
+        return f"the library '{name}' has errors (shown above)", None, list(exc.diagnostics)
+    return f"the library '{name}' cannot be read: {exc.strerror or exc}", None, []
+
+
+# What a LOAD reports at its own line (see failure); anything else is a bug.
+FAILURES = (LibraryNotFound, LibraryCycle, LigDiagnostics, OSError)
 
 
 def _has_scenes(stmts) -> bool:
@@ -299,14 +388,16 @@ def forget() -> None:
 
 
 __all__ = [
+    "FAILURES",
     "Library",
-    "LibraryNotFound",
     "LibraryCycle",
+    "LibraryNotFound",
+    "cache_dir",
+    "descriptions",
+    "failure",
+    "forget",
+    "load",
+    "resolve",
     "stdlib_dir",
     "stdlib_names",
-    "resolve",
-    "load",
-    "descriptions",
-    "cache_dir",
-    "forget",
 ]

@@ -1,4 +1,11 @@
-"""Reading a source file: strict UTF-8 and the 1986 listing conventions.
+"""Reading a source file: what counts as LIG text, strict UTF-8 and the 1986 listing conventions.
+
+A source file is read only if it is a regular file of at most
+:data:`MAX_SOURCE_BYTES`, opened without blocking so that a named pipe or a
+device named by mistake (or by a hostile LOAD) cannot hang a run. LIG text
+is UTF-8 without control characters other than tab, line feed, form feed
+and carriage return; see docs/security.md for why a file that is not LIG
+text is refused without quoting it.
 
 The thesis' listings flag extension statements with ``*`` in column 1 and
 write FORTRAN comment lines as ``C`` in column 1. Both are blanked here,
@@ -8,7 +15,10 @@ still point into the text the user wrote.
 
 from __future__ import annotations
 
+import errno
+import os
 import re
+import stat
 from dataclasses import dataclass, field
 
 from .ast import Pos
@@ -23,6 +33,128 @@ _PRIMITIVE_HEAD = re.compile(r"(?im)^[ \t*]*PRIMITIVE[ \t]+([A-Za-z][A-Za-z0-9_]
 _LOAD = re.compile(
     r"(?i)(?:^|[;\n])[ \t]*LOAD\s+(?:'([^'\n]*)'|((?:[A-Za-z][A-Za-z0-9_]*\s*,\s*)*[A-Za-z][A-Za-z0-9_]*)\s+FROM\s+'([^'\n]*)')")
 _BRACES = re.compile(r"\{[^}]*\}")
+
+# Larger than any program written by hand (the thesis' longest listing is a
+# few hundred lines) and small enough that checking it fits in memory.
+MAX_SOURCE_BYTES = 64 * 1024 * 1024
+# Control characters LIG text may hold: tab, line feed, form feed, carriage return.
+_CONTROL_BYTES = re.compile(rb"[\x00-\x08\x0b\x0e-\x1f\x7f]")
+_CONTROL_CHARS = re.compile("[\x00-\x08\x0b\x0e-\x1f\x7f-\x9f]")
+
+
+class SourceFileError(OSError):
+    """A file that cannot be a LIG source: not a regular file, too large, or not LIG text.
+
+    ``strerror`` is one plain sentence that never quotes the file's content,
+    so it is safe to show whatever file a LOAD named.
+    """
+
+    def __init__(self, message: str, filename: str):
+        super().__init__(errno.EINVAL, message, filename)
+
+
+def _kind(mode: int) -> str:
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISFIFO(mode):
+        return "a named pipe"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    return "a special file"
+
+
+def _require_regular(st: os.stat_result, path: str) -> None:
+    if not stat.S_ISREG(st.st_mode):
+        raise SourceFileError(f"not an ordinary file but {_kind(st.st_mode)}", path)
+    if st.st_size > MAX_SOURCE_BYTES:
+        raise SourceFileError(_too_large(), path)
+
+
+def _too_large() -> str:
+    return f"larger than {MAX_SOURCE_BYTES // (1024 * 1024)} MB, the most a LIG source may hold"
+
+
+def read_source_bytes(path: str, *, follow_symlinks: bool = True) -> bytes:
+    """The bytes of a source file, refusing anything but a regular file of at most MAX_SOURCE_BYTES.
+
+    The file is looked at before it is opened (a device is never opened),
+    opened without blocking (a named pipe put in its place meanwhile cannot
+    hang) and looked at again through the open descriptor. Files that report
+    no size (``/proc``) are read up to the limit.
+
+    Parameters
+    ----------
+    path : str
+        The file.
+    follow_symlinks : bool
+        False refuses a symbolic link as the last part of ``path`` (library
+        paths are already resolved, so a link there appeared afterwards).
+
+    Raises
+    ------
+    SourceFileError
+        Not a regular file, or too large.
+    OSError
+        Missing, unreadable.
+    """
+    _require_regular(os.stat(path, follow_symlinks=follow_symlinks), path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
+    if not follow_symlinks:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
+    fd = os.open(path, flags)
+    try:
+        _require_regular(os.fstat(fd), path)
+        chunks, total = [], 0
+        while True:
+            chunk = os.read(fd, min(1 << 20, MAX_SOURCE_BYTES + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+            if total > MAX_SOURCE_BYTES:
+                raise SourceFileError(_too_large(), path)
+    finally:
+        os.close(fd)
+    return b"".join(chunks)
+
+
+def _line_col(data: bytes, offset: int) -> tuple:
+    start = data.rfind(b"\n", 0, offset) + 1
+    return data.count(b"\n", 0, offset) + 1, len(data[start:offset].decode("utf-8", errors="replace")) + 1
+
+
+def _text_line_col(text: str, offset: int) -> tuple:
+    return text.count("\n", 0, offset) + 1, offset - (text.rfind("\n", 0, offset) + 1) + 1
+
+
+def lig_text(data: bytes, path: str) -> str:
+    """Decode a file a LOAD named, refusing anything that is not LIG text.
+
+    The refusal says what is wrong and where, never what the file holds: a
+    LOAD may name a file its author cannot read (see docs/security.md).
+
+    Raises
+    ------
+    SourceFileError
+        Not UTF-8, or holding control characters other than tab, line feed,
+        form feed and carriage return.
+    """
+    bad = _CONTROL_BYTES.search(data)
+    if bad is not None:
+        line, col = _line_col(data, bad.start())
+        raise SourceFileError(f"not LIG text (a control character at line {line}, column {col})", path)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line, col = _line_col(data, exc.start)
+        raise SourceFileError(f"not UTF-8 text (a bad byte at line {line}, column {col})", path) from None
+    bad = _CONTROL_CHARS.search(text)
+    if bad is not None:
+        line, col = _text_line_col(text, bad.start())
+        raise SourceFileError(f"not LIG text (a control character at line {line}, column {col})", path)
+    return text.removeprefix("\ufeff")
 
 
 @dataclass
@@ -39,7 +171,7 @@ class Source:
         return {m.group(1).upper() for m in _PRIMITIVE_HEAD.finditer(self.lexed)}
 
     def load_requests(self) -> list:
-        """The LOAD statements, found before parsing: ``[(library, names or None), ...]``.
+        """The LOAD statements, found before parsing: ``[(library, names or None, Pos of the quote), ...]``.
 
         Only a hint for the lexer (which loaded names are primitives); the
         parsed LOAD statements are what the checker acts on.
@@ -47,10 +179,11 @@ class Source:
         text = _BRACES.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), self.lexed)
         found = []
         for m in _LOAD.finditer(text):
-            if m.group(1) is not None:
-                found.append((m.group(1), None))
-            else:
-                found.append((m.group(3), [n.strip().upper() for n in m.group(2).split(",")]))
+            group = 1 if m.group(1) is not None else 3
+            line, col = _text_line_col(text, m.start(group) - 1)
+            pos = Pos(line, col, line, col + len(m.group(group)) + 2)
+            names = None if group == 1 else [n.strip().upper() for n in m.group(2).split(",")]
+            found.append((m.group(group), names, pos))
         return found
 
 
@@ -72,8 +205,7 @@ def decode(data: bytes, filename: str) -> str:
                 source=shown,
             )
         ]) from None
-    if text.startswith("\ufeff"):
-        text = text[1:]
+    text = text.removeprefix("\ufeff")
     return text
 
 
@@ -98,8 +230,33 @@ def prepare(text: str, filename: str) -> Source:
 
 
 def load(path: str, display_name: str | None = None) -> Source:
-    """Read, decode and prepare a program file."""
-    with open(path, "rb") as fh:
-        data = fh.read()
+    """Read, decode and prepare a program file.
+
+    Raises
+    ------
+    SourceFileError
+        Not a regular file, or too large (see :func:`read_source_bytes`).
+    LigDiagnostics
+        Not UTF-8, or holding control characters: at the first bad one. Only
+        a file that is text in some encoding has its line shown (a binary
+        file's "line" is noise, or worse, terminal escapes).
+    """
+    data = read_source_bytes(path)
     name = display_name or path
-    return prepare(decode(data, name), name)
+    bad = _CONTROL_BYTES.search(data)
+    if bad is not None:
+        raise _binary(name, *_line_col(data, bad.start()), data[bad.start()])
+    text = decode(data, name)
+    bad = _CONTROL_CHARS.search(text)
+    if bad is not None:
+        raise _binary(name, *_text_line_col(text, bad.start()), ord(bad.group()))
+    return prepare(text, name)
+
+
+def _binary(filename: str, line: int, col: int, code: int) -> LigDiagnostics:
+    return LigDiagnostics([Diagnostic(
+        filename, Pos(line, col, line, col + 1),
+        f"the file holds a control character (U+{code:04X}), so it is not LIG text",
+        "a LIG program is plain UTF-8 text; tab, line feed, form feed and carriage return are the only "
+        "control characters it may hold",
+    )])
