@@ -66,7 +66,7 @@ def format_diagnostic(d: Diagnostic, source: str | None = None) -> str:
     not blank, with the caret just after its last character.
     """
     src = d.source if d.source is not None else source
-    head = f"{escape_text(d.filename)}:{d.pos.line}:{d.pos.column}: {d.severity}: {escape_text(d.message)}"
+    head = f"{escape_text(str(d.filename))}:{d.pos.line}:{d.pos.column}: {d.severity}: {escape_text(d.message)}"
     lines = [head]
     if src is not None and d.pos.line >= 1:
         lines.extend(_shown_source(src, d.pos))

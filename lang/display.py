@@ -121,12 +121,16 @@ def render_line(line: str, column: int, width: int = 1) -> tuple:
     text = "".join(cells[i][0] for i in shown)
     origin = starts[first] if first < len(cells) else total
     indent = (1 if left_mark else 0) + max(0, caret - origin)
-    underline = max(1, min(caret_end, b) - caret)
+    # The underline ends where the shown text ends (a cut escape is not shown).
+    shown_end = starts[shown[-1]] + cells[shown[-1]][1] if shown else caret
+    underline = max(1, min(caret_end, shown_end) - caret)
     return (("…" if left_mark else "") + text + ("…" if right_mark else ""),
             " " * indent + "^" + "~" * (underline - 1))
 
 
-_memo: list = [None, 1, 0]  # the last source looked up, a line number, that line's offset
+# The last look-up: (source, line number, offset of that line). One tuple,
+# replaced whole, so that threads formatting diagnostics never mix two.
+_memo: tuple = (None, 1, 0)
 
 
 def line_start(source: str, number: int):
@@ -136,8 +140,10 @@ def line_start(source: str, number: int):
     and U+2028 do not end a line). Successive look-ups in one source resume
     from the previous one, so printing many diagnostics in order stays linear.
     """
-    if _memo[0] is source and _memo[1] <= number:
-        k, i = _memo[1], _memo[2]
+    global _memo
+    memo = _memo
+    if memo[0] is source and memo[1] <= number:
+        k, i = memo[1], memo[2]
     else:
         k, i = 1, 0
     while number - k >= _SKIP_LINES:
@@ -150,7 +156,7 @@ def line_start(source: str, number: int):
         if j < 0:
             return None
         i, k = j + 1, k + 1
-    _memo[:] = [source, number, i]
+    _memo = (source, number, i)
     return i
 
 

@@ -13,6 +13,7 @@ import unicodedata
 
 import pytest
 from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, format_diagnostic
 from liganimate.lang.display import MAX_COLUMNS
@@ -207,6 +208,24 @@ def test_a_wide_token_is_underlined_over_its_full_width():
     d = Diagnostic("t.lig", Pos(1, 5, 1, 9), "bad", source="X = '漢字' * * 1")
     caret = format_diagnostic(d).split("\n")[2][4:]
     assert caret == "    ^" + "~" * 5
+
+
+_CHARS = st.sampled_from(list("ab =*(") + ["\t", "\x1b", "\x00", "\x7f", "\x85", "\x9b", "\u202e", "\u2066",
+                                           "\u200b", "\ufeff", "\u2028", "漢", "字", "Ａ", "é", "\U0001f600"])
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(_CHARS, max_size=400), st.lists(_CHARS, max_size=400), st.integers(1, 50))
+def test_any_line_is_shown_escaped_short_and_with_the_caret_under_its_character(left, right, span):
+    line = "".join(left) + "Z" + "".join(right)
+    column = len(left) + 1
+    d = Diagnostic("t.lig", Pos(1, column, 1, column + span), "bad", source=line + "\n")
+    out = format_diagnostic(d)
+    assert raw_controls(out) == []
+    shown, caret = (s[4:] for s in out.split("\n")[1:3])
+    assert width(shown) <= MAX_COLUMNS + 2
+    assert caret_target(shown, caret) == "Z"
+    assert set(caret) <= {" ", "^", "~"} and len(caret) <= width(shown) + 1
 
 
 def test_file_name_message_hint_and_notes_are_escaped():
