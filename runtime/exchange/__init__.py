@@ -23,7 +23,7 @@ from ._bvh_write import bvh_files, bvh_text
 from ._collect import ModelTake, SceneCollector, SceneTake, collect
 from ._files import write_files
 from ._gltf import gltf_bytes, gltf_document
-from ._lig_write import lig_library, read_root_path
+from ._lig_write import clip_angles, lig_library, read_root_path
 
 __all__ = [
     "BvhClip",
@@ -32,6 +32,7 @@ __all__ = [
     "SceneTake",
     "bvh_files",
     "bvh_text",
+    "clip_angles",
     "collect",
     "gltf_bytes",
     "gltf_document",

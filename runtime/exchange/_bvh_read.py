@@ -109,8 +109,12 @@ class _Tokens:
         raise LigDiagnostics([Diagnostic(self.filename, pos, message, hint, source=self.text)])
 
     def end_pos(self) -> Pos:
-        n = len(self.lines) + 1
-        return Pos(n, 1, n, 1)
+        """Just after the last character that is not blank (1:1 for an empty file)."""
+        for i in range(len(self.lines) - 1, -1, -1):
+            line = self.lines[i].rstrip()
+            if line:
+                return Pos(i + 1, len(line) + 1, i + 1, len(line) + 1)
+        return Pos(1, 1, 1, 1)
 
     def _fill(self) -> bool:
         while not self.pending:
