@@ -9,7 +9,6 @@ runs, so building it never recurses.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional, Union
 
 
 @dataclass(frozen=True, slots=True)
@@ -21,10 +20,27 @@ class Pos:
     end_line: int
     end_column: int
 
-    def to(self, other: "Pos") -> "Pos":
+    def to(self, other: Pos) -> Pos:
         """The span from the start of ``self`` to the end of ``other``."""
         return Pos(self.line, self.column, other.end_line, other.end_column)
 
+
+def _init_pos(self, line: int, column: int, end_line: int, end_column: int) -> None:
+    _set_line(self, line)
+    _set_column(self, column)
+    _set_end_line(self, end_line)
+    _set_end_column(self, end_column)
+
+
+# A frozen dataclass's __init__ assigns through object.__setattr__, which made
+# each Pos cost three times a plain object; a big program makes millions. The
+# slots' own setters do the same job; assigning to a field from outside still
+# raises FrozenInstanceError.
+_set_line, _set_column = Pos.line.__set__, Pos.column.__set__
+_set_end_line, _set_end_column = Pos.end_line.__set__, Pos.end_column.__set__
+_init_pos.__doc__ = Pos.__init__.__doc__
+_init_pos.__qualname__ = "Pos.__init__"
+Pos.__init__ = _init_pos  # type: ignore[method-assign]
 
 NOWHERE = Pos(0, 0, 0, 0)
 
@@ -39,7 +55,7 @@ class Node:
 
 @dataclass(slots=True)
 class Num(Node):
-    value: Union[int, float]
+    value: int | float
     text: str
 
 
@@ -78,7 +94,7 @@ class Modifier(Node):
 
     kind: str  # trans_joints trans rot scale_model scale_extremes scale_frames scale lightness
     arg: Node
-    axis: Optional[str] = None
+    axis: str | None = None
 
 
 @dataclass(slots=True)
@@ -161,7 +177,7 @@ class Assign(Node):
 class Keyframe(Node):
     frame: Node
     position: list  # 1 vector expression or 3 numbers
-    method: Optional[Name]
+    method: Name | None
 
 
 @dataclass(slots=True)
@@ -181,7 +197,7 @@ class DoHeader(Node):
     var: Name
     start: Node
     stop: Node
-    step: Optional[Node]
+    step: Node | None
 
 
 @dataclass(slots=True)
@@ -195,7 +211,7 @@ class Do(Node):
     var: Name
     start: Node
     stop: Node
-    step: Optional[Node]
+    step: Node | None
     body: list
     end_pos: Pos = NOWHERE
 
@@ -204,7 +220,7 @@ class Do(Node):
 class If(Node):
     cond: Node
     then: list
-    orelse: Optional[list]
+    orelse: list | None
 
 
 @dataclass(slots=True)
@@ -221,7 +237,7 @@ class ModelBlock(Node):
 @dataclass(slots=True)
 class MotionJoint(Node):
     joint: Node
-    start: Optional[list]
+    start: list | None
     keyframes: list
 
 
@@ -236,12 +252,12 @@ class Goal(Node):
     """One goal of a REACH block: ``kind`` is "point", "plane" or "axis"."""
 
     kind: str
-    link: Optional[Name]  # a link name, or None when ``joint`` names it
-    joint: Optional[Node]  # GOAL JOINT n: the link joint n attaches
-    point: Optional[Node]  # AT (p): the point in the link's coordinates
-    target: Optional[Node]  # point: TO (x); plane: its point; axis: ALONG (d)
-    normal: Optional[Node]  # plane: NORMAL (n); axis: AXIS (a) in the link
-    weight: Optional[Node]
+    link: Name | None  # a link name, or None when ``joint`` names it
+    joint: Node | None  # GOAL JOINT n: the link joint n attaches
+    point: Node | None  # AT (p): the point in the link's coordinates
+    target: Node | None  # point: TO (x); plane: its point; axis: ALONG (d)
+    normal: Node | None  # plane: NORMAL (n); axis: AXIS (a) in the link
+    weight: Node | None
 
 
 @dataclass(slots=True)
@@ -249,24 +265,24 @@ class ReachBlock(Node):
     name: Name
     model: Node
     frames: Node
-    method: Optional[Name]
-    start: Optional[Node]  # FROM motion
+    method: Name | None
+    start: Node | None  # FROM motion
     goals: list  # of Goal
-    joints: Optional[list] = None  # MOVE JOINTS ...
-    chain: Optional[Node] = None  # MOVE CHAIN n
-    translate: Optional[Name] = None  # TRANSLATE INTO v
-    solver: Optional[Name] = None
-    tolerance: Optional[Node] = None
-    iterations: Optional[Node] = None
+    joints: list | None = None  # MOVE JOINTS ...
+    chain: Node | None = None  # MOVE CHAIN n
+    translate: Name | None = None  # TRANSLATE INTO v
+    solver: Name | None = None
+    tolerance: Node | None = None
+    iterations: Node | None = None
     options: dict = field(default_factory=dict)  # option word -> Pos of its first use (for duplicates)
 
 
 @dataclass(slots=True)
 class FigureStmt(Node):
     model: Name
-    kind: Optional[str]  # None, LINK or JOINT
-    link: Optional[Name] = None
-    joint: Optional[Node] = None
+    kind: str | None  # None, LINK or JOINT
+    link: Name | None = None
+    joint: Node | None = None
 
 
 @dataclass(slots=True)
@@ -274,7 +290,7 @@ class Scene(Node):
     scene_id: Node
     init: list
     length: Node
-    sameframe: Optional[Node]
+    sameframe: Node | None
     body: list
     start_pos: Pos = NOWHERE
 
@@ -373,7 +389,7 @@ class PatternDef(Node):
 class PrimitiveDef(Node):
     name: Name
     body: list
-    pattern: Optional[PatternDef] = None
+    pattern: PatternDef | None = None
 
 
 @dataclass(slots=True)

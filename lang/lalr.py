@@ -17,12 +17,51 @@ against Lark's stock contextual lexer and loop), and errors are Lark's
 
 from __future__ import annotations
 
+import functools
+from operator import itemgetter
+
 from lark.exceptions import UnexpectedToken
 from lark.lexer import Token
-from lark.parse_tree_builder import ExpandSingleChild
+from lark.parse_tree_builder import ChildFilterLALR_NoPlaceholders, ExpandSingleChild
 from lark.parsers.lalr_analysis import Shift
 
-from .lexer import Scanner
+from .lexer import _SCAN, DOLLAR, NUMBER, OPERATOR, STRING, WORD, Scanner, Tok
+
+
+class _Inlined(tuple):
+    """The value of a ``_rule``, which its parent's child filter splices in.
+
+    Lark makes a ``Tree`` for it (through the transformer's ``__default__``)
+    only for the parent to read ``.children``: one per statement of a
+    program, for nothing. This is that ``.children`` and no more.
+    """
+
+    __slots__ = ()
+    children = property(itemgetter(0))
+
+
+def _inline(children: list) -> _Inlined:
+    return _new_tuple(_Inlined, (children,))
+
+
+_new_tuple = tuple.__new__
+
+
+def _inlined(callback):
+    """``callback`` with Lark's tree for an inlined ``_rule`` replaced by :class:`_Inlined`.
+
+    Only the two shapes Lark's tree builder gives such a rule are changed (a
+    child filter around the default callback, or the default callback
+    alone); any other is kept as it is, which is slower but the same.
+    """
+    def is_default(f):
+        return isinstance(f, functools.partial) and getattr(f.func, "__name__", "") == "default_callback"
+
+    if type(callback) is ChildFilterLALR_NoPlaceholders and is_default(callback.node_builder):
+        return ChildFilterLALR_NoPlaceholders(callback.to_include, _inline)
+    if is_default(callback):
+        return _inline
+    return callback
 
 
 class Driver:
@@ -59,6 +98,7 @@ class Driver:
         self.start = table.start_states["start"]
         self.end = table.end_states["start"]
         self.scanner = Scanner(lark.terminals, table.states)
+        self._chains: dict = {}  # see _chain
 
     @staticmethod
     def _rule(rule, callback):
@@ -67,19 +107,72 @@ class Driver:
         # transformer; when nothing else wraps it, the reduction is a no-op.
         keeps_child = (size == 1 and type(callback) is ExpandSingleChild and not rule.expansion[0].is_term
                        and not rule.expansion[0].name.startswith("_"))
-        return size, rule.origin.name, None if keeps_child else callback
+        if keeps_child:
+            return size, rule.origin.name, None
+        if rule.origin.name.startswith("_"):
+            callback = _inlined(callback)
+        return size, rule.origin.name, callback
 
     def parse(self, text: str, primitives: frozenset):
-        """Parse ``text``; a NAME in ``primitives`` is a PRIM_NAME. Returns the start rule's value."""
+        """Parse ``text``; a NAME in ``primitives`` is a PRIM_NAME. Returns the start rule's value.
+
+        The scanner's loop (:meth:`Scanner.tokens`) and the LALR loop in
+        one: a generator between them cost a fifth of the time. The
+        scanner's decisions are its own methods, shared with ``tokens``.
+        """
         actions = self.actions
         rules = self.rules
+        chains = self._chains
+        scanner = self.scanner
+        keywords = scanner.tables.keywords
+        choice = scanner._choice
         stack = [self.start]
         values: list = []
         push_state = stack.append
         push_value = values.append
+        scan = _SCAN.match
+        count = text.count
+        pos = 0
+        line, line_start = 1, 0
         tok = None
-        for tok in self.scanner.tokens(text, stack, primitives):
-            ttype = tok[0]
+        while True:
+            # ------------------------------------------------ next token
+            m = scan(text, pos)
+            k = m.lastindex if m is not None else None
+            if not k:
+                scanner.unexpected_character(text, pos, line, stack[-1])
+            start = m.start(k)
+            if start != pos:
+                nl = count("\n", pos, start)
+                if nl:
+                    line += nl
+                    line_start = text.rfind("\n", pos, start) + 1
+            end = m.end()
+            value = text[start:end]
+            if k == WORD:
+                word = value.upper()
+                if word in keywords:
+                    ttype = scanner.keyword(word, stack[-1], text, end)
+                    if ttype == "NAME" and word in primitives:
+                        ttype = "PRIM_NAME"
+                else:
+                    ttype = "PRIM_NAME" if word in primitives else "NAME"
+            elif k == NUMBER:
+                ttype = "NUMBER"
+            elif k == OPERATOR:
+                ttype = choice.get((stack[-1], value))
+                if ttype is None:
+                    ttype, value, end = scanner._operator(value, start, stack[-1])
+            elif k == STRING:
+                ttype = "STRING"
+            elif k == DOLLAR:
+                ttype = "DOLLAR_NAME"
+            else:
+                break
+            column = start - line_start + 1
+            tok = _new_tuple(Tok, (ttype, value, start, line, column, column + end - start, end))
+            pos = end
+            # ------------------------------------------------ feed it
             while True:
                 code = actions[stack[-1]].get(ttype)
                 if code is None:
@@ -90,7 +183,11 @@ class Driver:
                     break
                 size, origin, callback = rules[~code]
                 if callback is None:
-                    stack[-1] = actions[stack[-2]][origin]
+                    # A run of one-child ?rules (expr <- sum <- product ...):
+                    # where it ends depends only on these three, so take it in one step.
+                    key = (stack[-2], stack[-1], ttype)
+                    top = chains.get(key)
+                    stack[-1] = top if top is not None else self._chain(key)
                     continue
                 if size:
                     children = values[-size:]
@@ -100,11 +197,11 @@ class Driver:
                     children = []
                 push_value(callback(children))
                 push_state(actions[stack[-1]][origin])
-        end = Token.new_borrow_pos("$END", "", tok.as_lark()) if tok is not None else Token("$END", "", 0, 1, 1)
+        end_tok = Token.new_borrow_pos("$END", "", tok.as_lark()) if tok is not None else Token("$END", "", 0, 1, 1)
         while True:
             code = actions[stack[-1]].get("$END")
             if code is None or code >= 0:
-                raise self._unexpected(end, stack[-1])
+                raise self._unexpected(end_tok, stack[-1])
             size, origin, callback = rules[~code]
             if callback is None:
                 stack[-1] = actions[stack[-2]][origin]
@@ -119,6 +216,17 @@ class Driver:
                 push_state(actions[stack[-1]][origin])
             if stack[-1] == self.end:
                 return values[-1]
+
+    def _chain(self, key: tuple) -> int:
+        """The state a run of one-child ?rule reductions ends in, from (state below, state, lookahead)."""
+        below, top, ttype = key
+        while True:
+            code = self.actions[top].get(ttype)
+            if code is None or code >= 0 or self.rules[~code][2] is not None:
+                break
+            top = self.actions[below][self.rules[~code][1]]
+        self._chains[key] = top
+        return top
 
     def _unexpected(self, token: Token, state) -> UnexpectedToken:
         expected = {s for s in self.actions[state] if s.isupper()}

@@ -41,6 +41,8 @@ _SCAN = re.compile(
     + r"|(?P<end>\Z))"
 )
 _NEWLINE = "\n"
+#: _SCAN's groups, by number (Match.lastindex).
+WORD, NUMBER, STRING, DOLLAR, OPERATOR, END = range(1, 7)
 
 # Operator spellings, longest first, and the terminals each may be (in Lark's order).
 _OPERATORS = {
@@ -92,6 +94,8 @@ class GrammarTables:
                     self.strong.setdefault(w, []).append((t.name, lookahead))
                     if lookahead:
                         self.contextual.add(w)
+        #: Every word that is a keyword somewhere; any other word is always a NAME.
+        self.keywords = frozenset(self.strong) | frozenset(self.plain)
 
     def word_candidates(self, word: str, text: str, end: int) -> tuple:
         """Terminals the word may be, strongest first (NAME last)."""
@@ -197,57 +201,63 @@ class Scanner:
         line, line_start = 1, 0
         scan = _SCAN.match
         tables = self.tables
-        contextual = tables.contextual
+        keywords = tables.keywords
         choice = self._choice
         count = text.count
         while True:
             m = scan(text, pos)
-            if m is None or not m.lastindex:
-                # Nothing we know starts here: skip what can be skipped, report the character.
-                skipped = re.compile(_SKIP).match(text, pos).end()
-                line += count(_NEWLINE, pos, skipped)
-                line_start = text.rfind(_NEWLINE, 0, skipped) + 1
-                raise UnexpectedCharacters(text, skipped, line, skipped - line_start + 1,
-                                           allowed=self.accepted(stack[-1]))
-            start = m.start(m.lastindex)
+            k = m.lastindex if m is not None else None
+            if not k:
+                self.unexpected_character(text, pos, line, stack[-1])
+            start = m.start(k)
             if start != pos:
                 nl = count(_NEWLINE, pos, start)
                 if nl:
                     line += nl
                     line_start = text.rfind(_NEWLINE, pos, start) + 1
-            kind = m.lastgroup
             end = m.end()
-            if kind == "w":
-                value = text[start:end]
+            value = text[start:end]
+            if k == WORD:
                 word = value.upper()
-                key = (stack[-1], word)
-                ttype = choice.get(key)
-                if ttype is None:
-                    candidates = tables.word_candidates(word, text, end)
-                    # A word such as MOTION may be a type or a variable depending on
-                    # what follows it, so its choice is never remembered.
-                    ttype = self._pick(candidates, stack[-1], cache=None if word in contextual else key)
-                if ttype == "NAME" and word in primitives:
-                    ttype = "PRIM_NAME"
-            elif kind == "n":
-                value = text[start:end]
+                if word in keywords:
+                    ttype = self.keyword(word, stack[-1], text, end)
+                    if ttype == "NAME" and word in primitives:
+                        ttype = "PRIM_NAME"
+                else:
+                    ttype = "PRIM_NAME" if word in primitives else "NAME"
+            elif k == NUMBER:
                 ttype = "NUMBER"
-            elif kind == "o":
-                value = text[start:end]
+            elif k == OPERATOR:
                 ttype = choice.get((stack[-1], value))
                 if ttype is None:
                     ttype, value, end = self._operator(value, start, stack[-1])
-            elif kind == "s":
-                value = text[start:end]
+            elif k == STRING:
                 ttype = "STRING"
-            elif kind == "d":
-                value = text[start:end]
+            elif k == DOLLAR:
                 ttype = "DOLLAR_NAME"
             else:
                 return
             column = start - line_start + 1
             yield _new_tok(Tok, (ttype, value, start, line, column, column + end - start, end))
             pos = end
+
+    def keyword(self, word: str, state, text: str, end: int) -> str:
+        """The terminal the keyword ``word`` (upper-cased, ending at ``end``) is in parser state ``state``."""
+        key = (state, word)
+        ttype = self._choice.get(key)
+        if ttype is None:
+            candidates = self.tables.word_candidates(word, text, end)
+            # A word such as MOTION may be a type or a variable depending on
+            # what follows it, so its choice is never remembered.
+            ttype = self._pick(candidates, state, cache=None if word in self.tables.contextual else key)
+        return ttype
+
+    def unexpected_character(self, text: str, pos: int, line: int, state):
+        """Raise UnexpectedCharacters for the first character after ``pos`` that starts no token."""
+        skipped = re.compile(_SKIP).match(text, pos).end()
+        line += text.count(_NEWLINE, pos, skipped)
+        line_start = text.rfind(_NEWLINE, 0, skipped) + 1
+        raise UnexpectedCharacters(text, skipped, line, skipped - line_start + 1, allowed=self.accepted(state))
 
     def _pick(self, candidates, state, cache=None) -> str:
         acc = self.accepted(state)
