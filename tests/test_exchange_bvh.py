@@ -6,6 +6,7 @@ import os
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -404,3 +405,23 @@ def test_another_reader_takes_our_bvh(tmp_path):
     assert bvh.FrameTime == pytest.approx(1 / 24)
     root_positions = np.array([list(k.Position) for k in bvh.Root.Keyframes])
     np.testing.assert_allclose(root_positions[:, 0], 0.02 * np.arange(20), atol=1e-6)
+
+
+@pytest.mark.parametrize("tolerance", [0.05, 1.0])
+def test_fewer_keyframes_within_a_stated_tolerance(tmp_path, tolerance):
+    bvh = tmp_path / "capture.bvh"
+    _bvhio_file(bvh, frames=240)  # a second at 240 Hz
+    full, reduced = str(tmp_path / "full.lig"), str(tmp_path / "reduced.lig")
+    assert _cli("import", str(bvh), "-o", full, "--motion", "M", "--model", "F").returncode == 0
+    r = _cli("import", str(bvh), "-o", reduced, "--motion", "M", "--model", "F", "--tolerance", str(tolerance))
+    assert r.returncode == 0, r.stderr
+    count = [Path(p).read_text().count(" FRAME ") for p in (full, reduced)]
+    assert count[1] < 0.8 * count[0], count
+    played = []
+    for lib in (full, reduced):
+        folder = tmp_path / os.path.basename(lib)[:-4]
+        folder.mkdir()
+        (folder / "lib.lig").write_text(Path(lib).read_text())
+        played.append(X.collect(load_program(_player(folder, str(folder / "lib.lig"), "F", "M", 240))[0])[0].models[0])
+    diff = (played[0].angles - played[1].angles + 180.0) % 360.0 - 180.0
+    assert 0 < np.abs(diff).max() <= tolerance

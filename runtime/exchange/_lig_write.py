@@ -29,10 +29,11 @@ import re
 import numpy as np
 from liganimate.compiler.types import BUILTINS
 
+from ..motion import Motion
 from ._numbers import format_rows
 from ._rotations import euler_zyx_from_matrix, matrix_from_axes
 
-__all__ = ["ROOT_PATH_MARK", "clip_angles", "lig_library", "read_root_path"]
+__all__ = ["ROOT_PATH_MARK", "clip_angles", "lig_library", "read_root_path", "reduce_keyframes"]
 
 ROOT_PATH_MARK = "ROOT PATH"
 DECIMALS = 7
@@ -158,7 +159,8 @@ def _comment_text(text: str) -> str:
     return re.sub(r"[{}\x00-\x1f\x7f]", "?", text)
 
 
-def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_name: str | None = None) -> bytes:
+def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_name: str | None = None,
+                tolerance: float = 0.0) -> bytes:
     """The text of a LIG library holding a BVH clip's skeleton as a MODEL and its frames as a MOTION.
 
     Parameters
@@ -168,6 +170,11 @@ def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_n
         The variable names (valid LIG names, checked by the caller).
     source_name : str, optional
         The BVH file's name as the comments mention it.
+    tolerance : float
+        Degrees.  0 (the default) keeps a keyframe at every frame; a
+        positive tolerance drops the keyframes that the motion, as LIG plays
+        it, can do without while every angle at every frame stays within
+        ``tolerance`` of the captured one (see :func:`reduce_keyframes`).
 
     Returns
     -------
@@ -200,7 +207,8 @@ def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_n
         out.append(f"C   {j + 1:<5}  {links[j]:<18} {_comment_text(clip.names[j])} ({' '.join(clip.channels[j]) or 'none'})")
     out.append("")
     out.append(f"{{@ {model}: the skeleton of {src}, {J} joints, every axis free }}")
-    out.append(f"{{@ {motion}: {F} frames of {src} at {fps:g} frames per second, one keyframe per frame }}")
+    kept = "one keyframe per frame" if tolerance <= 0 else f"keyframes within {tolerance:g} degrees"
+    out.append(f"{{@ {motion}: {F} frames of {src} at {fps:g} frames per second, {kept} }}")
     out.append("")
     out.append("      GRAPHICAL ORIGIN")
     for k in range(0, J, 6):
@@ -231,11 +239,12 @@ def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_n
     out.append("      ENDMODEL")
     out.append("")
     head = ("\n".join(out) + "\n").encode("utf-8")
-    return head + _motion_text(motion, angles, rotating) + _path_table(path)
+    keep = reduce_keyframes(angles, tolerance) if tolerance > 0 else None
+    return head + _motion_text(motion, angles, rotating, keep) + _path_table(path)
 
 
-def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray) -> bytes:
-    """STARTMOTION ... ENDMOTION with a keyframe per frame for every joint that moves."""
+def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None) -> bytes:
+    """STARTMOTION ... ENDMOTION: keyframes at every frame (or at ``keep[j]``) for every joint that moves."""
     F, J = angles.shape[:2]
     parts = [f"      STARTMOTION {name}\n".encode("ascii")]
     moving = (angles != angles[:1]).any(axis=(0, 2)) if F > 1 else np.zeros(J, dtype=bool)
@@ -248,7 +257,8 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray) -> bytes:
         start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {j + 1} POSITION", suffix="\n")
         parts.append(start)
         if moving[j]:
-            table = np.column_stack([frames, angles[1:, j]])
+            rows = np.arange(1, F) if keep is None else keep[j][keep[j] > 0]
+            table = np.column_stack([frames[rows - 1], angles[rows, j]])
             parts.append(format_rows(table, [0, DECIMALS, DECIMALS, DECIMALS],
                                      columns_prefix=["          FRAME", " POSITION", ",", ","], suffix="\n"))
     parts.append(b"      ENDMOTION\n")
@@ -291,3 +301,77 @@ def read_root_path(path: str) -> np.ndarray:
     rows = body.split("\n")[2:]
     table = np.array([[float(v) for v in r.split()] for r in rows if r.strip()], dtype=np.float64).reshape(-1, 4)
     return table[np.argsort(table[:, 0], kind="stable"), 1:]
+
+
+def _wrapped(d: np.ndarray) -> np.ndarray:
+    return (d + 180.0) % 360.0 - 180.0
+
+
+def reduce_keyframes(angles: np.ndarray, tolerance: float, rounds: int = 64) -> list:
+    """Which frames each joint needs as keyframes to stay within ``tolerance`` degrees everywhere.
+
+    Parameters
+    ----------
+    angles : ndarray, shape (F, J, 3)
+        The captured angles (unwrapped along the frames).
+    tolerance : float
+        Degrees, per axis, at every integer frame.
+
+    Returns
+    -------
+    list of ndarray of int
+        Per joint, the kept frames, ascending, always with the first and the
+        last.
+
+    Notes
+    -----
+    Frames are first dropped where a straight line between the kept ones
+    stays within half the tolerance (and no two kept keyframes differ by
+    180 degrees or more, which the player would take the short way round).
+    That is then checked against the motion as LIG evaluates it (LINEAR
+    with its velocity ramps, free axes unwrapped), at the values as written
+    (seven decimals); frames that miss are kept again, until none miss.
+    """
+    F, J = angles.shape[:2]
+    values = np.round(angles, DECIMALS)
+    keep = [_linear_keep(values[:, j], tolerance / 2.0) for j in range(J)]
+    frames = np.arange(F, dtype=np.float64)
+    budget = tolerance - 10.0 ** -DECIMALS
+    for _ in range(rounds):
+        spec = {j + 1: (values[0, j], [(float(f), values[f, j], "LINEAR") for f in keep[j][1:].tolist()])
+                for j in range(J)}
+        motion = Motion.from_tracks(spec).unwrapped({j + 1: (True, True, True) for j in range(J)})
+        played = motion.evaluate(frames)
+        miss = np.abs(_wrapped(played - values)).max(axis=2) > budget  # (F, J)
+        if not miss.any():
+            return keep
+        for j in np.flatnonzero(miss.any(axis=0)):
+            keep[j] = np.union1d(keep[j], np.flatnonzero(miss[:, j]))
+    return [np.arange(F) for _ in range(J)]
+
+
+def _linear_keep(v: np.ndarray, tol: float) -> np.ndarray:
+    """Frames of one joint's (F, 3) curve to keep so that straight lines between them stay within ``tol``."""
+    F = len(v)
+    kept = np.arange(F)
+    while len(kept) > 2:
+        # Try dropping every other interior keyframe at once; each gap then
+        # spans two old gaps, and is checked over every frame inside it.
+        trial = np.concatenate([kept[::2], kept[-1:]]) if len(kept) % 2 == 0 else kept[::2]
+        dropped = np.setdiff1d(kept, trial)
+        seg = np.searchsorted(trial, np.arange(F), side="right") - 1
+        seg = seg.clip(0, len(trial) - 2)
+        a, b = trial[seg], trial[seg + 1]
+        u = ((np.arange(F) - a) / (b - a))[:, None]
+        err = np.abs(v[a] + u * (v[b] - v[a]) - v).max(axis=1)
+        span_err = np.zeros(len(trial) - 1)
+        np.maximum.at(span_err, seg, err)
+        jump = np.abs(np.diff(v[trial], axis=0)).max(axis=1) >= 180.0
+        bad_span = (span_err > tol) | jump
+        # A dropped frame comes back when the gap it sat in is too coarse.
+        restore = dropped[bad_span[np.searchsorted(trial, dropped) - 1]]
+        new = np.union1d(trial, restore)
+        if len(new) == len(kept):
+            break
+        kept = new
+    return kept

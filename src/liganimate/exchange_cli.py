@@ -26,6 +26,16 @@ def _fps(text: str) -> float:
     return value
 
 
+def _degrees(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of degrees") from None
+    if not (0 <= value < 180):
+        raise argparse.ArgumentTypeError(f"the tolerance must be at least 0 and below 180 degrees, not {text}")
+    return value
+
+
 def _lig_name(text: str) -> str:
     if not _NAME.match(text):
         raise argparse.ArgumentTypeError(f"{text!r} is not a LIG name (a letter, then letters, digits and _)")
@@ -54,6 +64,8 @@ def add_commands(subparsers) -> None:
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
     p.add_argument("--model", type=_lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
     p.add_argument("--motion", type=_lig_name, help="the MOTION's name (default: <STEM>)")
+    p.add_argument("--tolerance", type=_degrees, default=0.0, metavar="DEG",
+                   help="drop keyframes while every angle stays within DEG degrees (default 0: every frame)")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_import)
 
@@ -114,7 +126,8 @@ def cmd_import(args) -> int:
                            "give them different names with --model and --motion")
         out = args.output or f"{stem}.lig"
         clip = X.read_bvh(args.file)
-        text = X.lig_library(clip, model=model, motion=motion, source_name=os.path.basename(args.file))
+        text = X.lig_library(clip, model=model, motion=motion, source_name=os.path.basename(args.file),
+                             tolerance=args.tolerance)
         X.write_files([(out, text)])
         if not args.quiet:
             sys.stderr.write(f"wrote {out}: MODEL {model} and MOTION {motion} "
