@@ -12,6 +12,9 @@ import numpy as np
 import pytest
 from exchange_support import pose_records
 from liganimate.runtime import exchange as X
+
+# bvhio imports PyGLM under its old name; not ours to fix.
+pytestmark = pytest.mark.filterwarnings("ignore:Importing PyGLM:PendingDeprecationWarning")
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.transform import Rotation
 
@@ -425,3 +428,25 @@ def test_fewer_keyframes_within_a_stated_tolerance(tmp_path, tolerance):
         played.append(X.collect(load_program(_player(folder, str(folder / "lib.lig"), "F", "M", 240))[0])[0].models[0])
     diff = (played[0].angles - played[1].angles + 180.0) % 360.0 - 180.0
     assert 0 < np.abs(diff).max() <= tolerance
+
+
+def test_awkward_joint_names_become_safe_segment_names(tmp_path):
+    """Spaces, braces, digits first, keywords, function names, repeats: the library still LOADs."""
+    names = ["Hips", "left hand", "Spine{1}", "2nd", "JOINT", "SIN", "ORIGIN", "Hips", "C", "end"]
+    lines = ["HIERARCHY", f"ROOT {names[0]}", "{", "  OFFSET 0 0 0",
+             "  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation"]
+    for n in names[1:]:
+        lines += [f"  JOINT {n}", "  {", "    OFFSET 0 1 0", "    CHANNELS 3 Zrotation Xrotation Yrotation",
+                  "    End Site", "    {", "      OFFSET 0 1 0", "    }", "  }"]
+    lines += ["}", "MOTION", "Frames: 2", "Frame Time: 0.1"]
+    lines += [" ".join(["0"] * (6 + 3 * 9)), " ".join(["1"] * (6 + 3 * 9))]
+    bvh = _write(tmp_path, "odd {name}.bvh", "\n".join(lines) + "\n")
+    lib = str(tmp_path / "odd.lig")
+    r = _cli("import", bvh, "-o", lib, "--model", "ODD", "--motion", "MOVE")
+    assert r.returncode == 0, r.stderr
+    text = Path(lib).read_text()
+    segments = re.findall(r"JOINT \d+, \w+, \([^)]*\), (\w+),", text)
+    assert segments == ["HIPS", "LEFT_HAND", "SPINE_1", "J_2ND", "JOINT_", "SIN_", "ORIGIN_", "HIPS_2", "C", "END_"]
+    take = X.collect(load_program(_player(tmp_path, lib, "ODD", "MOVE", 2))[0])[0].models[0]
+    assert take.figure.n_joints == 10
+    assert [l.name for l in take.figure.links[1:]] == segments

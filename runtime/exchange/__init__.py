@@ -13,7 +13,8 @@ This sub-package owns the exchange formats and nothing else:
 
 It may import the runtime (figure, kinematics, pose, motion, camera, values,
 errors), ``liganimate.lang.diagnostics`` and ``liganimate.lang.ast`` for
-diagnostics, numpy and pygltflib.  Nothing in the runtime, the compiler or
+diagnostics, ``liganimate.compiler.types`` for the names of the built-in
+functions (which imported segment names avoid), numpy and pygltflib.  Nothing in the runtime, the compiler or
 the language imports it; the command line reaches it through
 ``liganimate.exchange_cli``.  See ``docs/exchange.md``.
 """
