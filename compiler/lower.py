@@ -302,7 +302,8 @@ class Lowerer:
         animated = info.animated
         if animated:
             self.emit(f"_base = {_tuple_value(animated)}")
-        self.emit(f"for _tick in rt.ticks({self.expr(s.length)}, {sameframe}, {self.at(s)}):")
+        sameframe_at = self.at(s.sameframe) if s.sameframe is not None else "None"
+        self.emit(f"for _tick in rt.ticks({self.expr(s.length)}, {sameframe}, {self.at(s.length)}, {sameframe_at}):")
         self.indent += 1
         if animated:
             self.emit(f"{_tuple_target(animated)} = _base")
@@ -368,7 +369,7 @@ class Lowerer:
 
     def s_DrawPoly(self, s, where):
         pts = "".join(self.expr(p) + ", " for p in s.points)
-        self.emit(f"_g.poly(({pts}), {self.at(s)})")
+        self.emit(f"rt.poly(_g, ({pts}), {self.at(s)})")
 
     # -------------------------------------------------------- expressions
     def expr(self, e) -> str:
@@ -457,8 +458,10 @@ class Lowerer:
                 args.append(f"{slot.param}={code}")
         pdef = self.c.primitives[e.name][0]
         own = pdef is not None or e.name in self.c.loaded_primitives
-        fn = f"_prim_{e.name}" if own else f"rt.prim_{e.name}"
-        return f"{fn}(rt, {', '.join(args)})"
+        if own:
+            return f"_prim_{e.name}(rt, {', '.join(args)})"
+        args.append(f"_at={self.at(e)}")  # a built-in primitive reports its own failures here
+        return f"rt.prim_{e.name}(rt, {', '.join(args)})"
 
     def e_JointExpr(self, e):
         a = e.args

@@ -39,8 +39,11 @@ MAX_SCENE_LENGTH = 10_000_000
 MAX_FRAME = 1e9
 """The latest frame a keyframe, a solved REACH pose or a stretched motion may put a keyframe at."""
 
-MIN_FRAME_GAP = 1e-6
-"""The closest two keyframes of a joint may be, in frames, unless they share a frame (a step)."""
+MIN_FRAME_GAP = 1e-100
+"""The closest two keyframes of a joint may be, in frames, unless they share a frame (a step).
+
+Closer keyframes would make the interpolation's speeds overflow; the bound
+sits far below any rounding noise between frames of everyday size."""
 
 MAX_ANGLE = 1e9
 """The largest angle, in degrees, a keyframe or a starting position may hold."""

@@ -31,24 +31,26 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import operator
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import NamedTuple, Sequence
+from typing import NamedTuple
 
 import numpy as np
+from liganimate.lang.numbers import INT_MAX, MAX_ANGLE
 
 from .errors import FigureError
 
 __all__ = [
     "AXES",
-    "Link",
-    "Joint",
     "Figure",
+    "Joint",
     "JointSpec",
+    "Link",
     "TraversalLevel",
-    "normalize_extremes",
-    "join",
     "assemble",
+    "join",
+    "normalize_extremes",
 ]
 
 AXES = ("X", "Y", "Z")
@@ -95,7 +97,9 @@ def _frozen(value, shape: tuple[int, ...], what: str) -> np.ndarray:
     if arr.shape != shape:
         raise FigureError(f"{what} must have shape {shape}, not {arr.shape}.")
     if not np.all(np.isfinite(arr)):
-        raise FigureError(f"{what} must be finite numbers, not {value!r}.")
+        # Never the array itself in the sentence: a diagnostic is one plain line.
+        bad = arr[~np.isfinite(arr)].flat[0]
+        raise FigureError(f"{what} must be finite numbers; one of them is {bad}.")
     arr = arr + 0.0  # turns -0.0 into 0.0 so printing and comparisons stay tidy
     arr.setflags(write=False)
     return arr
@@ -150,6 +154,9 @@ def normalize_extremes(extremes) -> np.ndarray:
         )
     if not np.all(np.isfinite(arr)):
         raise FigureError("joint extremes must be finite numbers of degrees.")
+    if not np.all(np.abs(arr) <= MAX_ANGLE):
+        raise FigureError(f"joint extremes must lie within ±{MAX_ANGLE:g} degrees.",
+                          hint="a range of 360 degrees or more already lets the joint turn freely")
     out = np.zeros((3, 2))
     out[: arr.shape[0]] = arr
     for axis in range(3):
@@ -351,7 +358,7 @@ class Figure:
     # ----------------------------------------------------------------- structure
 
     @classmethod
-    def from_link(cls, link: Link) -> "Figure":
+    def from_link(cls, link: Link) -> Figure:
         """A one-link figure (a graphical object used where a model is expected)."""
         return cls((link,))
 
@@ -500,11 +507,11 @@ class Figure:
 
     # ----------------------------------------------------------------- placement
 
-    def with_placement(self, matrix) -> "Figure":
+    def with_placement(self, matrix) -> Figure:
         """The same figure with host placement ``matrix`` (shape (4, 4))."""
         return dataclasses.replace(self, placement=_frozen(matrix, (4, 4), "a figure's placement"))
 
-    def placed(self, matrix) -> "Figure":
+    def placed(self, matrix) -> Figure:
         """Apply host transform ``matrix`` (shape (4, 4)) after the current placement.
 
         ``HUMAN :- HUMAN <TRANS (v)>`` is ``human.placed(translation(v))``: the
@@ -515,12 +522,15 @@ class Figure:
 
     # ----------------------------------------------------------------- transformations
 
-    def trans_joints(self, n: int) -> "Figure":
+    def trans_joints(self, n: int) -> Figure:
         """TRANS JOINTS BY ``n``: add ``n`` to every joint identifier."""
         n = _joint_id(n)
-        return dataclasses.replace(self, joints=tuple(dataclasses.replace(j, id=j.id + n) for j in self.joints))
+        ids = [j.id + n for j in self.joints]
+        if ids and not -INT_MAX <= min(ids) <= max(ids) <= INT_MAX:
+            raise FigureError(f"TRANS JOINTS {n} makes a joint identifier outside the INTEGER range ±{INT_MAX}.")
+        return dataclasses.replace(self, joints=tuple(dataclasses.replace(j, id=i) for j, i in zip(self.joints, ids)))
 
-    def scale_model(self, r: float) -> "Figure":
+    def scale_model(self, r: float) -> Figure:
         """SCALE MODEL ``r``: scale every link's geometry and every joint location by ``r``.
 
         The links' frames stay rigid: the factor is recorded on each
@@ -544,7 +554,7 @@ class Figure:
         joints = tuple(dataclasses.replace(j, loc1=j.loc1 * r, loc2=j.loc2 * r) for j in self.joints)
         return dataclasses.replace(self, links=links, joints=joints)
 
-    def scale_extremes(self, r: float) -> "Figure":
+    def scale_extremes(self, r: float) -> Figure:
         """SCALE EXTREMES ``r``: multiply every joint extreme by ``r``.
 
         A negative ``r`` mirrors the ranges: ``(a, b) * -1 == (-b, -a)``.
@@ -564,18 +574,18 @@ class Figure:
 
     # ----------------------------------------------------------------- main link
 
-    def with_main(self, link: int) -> "Figure":
+    def with_main(self, link: int) -> Figure:
         """The figure animated from link index ``link`` (the structure is unchanged)."""
         link = operator.index(link)
         if not 0 <= link < len(self.links):
             raise FigureError(f"the model has no link number {link}.")
         return dataclasses.replace(self, main=link)
 
-    def with_original_main(self) -> "Figure":
+    def with_original_main(self) -> Figure:
         """FIGURE m MAIN: animate from the original main link again."""
         return dataclasses.replace(self, main=self.root)
 
-    def with_main_joint(self, joint_id: int) -> "Figure":
+    def with_main_joint(self, joint_id: int) -> Figure:
         """FIGURE m MAIN JOINT ``joint_id``: the joint's secondary link becomes main.
 
         Raises
@@ -585,7 +595,7 @@ class Figure:
         """
         return self.with_main(self.joint(joint_id).secondary)
 
-    def with_main_link(self, name: str, *, model_name: str | None = None) -> tuple["Figure", str | None]:
+    def with_main_link(self, name: str, *, model_name: str | None = None) -> tuple[Figure, str | None]:
         """FIGURE m MAIN LINK ``name``.
 
         Parameters
@@ -646,9 +656,9 @@ class Figure:
         """
         head = f"MODEL {name}: " if name else "MODEL: "
         lines = [
-            f"{head}{self.n_links} links, {self.n_joints} joints; "
+            (f"{head}{self.n_links} links, {self.n_joints} joints; "
             f"original main link {self.links[self.root].label} (node {self.root}); "
-            f"current main link {self.links[self.main].label} (node {self.main})"
+            f"current main link {self.links[self.main].label} (node {self.main})")
         ]
         for i in self.preorder:
             link = self.links[i]
@@ -916,8 +926,8 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
         warnings.append(
             (
                 s.statement_index,
-                f"JOINT {s.joint_id}: {len(cands)} segments are named {s.primary_name}, so the reference is "
-                f"ambiguous; using {made_by}, the latest made before this statement.",
+                (f"JOINT {s.joint_id}: {len(cands)} segments are named {s.primary_name}, so the reference is "
+                f"ambiguous; using {made_by}, the latest made before this statement."),
             )
         )
 

@@ -16,10 +16,12 @@ import re
 import sys
 
 import numpy as np
+from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 
 from . import figure as F
+from . import limits
 from . import motion as M
 from .arithmetic import Arithmetic
 from .errors import LigError
@@ -162,9 +164,16 @@ class Runtime(Arithmetic):
         self.warnings.append(Diagnostic(self.program.name, self.pos(at), message, hint, "warning", self.program.source))
 
     def _guard(self, at, fn, *args):
+        """``fn(*args)``, its LigError or NumberError reported at ``at``.
+
+        numpy's floating-point warnings are silenced: the runtime checks its
+        results (finite, within the limits) and reports at ``at`` instead of
+        letting numpy print.
+        """
         try:
-            return fn(*args)
-        except LigError as exc:
+            with np.errstate(all="ignore"):
+                return fn(*args)
+        except (LigError, N.NumberError) as exc:
             self.fail(at, _sentence(exc.message), exc.hint)
 
     def f_LEN(self, m, at):
@@ -176,9 +185,14 @@ class Runtime(Arithmetic):
         return Canvas()
 
     @staticmethod
-    def prim_BOX(rt, CENTRE=None, WIDTH=None, HEIGHT=None, DEPTH=None, LIGHT=None) -> Graphical:
-        return box(CENTRE if CENTRE is not None else ZERO, WIDTH or 0.0, HEIGHT or 0.0, DEPTH or 0.0,
-                   40.0 if LIGHT is None else LIGHT)
+    def prim_BOX(rt, CENTRE=None, WIDTH=None, HEIGHT=None, DEPTH=None, LIGHT=None, _at=None) -> Graphical:
+        """The built-in BOX primitive (``_at``: the call's position)."""
+        return rt._guard(_at, box, CENTRE if CENTRE is not None else ZERO, WIDTH or 0.0, HEIGHT or 0.0,
+                         DEPTH or 0.0, 40.0 if LIGHT is None else LIGHT)
+
+    def poly(self, canvas: Canvas, points, at) -> None:
+        """DRAW POLY inside a PRIMITIVE."""
+        self._guard(at, canvas.poly, points)
 
     @staticmethod
     def superpose(a: Graphical, b: Graphical) -> Graphical:
@@ -189,7 +203,8 @@ class Runtime(Arithmetic):
             if kind == "lightness":
                 g = g.with_lightness(arg)
             else:
-                g = g.transformed(self._host_matrix(kind, arg, axis, at))
+                g = self._guard(at, g.transformed, self._host_matrix(kind, arg, axis, at))
+                self._guard(at, limits.check_graphical, g, "the transformed object")
         return g
 
     def _host_matrix(self, kind, arg, axis, at) -> np.ndarray:
@@ -228,7 +243,8 @@ class Runtime(Arithmetic):
     def joint(self, jid, primary, loc1, secondary, loc2, extremes, names, at):
         p = self._segment(primary, names[0], at)
         s = self._segment(secondary, names[1], at)
-        return self._guard(at, F.join, jid, p, loc1, s, loc2, extremes)
+        fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes)
+        return self._guard(at, limits.check_figure, fig, "the joined model")
 
     def model_block(self, name, specs, at):
         shapes = {}
@@ -248,7 +264,7 @@ class Runtime(Arithmetic):
             self.fail(at, _sentence(exc.message), exc.hint)
         for index, sentence in warnings:
             self.warn(specs[index][-1], _sentence(sentence))
-        return figure
+        return self._guard(at, limits.check_figure, figure, f"the model {name}")
 
     def modify_model(self, m, mods, at):
         posed = m if isinstance(m, Posed) else None
@@ -261,7 +277,9 @@ class Runtime(Arithmetic):
             elif kind == "scale_extremes":
                 fig = self._guard(at, fig.scale_extremes, arg)
             else:
-                fig = fig.placed(self._host_matrix(kind, arg, axis, at))
+                fig = self._guard(at, fig.placed, self._host_matrix(kind, arg, axis, at))
+            if kind != "scale_extremes":
+                self._guard(at, limits.check_figure, fig, "the transformed model")
         return posed.with_figure(fig) if posed is not None else fig
 
     def figure(self, m, kind, arg, at):
@@ -305,8 +323,10 @@ class Runtime(Arithmetic):
     def set_keyframe(self, m, joint, k, frame, position, method, at):
         if k < 0:
             self.fail(at, f"keyframe numbers start at 0 (the starting position), not {k}")
-        if frame < 0:
-            self.fail(at, f"frame {frame:g} is before the motion starts")
+        if k > N.MAX_KEYFRAME:
+            self.fail(at, f"keyframe {k} is beyond the last keyframe number allowed, {N.MAX_KEYFRAME:,}",
+                      "number the keyframes of each joint 1, 2, 3, ...")
+        self._keyframe_values(frame, position, at)
         base = m.base if isinstance(m, KeyframeEdits) else m
         return KeyframeEdits(base, (joint, k, frame, tuple(position), method, at), m if isinstance(m, KeyframeEdits) else None)
 
@@ -333,18 +353,23 @@ class Runtime(Arithmetic):
                 entry[1][k] = (frame, position, method or "LINEAR", eat, None)
         spec = {}
         for joint, (start, kfs) in tracks.items():
-            n = max(kfs) if kfs else 0
-            missing = [i for i in range(1, n + 1) if i not in kfs]
-            if missing:
+            numbers = sorted(kfs)
+            n = numbers[-1] if numbers else 0
+            if len(numbers) != n:
+                # The keys are 1..n exactly when there are n of them; else find the first gap (O(set), not O(n)).
+                first = next(i for i, k in enumerate(numbers, start=1) if k != i)
                 eat = kfs[n][3] if kfs[n][3] is not None else at
-                self.fail(eat, f"keyframe {n} of joint {joint} is set, but keyframe {missing[0]} never is",
+                self.fail(eat, f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
                           "number the keyframes of each joint 1, 2, 3, ... without gaps")
-            seq = [kfs[i] for i in range(1, n + 1)]
+            seq = [kfs[i] for i in numbers]
             for i in range(1, len(seq)):
-                if seq[i][0] < seq[i - 1][0]:
+                gap = seq[i][0] - seq[i - 1][0]
+                if gap < 0 or 0 < gap < N.MIN_FRAME_GAP:
                     eat = seq[i][3] if seq[i][3] is not None else at
                     self.fail(eat, f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
-                                   f"before keyframe {i} at frame {seq[i - 1][0]:g}")
+                                   + ("before" if gap < 0 else "too close after")
+                                   + f" keyframe {i} at frame {seq[i - 1][0]:g}",
+                              None if gap < 0 else _GAP_HINT)
             spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
         motion = self._guard(at, M.Motion.from_tracks, spec)
         m._cache = motion
@@ -384,14 +409,19 @@ class Runtime(Arithmetic):
             solver=solver, tolerance=tolerance, max_iterations=iterations))
         # Unmet goals, in the solver's own words and by its own test of "met",
         # each shown at its GOAL line.
-        for w in R.residual_warnings(fig, built, result.solution):
+        t = np.asarray(result.translation, dtype=float).reshape(3)
+        if not np.all(np.abs(t) <= N.GEOMETRY_MAX):
+            self.fail(at, "the solved translation is not within the geometry limit",
+                      "the goals may be too far away for the model; everything drawn stays within 1E12 units")
+        with np.errstate(all="ignore"):
+            residual = R.residual_warnings(fig, built, result.solution)
+        for w in residual:
             m = re.match(r"goal (\d+): ", w)
             if m is None:
                 self.warn(at, _sentence(w))
                 continue
             self.warn(goals[int(m.group(1)) - 1][-1], _sentence(w[m.end():]),
                       "the model cannot get there within its extremes, or other goals pull it away")
-        t = np.asarray(result.translation, dtype=float).reshape(3)
         return result.motion, Vec(float(t[0]), float(t[1]), float(t[2]))
 
     def motion_block(self, joints, at):
@@ -399,16 +429,33 @@ class Runtime(Arithmetic):
         for joint, start, kfs, jat in joints:
             if joint in spec:
                 self.fail(jat, f"joint {joint} appears twice in this motion")
-            last = None
+            last = 0
             for frame, pos, method, kat in kfs:
-                if frame < 0:
-                    self.fail(kat, f"frame {frame:g} is before the motion starts")
-                if last is not None and frame < last:
+                self._keyframe_values(frame, pos, kat)
+                if frame < last:
                     self.fail(kat, f"keyframes must be in ascending frame order: frame {frame:g} comes after frame {last:g}")
+                if 0 < frame - last < N.MIN_FRAME_GAP:
+                    self.fail(kat, f"frame {frame:g} is too close after frame {last:g}", _GAP_HINT)
                 last = frame
+            if start is not None:
+                self._angles(start, jat)
             spec[joint] = (tuple(start) if start is not None else (0.0, 0.0, 0.0),
                            [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs])
         return self._guard(at, M.Motion.from_tracks, spec)
+
+    def _keyframe_values(self, frame, position, at) -> None:
+        """A keyframe's frame and angles within the limits of lang/numbers.py."""
+        if frame < 0:
+            self.fail(at, f"frame {frame:g} is before the motion starts")
+        if frame > N.MAX_FRAME:
+            self.fail(at, f"frame {frame:g} is beyond the last frame a keyframe may have, {N.MAX_FRAME:g}")
+        self._angles(position, at)
+
+    def _angles(self, position, at) -> None:
+        if not max(abs(a) for a in position) <= N.MAX_ANGLE:
+            far = max(abs(a) for a in position)
+            self.fail(at, f"an angle of {far:g} degrees is beyond the largest a keyframe may hold, {N.MAX_ANGLE:g}",
+                      "angles are in degrees; a joint's extremes clip them anyway")
 
     def concat(self, a, b, at):
         return self._guard(at, M.concat, self._motion(a, at), self._motion(b, at))
@@ -435,15 +482,14 @@ class Runtime(Arithmetic):
 
     # -------------------------------------------------------------- scenes
     def view(self, what, value, at):
+        # The limits guarantee that the renderer's camera accepts the view
+        # and projects everything drawn to finite pixel coordinates.
         if what == "POINT":
-            if Vec(*value).norm() == 0:
-                self.fail(at, "the VIEW POINT cannot be the origin: the camera looks at the origin")
+            value = Vec(*self._guard(at, limits.check_view_point, value))
             target = "view_point"
         else:
-            if not value > 0:
-                self.fail(at, f"the VIEW WIDTH must be positive, not {value:g}")
+            value = self._guard(at, limits.check_view_width, value)
             target = "view_width"
-            value = float(value)
         if self.scene is not None:
             setattr(self.scene, target, value)
         else:
@@ -468,11 +514,15 @@ class Runtime(Arithmetic):
                 self.scene = None
         self.scenes = {}
 
-    def ticks(self, length, sameframe, at):
+    def ticks(self, length, sameframe, at, sameframe_at=None):
+        """The ticks of the scene being shot (``at``: its LENGTH, ``sameframe_at``: its SAMEFRAME)."""
         if length < 0:
             self.fail(at, f"a scene's LENGTH cannot be negative ({length})")
+        if length > N.MAX_SCENE_LENGTH:
+            self.fail(at, f"a scene of {length:,} ticks is longer than the longest allowed, {N.MAX_SCENE_LENGTH:,}",
+                      "that is about 4.6 days at 24 frames a second; split the action into several scenes")
         if sameframe < 1:
-            self.fail(at, f"SAMEFRAME must be at least 1, not {sameframe}")
+            self.fail(at if sameframe_at is None else sameframe_at, f"SAMEFRAME must be at least 1, not {sameframe}")
         state = self.scene
         state.length, state.sameframe = length, sameframe
         for t in range(length):
@@ -579,6 +629,9 @@ class SceneState:
         self.length = 0
         self.sameframe = 1
         self.at = at
+
+
+_GAP_HINT = (f"two keyframes of a joint share a frame (a step) or lie at least {N.MIN_FRAME_GAP:g} frames apart")
 
 
 def _fmt_vec(v) -> str:

@@ -11,23 +11,22 @@ from __future__ import annotations
 
 import math
 import operator
-from typing import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
-
 from liganimate.runtime import interpolation
 from liganimate.runtime import track as tr
 from liganimate.runtime.errors import MotionError
 
 __all__ = [
+    "DEFAULT_KEYFRAME_LIMIT",
     "Motion",
     "concat",
     "repeat",
+    "scale_extremes",
+    "scale_frames",
     "strip",
     "synchronize",
-    "scale_frames",
-    "scale_extremes",
-    "DEFAULT_KEYFRAME_LIMIT",
 ]
 
 DEFAULT_KEYFRAME_LIMIT = 100_000
@@ -104,7 +103,10 @@ def _leaf(joint: int, spec) -> tr.Leaf:
         values.append(_vector(key[1], f"{where}: position"))
         methods.append(method)
         ramps.append(ramp)
-    return tr.Leaf(start, frames, np.reshape(values, (-1, 3)), methods, ramps)
+    values = np.reshape(values, (-1, 3))
+    tr.check_frames(np.asarray(frames, dtype=float), f"joint {joint}: a keyframe list that")
+    tr.check_angles(np.vstack([start[None, :], values]), f"joint {joint}: a position that")
+    return tr.Leaf(start, frames, values, methods, ramps)
 
 
 class Motion:
@@ -114,7 +116,7 @@ class Motion:
     ``n * m`` and the methods below.  All operations return new motions.
     """
 
-    __slots__ = ("_tracks", "_length", "_expr", "_derived")
+    __slots__ = ("_derived", "_expr", "_length", "_tracks")
 
     def __init__(self, tracks: Mapping[int, tr.Track], expr: tuple, length: float | None = None):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
@@ -131,10 +133,14 @@ class Motion:
         self._length = float(
             length if length is not None else max((t.end for t in self._tracks.values()), default=0.0)
         )
+        if not math.isfinite(self._length):
+            # n * m and SCALE FRAMES multiply lengths; LEN must stay a finite REAL.
+            raise MotionError("the motion would be longer than a REAL can count (about 1.8E308 frames)",
+                              hint="repeat or stretch it less")
         self._expr = expr
         self._derived: dict | None = None
 
-    def _derive(self, key: tuple, keep, make) -> "Motion":
+    def _derive(self, key: tuple, keep, make) -> Motion:
         """``make()``, remembered under ``key`` (a few entries per motion).
 
         A scene body such as ``ANIMATE H USING WALK <SCALE FRAMES 2>`` runs
@@ -166,7 +172,7 @@ class Motion:
     # -- construction -----------------------------------------------------
 
     @classmethod
-    def from_tracks(cls, tracks: Mapping[int, tuple], name: str | None = None) -> "Motion":
+    def from_tracks(cls, tracks: Mapping[int, tuple], name: str | None = None) -> Motion:
         """Build a motion from explicit keyframes.
 
         Parameters
@@ -197,7 +203,7 @@ class Motion:
         return cls(leaves, ("keys", name, len(leaves), nkeys))
 
     @classmethod
-    def empty(cls) -> "Motion":
+    def empty(cls) -> Motion:
         """The motion with no joints and length 0.
 
         Returns
@@ -239,7 +245,7 @@ class Motion:
 
     # -- algebra ----------------------------------------------------------
 
-    def __add__(self, other: "Motion") -> "Motion":
+    def __add__(self, other: Motion) -> Motion:
         """``self + other``: ``other`` played after this motion (see :func:`concat`).
 
         Parameters
@@ -255,7 +261,7 @@ class Motion:
             return NotImplemented
         return self._derive(("+", id(other)), other, lambda: self._concat(other))
 
-    def _concat(self, other: "Motion") -> "Motion":
+    def _concat(self, other: Motion) -> Motion:
         la, lb = self._length, other._length
         tracks = {}
         for j in self._tracks.keys() | other._tracks.keys():
@@ -268,7 +274,7 @@ class Motion:
                 tracks[j] = tr.concat(ta, tb, la)
         return Motion(tracks, ("+", self._expr, other._expr))
 
-    def repeat(self, n: int) -> "Motion":
+    def repeat(self, n: int) -> Motion:
         """``n`` copies played back to back (the thesis' ``n * motion``).
 
         Parameters
@@ -294,7 +300,7 @@ class Motion:
             raise MotionError(f"a motion cannot be repeated a negative number of times ({n})")
         return self._derive(("*", n), None, lambda: self._repeat(n))
 
-    def _repeat(self, n: int) -> "Motion":
+    def _repeat(self, n: int) -> Motion:
         expr = ("*", n, self._expr)
         if n == 0:
             return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr)
@@ -305,12 +311,12 @@ class Motion:
         tracks = {j: tr.Repeat(t, n, L, end=n * L if t.end == L else None) for j, t in self._tracks.items()}
         return Motion(tracks, expr, n * L)
 
-    def __mul__(self, n) -> "Motion":
+    def __mul__(self, n) -> Motion:
         return self.repeat(n)
 
     __rmul__ = __mul__
 
-    def strip(self, joints: Iterable[int]) -> "Motion":
+    def strip(self, joints: Iterable[int]) -> Motion:
         """Keep only some joints (STRIP).
 
         Parameters
@@ -333,7 +339,7 @@ class Motion:
             kept[j] = self._tracks[j]
         return Motion(kept, ("strip", tuple(kept), self._expr))
 
-    def scale_frames(self, r: float) -> "Motion":
+    def scale_frames(self, r: float) -> Motion:
         """Stretch time by ``|r|``; a negative ``r`` also plays the motion backwards.
 
         Parameters
@@ -357,7 +363,7 @@ class Motion:
             raise MotionError("SCALE FRAMES 0 would squeeze the motion into no time", hint="use a non-zero factor")
         return self._derive(("frames", r), None, lambda: self._scale_frames(r))
 
-    def _scale_frames(self, r: float) -> "Motion":
+    def _scale_frames(self, r: float) -> Motion:
         s, L = abs(r), self._length * abs(r)
         memo: dict = {}
         tracks = {j: tr.scale_frames(t, s, memo) for j, t in self._tracks.items()}
@@ -365,7 +371,7 @@ class Motion:
             tracks = {j: tr.reverse(t, L, memo) for j, t in tracks.items()}
         return Motion(tracks, ("frames", r, self._expr), L)
 
-    def scale_extremes(self, r: float) -> "Motion":
+    def scale_extremes(self, r: float) -> Motion:
         """Multiply every angle (start and keyframe positions) by ``r``.
 
         Parameters
@@ -379,12 +385,12 @@ class Motion:
         r = _real(r, "the SCALE EXTREMES factor")
         return self._derive(("extremes", r), None, lambda: self._scale_extremes(r))
 
-    def _scale_extremes(self, r: float) -> "Motion":
+    def _scale_extremes(self, r: float) -> Motion:
         memo: dict = {}
         tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
         return Motion(tracks, ("extremes", r, self._expr), self._length)
 
-    def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> "Motion":
+    def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> Motion:
         """Take the short way round on axes that can turn freely.
 
         Parameters
@@ -440,8 +446,13 @@ class Motion:
         t = self._times(times)
         js = self._joint_list(joints)
         out = np.empty((len(t), len(js), 3))
-        for i, j in enumerate(js):
-            out[:, i] = self._tracks[j].sample_x(t)
+        # The limits on frames, gaps and angles (lang/numbers.py) keep every
+        # formula finite on the rows it is chosen for; np.where also
+        # evaluates the other branch, whose overflow must not print.
+        with np.errstate(all="ignore"):
+            for i, j in enumerate(js):
+                out[:, i] = self._tracks[j].sample_x(t)
+        _finite(out)
         return out
 
     def evaluate_full(self, times, joints: Iterable[int] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -464,9 +475,11 @@ class Motion:
         t = self._times(times)
         js = self._joint_list(joints)
         out = np.zeros((3, len(t), len(js), 3))
-        for i, j in enumerate(js):
-            s = self._tracks[j].sample(t)
-            out[0, :, i], out[1, :, i], out[2, :, i] = s
+        with np.errstate(all="ignore"):  # see evaluate
+            for i, j in enumerate(js):
+                s = self._tracks[j].sample(t)
+                out[0, :, i], out[1, :, i], out[2, :, i] = s
+        _finite(out)
         return out[0], out[1], out[2]
 
     # -- inspection -------------------------------------------------------
@@ -580,6 +593,11 @@ class Motion:
 
     def __repr__(self) -> str:
         return f"<Motion length={self._length:g} joints={list(self.joints)}: {self.describe(200)}>"
+
+
+def _finite(values: np.ndarray) -> None:
+    if not np.isfinite(values).all():  # pragma: no cover - the limits are meant to make this impossible
+        raise MotionError("the motion's interpolation gave a number that is not finite")
 
 
 def concat(a: Motion, b: Motion) -> Motion:

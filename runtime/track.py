@@ -14,10 +14,11 @@ The exact formulas are documented in ``docs/semantics-motion.md``.
 
 from __future__ import annotations
 
-from typing import Callable, NamedTuple
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
-
+from liganimate.lang.numbers import MAX_ANGLE, MAX_FRAME, MIN_FRAME_GAP
 from liganimate.runtime import interpolation
 from liganimate.runtime.errors import MotionError
 
@@ -70,7 +71,7 @@ class Track:
         lets ``materialize`` refuse a billion-fold repeat before building it.
     """
 
-    __slots__ = ("end", "start_value", "end_value", "min_keys")
+    __slots__ = ("end", "end_value", "min_keys", "start_value")
 
     def sample(self, t: np.ndarray) -> Samples:
         """Evaluate the track.
@@ -100,7 +101,7 @@ class Track:
         """
         return self.sample(t).x
 
-    def children(self) -> tuple["Track", ...]:
+    def children(self) -> tuple[Track, ...]:
         """Nodes this one evaluates (for inspection).
 
         Returns
@@ -111,16 +112,16 @@ class Track:
 
     # Transformations are written per node and reached through the memoized
     # module functions below, so that shared subtrees are rebuilt only once.
-    def _reversed(self, length: float, memo: dict) -> "Track":
+    def _reversed(self, length: float, memo: dict) -> Track:
         raise NotImplementedError
 
-    def _scaled_frames(self, r: float, memo: dict) -> "Track":
+    def _scaled_frames(self, r: float, memo: dict) -> Track:
         raise NotImplementedError
 
-    def _mapped(self, m: "LeafMap", memo: dict) -> "Track":
+    def _mapped(self, m: LeafMap, memo: dict) -> Track:
         raise NotImplementedError
 
-    def _emit(self, out: "_Emitter", offset: float) -> None:
+    def _emit(self, out: _Emitter, offset: float) -> None:
         raise NotImplementedError
 
 
@@ -169,7 +170,7 @@ class Leaf(Track):
         users); reversed leaves are left-continuous.
     """
 
-    __slots__ = ("start", "frames", "values", "methods", "ramps", "right", "_prep")
+    __slots__ = ("_prep", "frames", "methods", "ramps", "right", "start", "values")
 
     def __init__(self, start, frames, values, methods, ramps, right: bool = True):
         self.start = _frozen(start).reshape(3)
@@ -295,7 +296,7 @@ class Leaf(Track):
             return concat(Const(self.end_value, 0.0), rev, length - self.end, right=not self.right, end=length)
         return rev
 
-    def _mirror(self) -> "Leaf":
+    def _mirror(self) -> Leaf:
         E = self.end
         F = np.concatenate([[0.0], self.frames])
         V = np.vstack([self.start[None, :], self.values])
@@ -310,7 +311,13 @@ class Leaf(Track):
         return Leaf(V[-1], E - F[::-1][1:], V[::-1][1:], methods, self.ramps[::-1], right=not self.right)
 
     def _scaled_frames(self, r, memo):
-        return Leaf(self.start, self.frames * r, self.values, self.methods, self.ramps * r, self.right)
+        with np.errstate(all="ignore"):
+            frames, ramps = self.frames * r, self.ramps * r
+        check_frames(frames, f"SCALE FRAMES {r:g}")
+        if len(ramps) and not ramps.min() > 0:
+            raise MotionError(f"SCALE FRAMES {r:g} squeezes the motion's speed-up ramps to nothing",
+                              hint="use a larger factor")
+        return Leaf(self.start, frames, self.values, self.methods, ramps, self.right)
 
     def _mapped(self, m, memo):
         return m.leaf(self)
@@ -354,7 +361,7 @@ def _trapezoid(p: _Prepared, s: np.ndarray, ts: np.ndarray, full: bool = True):
 
 def _fixed(p: _Prepared, m, s: np.ndarray, ts: np.ndarray, full: bool = True):
     """Fixed-shape segments: v0 + D e(u).  Returns (x, v, a); v and a are None unless ``full``."""
-    tau, sig, v0, v1 = _gather(p, s, ts)
+    tau, _sig, v0, v1 = _gather(p, s, ts)
     T = _col(p.T[s])
     D = p.D[s]
     u = np.clip(tau / T, 0.0, 1.0)
@@ -452,7 +459,7 @@ class Pad(Track):
         being tied to ``inner``, the held value follows any change of angles.
     """
 
-    __slots__ = ("inner", "hold_from")
+    __slots__ = ("hold_from", "inner")
 
     def __init__(self, inner: Track, end: float, hold_from: float | None = None):
         self.inner = inner
@@ -799,10 +806,47 @@ def scale_extremes(track: Track, r: float, memo: dict | None = None) -> Track:
     Track
     """
 
-    def leaf(lf: Leaf) -> Leaf:
-        return Leaf(lf.start * r, lf.frames, lf.values * r, lf.methods, lf.ramps, lf.right)
+    def angles(v: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            out = v * r
+        check_angles(out, f"SCALE EXTREMES {r:g}")
+        return out
 
-    return map_leaves(track, LeafMap(("extremes", r), leaf, lambda v: v * r), memo)
+    def leaf(lf: Leaf) -> Leaf:
+        return Leaf(angles(lf.start), lf.frames, angles(lf.values), lf.methods, lf.ramps, lf.right)
+
+    return map_leaves(track, LeafMap(("extremes", r), leaf, angles), memo)
+
+
+def check_frames(frames: np.ndarray, cause: str) -> None:
+    """Keyframe frames (non-decreasing, from 0) within the limits of ``lang/numbers.py``, else MotionError.
+
+    Parameters
+    ----------
+    frames : ndarray, shape (K,)
+    cause : str
+        What made them (``"SCALE FRAMES 0.5"``), to start the message.
+    """
+    if not len(frames):
+        return
+    last = frames[-1]
+    if not last <= MAX_FRAME:
+        raise MotionError(f"{cause} puts a keyframe at frame {last:g}, beyond the last frame allowed, {MAX_FRAME:g}",
+                          hint="a keyframe's frame is at most 1E9")
+    gaps = np.diff(frames, prepend=0.0)
+    close = (gaps > 0) & (gaps < MIN_FRAME_GAP)
+    if close.any():
+        gap = float(gaps[close][0])
+        raise MotionError(f"{cause} puts two keyframes {gap:g} frames apart, closer than {MIN_FRAME_GAP:g}",
+                          hint="keyframes of a joint share a frame (a step) or lie at least 1E-100 frames apart")
+
+
+def check_angles(values: np.ndarray, cause: str) -> None:
+    """Angles within ``±MAX_ANGLE`` degrees, else MotionError naming ``cause``."""
+    far = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    if not far <= MAX_ANGLE:
+        raise MotionError(f"{cause} makes an angle of {far:g} degrees, beyond the largest allowed, {MAX_ANGLE:g}",
+                          hint="angles are in degrees; a joint's extremes clip them anyway")
 
 
 def unwrap_angles(start: np.ndarray, values: np.ndarray) -> np.ndarray:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from liganimate.lang.numbers import GEOMETRY_MAX
 
 from .errors import LigError
 
@@ -41,8 +42,8 @@ class Vec(tuple):
         return f"({_num(self[0])}, {_num(self[1])}, {_num(self[2])})"
 
     def norm(self) -> float:
-        """Euclidean length."""
-        return math.sqrt(self[0] ** 2 + self[1] ** 2 + self[2] ** 2)
+        """Euclidean length (scaled internally, so it overflows only if the length itself would)."""
+        return math.hypot(self[0], self[1], self[2])
 
 
 def _num(x: float) -> str:
@@ -64,24 +65,32 @@ class Graphical:
         counter-clockwise seen from outside.
     """
 
-    __slots__ = ("triangles", "lightness", "closed")
+    __slots__ = ("_extent", "closed", "lightness", "triangles")
 
     def __init__(self, triangles, lightness, closed):
         self.triangles = np.ascontiguousarray(triangles, dtype=np.float64).reshape(-1, 3, 3)
         self.lightness = np.asarray(lightness, dtype=np.float64).reshape(-1)
         self.closed = np.asarray(closed, dtype=bool).reshape(-1)
+        self._extent = None
+
+    def extent(self) -> float:
+        """The largest coordinate magnitude of any vertex (0 when empty; NaN if one is NaN)."""
+        if self._extent is None:
+            t = self.triangles
+            self._extent = float(np.max(np.abs(t))) if t.size else 0.0
+        return self._extent
 
     def __len__(self):
         return len(self.triangles)
 
-    def __add__(self, other: "Graphical") -> "Graphical":
+    def __add__(self, other: Graphical) -> Graphical:
         return Graphical(
             np.concatenate([self.triangles, other.triangles]),
             np.concatenate([self.lightness, other.lightness]),
             np.concatenate([self.closed, other.closed]),
         )
 
-    def transformed(self, matrix) -> "Graphical":
+    def transformed(self, matrix) -> Graphical:
         """Apply a 4x4 affine transform; a mirror keeps the solids wound outward."""
         m = np.asarray(matrix, dtype=np.float64)
         tris = self.triangles @ m[:3, :3].T + m[:3, 3]
@@ -89,9 +98,9 @@ class Graphical:
             tris = tris[:, ::-1, :]
         return Graphical(tris, self.lightness, self.closed)
 
-    def with_lightness(self, lightness: float) -> "Graphical":
+    def with_lightness(self, lightness: float) -> Graphical:
         """Every triangle at one lightness."""
-        return Graphical(self.triangles, np.full(len(self), float(lightness)), self.closed)
+        return Graphical(self.triangles, np.full(len(self), _clip_lightness(lightness)), self.closed)
 
 
 EMPTY = Graphical(np.zeros((0, 3, 3)), np.zeros(0), np.zeros(0, dtype=bool))
@@ -111,16 +120,27 @@ class Canvas:
         self.light = 40.0
 
     def lightness(self, value) -> None:
-        """Set the lightness of the polygons drawn next."""
-        self.light = float(value)
+        """Set the lightness of the polygons drawn next (clipped to 0..100 when drawn)."""
+        self.light = _clip_lightness(value)
 
     def poly(self, points, at=None) -> None:
-        """Add a polygon; a closing point equal to the first is dropped."""
+        """Add a polygon; a closing point equal to the first is dropped.
+
+        Raises
+        ------
+        LigError
+            For fewer than three corners, or a corner beyond the geometry
+            limit (:data:`~liganimate.lang.numbers.GEOMETRY_MAX`).
+        """
         pts = [tuple(p) for p in points]
         if len(pts) > 1 and pts[-1] == pts[0]:
             pts = pts[:-1]
         if len(pts) < 3:
             raise LigError(f"a polygon needs at least three corners; this one has {len(pts)}")
+        far = max(abs(c) for p in pts for c in p)
+        if not far <= GEOMETRY_MAX:
+            raise LigError(f"this polygon has a corner {far:g} units along an axis, beyond the limit of "
+                           f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
         self.polys.append((np.asarray(pts, dtype=np.float64), self.light))
 
     def result(self) -> Graphical:
@@ -222,11 +242,31 @@ def _solid_orientation(polys) -> list:
     return side
 
 
+_FAR_HINT = "everything drawn must stay within 1E12 units of the origin along each axis"
+
+
+def _clip_lightness(value) -> float:
+    # Drawing clips to 0..100 anyway; clipping early keeps 1.5 * LIGHTNESS finite.
+    return min(max(float(value), -1000.0), 1000.0)
+
+
 def box(centre, width, height, depth, light) -> Graphical:
-    """The built-in BOX: exactly the polygons of the thesis' Appendix A PRIMITIVE BOX."""
+    """The built-in BOX: exactly the polygons of the thesis' Appendix A PRIMITIVE BOX.
+
+    Raises
+    ------
+    LigError
+        If a corner would lie beyond the geometry limit
+        (:data:`~liganimate.lang.numbers.GEOMETRY_MAX`).
+    """
     c = np.asarray(centre, dtype=np.float64)
     w, h, d = float(width), float(height), float(depth)
-    l1, l2 = float(light), float(light) * 1.5
+    far = float(np.max(np.abs(c))) + max(abs(w), abs(h), abs(d))
+    if not far <= GEOMETRY_MAX:
+        raise LigError(f"this BOX reaches {far:g} units from the origin along an axis, beyond the limit of "
+                       f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
+    light = _clip_lightness(light)
+    l1, l2 = light, light * 1.5
     ftr = c + (w / 2, h / 2, d / 2)
     ftl = ftr - (w, 0, 0)
     fbl = ftl - (0, h, 0)

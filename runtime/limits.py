@@ -1,0 +1,122 @@
+"""The geometry limit: what the camera may be asked to draw.
+
+Rendering divides by depths and multiplies coordinates together (facing
+tests, edge slopes); with every drawn point within
+:data:`~liganimate.lang.numbers.GEOMETRY_MAX` of the origin along each axis,
+a VIEW POINT as far at most and at least
+:data:`~liganimate.lang.numbers.GEOMETRY_MIN` from the origin, and a VIEW
+WIDTH of at least ``GEOMETRY_MIN``, every number the renderer computes stays
+finite (pixel coordinates below about 1E33). The limit is enforced where
+geometry is made (BOX, DRAW POLY, JOINT, STARTMODEL, host transformations,
+SCALE MODEL), so every GRAPHICAL object and every MODEL a program holds is
+drawable, in every pose: joint rotations keep distances, and a model's
+:func:`figure_reach` bounds all its poses at once.
+
+Each check raises :class:`~.errors.LigError`; the runtime reports it at the
+statement that made the geometry.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from liganimate.lang.numbers import GEOMETRY_MAX, GEOMETRY_MIN
+
+from .errors import LigError
+from .values import Graphical
+
+_HINT = "everything drawn must stay within 1E12 units of the origin along each axis"
+
+# figure_reach per model structure: id(joints) -> (joints, links, reach); a
+# placed or re-rooted copy of a model shares its joints and links tuples.
+_REACH: dict = {}
+_REACH_MAX = 256
+
+
+def _fmt(x: float) -> str:
+    return "not a number" if math.isnan(x) else f"{x:g}"
+
+
+def check_graphical(g: Graphical, what: str = "this object") -> Graphical:
+    """``g`` if all its vertices are within the geometry limit, else LigError."""
+    e = g.extent()
+    if not e <= GEOMETRY_MAX:
+        raise LigError(f"{what} reaches {_fmt(e)} units from the origin along an axis, beyond the limit of "
+                       f"{GEOMETRY_MAX:g} for anything drawn", _HINT)
+    return g
+
+
+def figure_reach(fig) -> float:
+    """A bound on how far from its main link's origin any point of ``fig`` can be, in any pose.
+
+    Every joint location counts once at full length (as if all the model's
+    joints lay in one straight chain), plus the largest segment; the bound
+    is the same for every pose and every choice of main link.
+
+    Parameters
+    ----------
+    fig : Figure
+
+    Returns
+    -------
+    float
+        Euclidean distance, in the main link's (unplaced) coordinates.
+    """
+    hit = _REACH.get(id(fig.joints))
+    if hit is not None and hit[0] is fig.joints and hit[1] is fig.links:
+        return hit[2]
+    root3 = math.sqrt(3.0)
+    with np.errstate(all="ignore"):
+        reach = 0.0
+        for j in fig.joints:
+            reach += root3 * (float(np.max(np.abs(j.loc1))) + float(np.max(np.abs(j.loc2))))
+        size = 0.0
+        for link in fig.links:
+            if isinstance(link.shape, Graphical):  # the only shapes drawn (pose.MeshTable)
+                size = max(size, abs(link.scale) * link.shape.extent())
+        reach += root3 * size
+    if len(_REACH) >= _REACH_MAX:
+        _REACH.clear()
+    _REACH[id(fig.joints)] = (fig.joints, fig.links, reach)
+    return reach
+
+
+def check_figure(fig, what: str = "the model"):
+    """``fig`` if every point of it, in any pose and placed as it is, is within the geometry limit, else LigError."""
+    reach = figure_reach(fig)
+    p = np.asarray(fig.placement, dtype=np.float64)
+    with np.errstate(all="ignore"):
+        far = float(np.linalg.norm(p[:3, :3]) * reach + np.max(np.abs(p[:3, 3])))
+    if not far <= GEOMETRY_MAX:
+        raise LigError(f"{what} can reach {_fmt(far)} units from the origin, beyond the limit of "
+                       f"{GEOMETRY_MAX:g} for anything drawn",
+                       "a model is measured by its segments and joint locations, so that it stays within the "
+                       "limit in every pose; " + _HINT)
+    return fig
+
+
+def check_view_point(point) -> tuple:
+    """The VIEW POINT as three floats, if within the limits, else LigError."""
+    x, y, z = (float(c) for c in point)
+    far = max(abs(x), abs(y), abs(z))
+    if not far <= GEOMETRY_MAX:
+        raise LigError(f"the VIEW POINT is {_fmt(far)} units from the origin along an axis, beyond the limit of "
+                       f"{GEOMETRY_MAX:g}", _HINT)
+    if math.hypot(x, y, z) < GEOMETRY_MIN:
+        if x == y == z == 0:
+            raise LigError("the VIEW POINT cannot be the origin: the camera looks at the origin")
+        raise LigError(f"the VIEW POINT is closer to the origin than {GEOMETRY_MIN:g}, so the camera has no "
+                       "usable direction", "the camera looks at the origin from the VIEW POINT")
+    return (x, y, z)
+
+
+def check_view_width(width) -> float:
+    """The VIEW WIDTH as a float, if at least the smallest width, else LigError."""
+    w = float(width)
+    if not w > 0:
+        raise LigError(f"the VIEW WIDTH must be positive, not {w:g}")
+    if w < GEOMETRY_MIN:
+        raise LigError(f"the VIEW WIDTH {w:g} is below the smallest width, {GEOMETRY_MIN:g}",
+                       "VIEW WIDTH is the width of the view around the origin, in world units")
+    return w
