@@ -362,14 +362,16 @@ class Runtime(Arithmetic):
                 self.fail(eat, f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
                           "number the keyframes of each joint 1, 2, 3, ... without gaps")
             seq = [kfs[i] for i in numbers]
-            for i in range(1, len(seq)):
-                gap = seq[i][0] - seq[i - 1][0]
+            previous = 0.0  # keyframe 0, the starting position, is at frame 0
+            for i in range(len(seq)):
+                gap = seq[i][0] - previous
                 if gap < 0 or 0 < gap < N.MIN_FRAME_GAP:
                     eat = seq[i][3] if seq[i][3] is not None else at
                     self.fail(eat, f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
                                    + ("before" if gap < 0 else "too close after")
-                                   + f" keyframe {i} at frame {seq[i - 1][0]:g}",
+                                   + f" keyframe {i} at frame {previous:g}",
                               None if gap < 0 else _GAP_HINT)
+                previous = seq[i][0]
             spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
         motion = self._guard(at, M.Motion.from_tracks, spec)
         m._cache = motion
@@ -580,6 +582,13 @@ class Runtime(Arithmetic):
     # --------------------------------------------------------------- PRINT
     def print_items(self, items, at):
         if self.mode == "check":
+            # Nothing is written, but whatever could fail when it is (a model
+            # without a value, a motion whose keyframes do not fit) fails now.
+            for kind, value, label in items:
+                if kind in ("MODEL", "table"):
+                    self._model(value, at, label)
+                elif kind == "MOTION":
+                    self._motion(value, at)
             return
         for kind, value, label in items:
             self.out.write(self._print_one(kind, value, label, at) + "\n")
