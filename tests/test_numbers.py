@@ -24,6 +24,7 @@ HUMANOID = "LOAD HUMANOID, WALK FROM 'humanoid'; "
 
 def cli(*args, cwd, env=None, preexec_fn=None, timeout=120):
     return subprocess.run([sys.executable, "-m", "liganimate", *args], capture_output=True, text=True, cwd=cwd,
+                          check=False,
                           env=env, preexec_fn=preexec_fn, timeout=timeout)
 
 
