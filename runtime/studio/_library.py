@@ -1,0 +1,199 @@
+"""The studio's "Save": a LIG library holding the posed model and the kept poses as a motion.
+
+The model is written out as what is drawn, so the library stands on its
+own: one PRIMITIVE per distinct segment shape, drawing its triangles with
+DRAW POLY (corners to nine significant digits, scaled by the segment's SCALE MODEL factor, so the library's
+model has scale 1), and a STARTMODEL block with the joints' locations and
+extremes.  Segment names are kept where they are unique LIG names and made
+unique otherwise.  Each extreme is widened, when a kept pose goes beyond
+it, just enough to hold that pose (later generations may exceed the
+extremes; LIG would clamp such a pose when it plays it).  Axes locked at
+one value stay locked.
+
+The motion drives every joint: the first kept pose is its starting
+position and kept pose ``k`` is the keyframe at ``FRAME k * spacing``, so
+playing it shows each kept pose at those frames exactly.  Joint locations,
+extremes and angles are written with Python's shortest round-trip
+``repr``, so they read back as the same doubles.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+from liganimate.compiler.types import BUILTINS
+
+__all__ = ["library_text", "lig_name"]
+
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+# Words a segment may not be called: statement keywords and built-in names.
+_RESERVED = set(BUILTINS) | {
+    "ALONG", "AND", "ANIMATE", "AT", "AXIS", "BACKGROUND", "BEGIN", "BOX", "BY", "CHAIN", "CONTINUE", "DEPTH",
+    "DO", "DRAW", "ELSE", "END", "ENDJOINT", "ENDMODEL", "ENDMOTION", "ENDREACH", "ENDSCENE", "EXTREME",
+    "EXTREMES", "FIGURE", "FRAME", "FRAMES", "FROM", "GOAL", "GRAPHICAL", "HEIGHT", "IF", "INITIALIZE",
+    "INTEGER", "INTERPOLATE", "INTERPOLATION", "INTO", "ITERATIONS", "JOINT", "JOINTS", "LENGTH", "LIGHTNESS",
+    "LINK", "LOAD", "MAIN", "MODEL", "MOTION", "MOVE", "NORMAL", "NOT", "ON", "OR", "ORIGIN", "PLANE", "POINT",
+    "POLY", "POSITION", "PRIMITIVE", "PRINT", "REAL", "REPEAT", "RETURN", "ROT", "SAMEFRAME", "SCALE", "SCENE",
+    "SHOOTSCENE", "SHOOTSCENES", "SOLVER", "STARTMODEL", "STARTMOTION", "STARTREACH", "STARTSCENE", "STOP",
+    "STRIP", "SYNCHRONISE", "SYNCHRONIZE", "THEN", "TO", "TOLERANCE", "TRANS", "TRANSLATE", "USING", "VECTOR",
+    "VIEW", "WEIGHT", "WIDTH", "WITH",
+}
+
+
+def lig_name(text: str) -> bool:
+    """Whether ``text`` is a LIG name a library may define (not a keyword or built-in)."""
+    return bool(_NAME.match(text)) and text.upper() not in _RESERVED
+
+
+def _num(x: float) -> str:
+    return repr(float(x) + 0.0)
+
+
+def _vec(v) -> str:
+    return f"({_num(v[0])}, {_num(v[1])}, {_num(v[2])})"
+
+
+def _short(x: float) -> str:
+    s = f"{float(x) + 0.0:.9g}"
+    return s if "." in s or "e" in s else s + ".0"
+
+
+def _corner(v) -> str:
+    # Nine significant digits: a millionth of a millimetre on a 1 km figure, and half the text of repr.
+    return f"({_short(v[0])}, {_short(v[1])}, {_short(v[2])})"
+
+
+def _segment_names(fig, taken: set) -> list:
+    names = []
+    for i, link in enumerate(fig.links):
+        parent = fig.parent_joint_of(i)
+        base = (link.name or "").upper()
+        if not lig_name(base):
+            base = "SEGMENT" if parent is None else f"SEGMENT_{parent.id}"
+        name, n = base, 1
+        while name in taken:
+            n += 1
+            name = f"{base}_{n}"
+        taken.add(name)
+        names.append(name)
+    return names
+
+
+def _primitive(name: str, triangles: np.ndarray, lightness: np.ndarray) -> list:
+    out = [f"      PRIMITIVE {name}", f"      {name} ::= '{name}' ;"]
+    light = None
+    for tri, l in zip(triangles, lightness):
+        if (tri[0] == tri[1]).all() or (tri[1] == tri[2]).all() or (tri[2] == tri[0]).all():
+            continue  # a triangle with a repeated corner draws nothing, and DRAW POLY would refuse it
+        if l != light:
+            out.append(f"      DRAW WITH <LIGHTNESS {_num(l)}>")
+            light = l
+        out.append(f"      DRAW POLY FROM {_corner(tri[0])} TO {_corner(tri[1])} TO {_corner(tri[2])}")
+    out.append("      END")
+    out.append("")
+    return out
+
+
+def widened_extremes(fig, kept: np.ndarray) -> np.ndarray:
+    """Each joint's extremes grown to hold the kept poses; locked axes as they are.
+
+    Parameters
+    ----------
+    fig : Figure
+    kept : ndarray, shape (K, J, 3)
+
+    Returns
+    -------
+    ndarray, shape (J, 3, 2)
+    """
+    ext = np.array(fig.extremes, dtype=np.float64).reshape(fig.n_joints, 3, 2)
+    if len(kept):
+        locked = ext[..., 0] == ext[..., 1]
+        lo = np.minimum(ext[..., 0], kept.min(axis=0))
+        hi = np.maximum(ext[..., 1], kept.max(axis=0))
+        ext[..., 0] = np.where(locked, ext[..., 0], lo)
+        ext[..., 1] = np.where(locked, ext[..., 1], hi)
+    return ext
+
+
+def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: str = "") -> str:
+    """The text of a library with ``fig`` as MODEL ``model`` and the kept poses as MOTION ``motion``.
+
+    Parameters
+    ----------
+    fig : Figure
+    model, motion : str
+        LIG names (checked by the caller with :func:`lig_name`), different.
+    kept : sequence of ndarray, shape (J, 3)
+        At least one pose, in the figure's joint order.
+    spacing : int
+        Frames between kept poses.
+    note : str
+        One line for the header comment (no braces or line breaks).
+
+    Returns
+    -------
+    str
+        Library text that ``LOAD model, motion FROM 'file.lig'`` takes.
+    """
+    kept = np.asarray(kept, dtype=np.float64).reshape(-1, fig.n_joints, 3)
+    model, motion = model.upper(), motion.upper()
+    taken = {model, motion}
+    segs = _segment_names(fig, taken)
+    ext = widened_extremes(fig, kept)
+    grown = [fig.joints[k].id for k in range(fig.n_joints)
+             if not np.array_equal(ext[k], np.asarray(fig.extremes[k]).reshape(3, 2))]
+    out = [
+        f"C {model}, {motion}: posed with liganimate studio, the Generator of the thesis on",
+        "C posing figures with interactive genetic algorithms.",
+    ]
+    if note:
+        out.append(f"C {note}")
+    out += [
+        "C",
+        f"C {motion} holds {len(kept)} kept pose(s): the first is its starting position and pose k",
+        f"C is its keyframe at FRAME k * {spacing}. Play it with ANIMATE ... USING {motion}.",
+        f"C {model} is the model as drawn: each segment's triangles, its joints and extremes.",
+    ]
+    if grown:
+        out.append("C The extremes of joint(s) " + ", ".join(str(j) for j in grown)
+                   + " are widened to hold poses the Generator took beyond them.")
+    out += ["", f"{{@ {model}: the posed model, {fig.n_links} segments and {fig.n_joints} joints }}",
+            f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}", ""]
+    shapes: dict = {}  # (id(shape), scale) -> primitive name
+    assign = []
+    for i, link in enumerate(fig.links):
+        tris = getattr(link.shape, "triangles", None)
+        if tris is None or len(tris) == 0:
+            continue
+        key = (id(link.shape), link.scale)
+        prim = shapes.get(key)
+        if prim is None:
+            prim = f"SHAPE_{len(shapes) + 1}"
+            while prim in taken:
+                prim += "_"
+            taken.add(prim)
+            shapes[key] = prim
+            out += _primitive(prim, tris * link.scale, link.shape.lightness)
+        assign.append(f"      {segs[i]} :- ({prim})")
+    for k in range(0, len(segs), 6):
+        out.append("      GRAPHICAL " + ", ".join(segs[k:k + 6]))
+    out += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + ["", f"      STARTMODEL {model}"]
+    for k, j in enumerate(fig.joints):
+        pairs = ", ".join(f"({_num(a)}, {_num(b)})" for a, b in ext[k])
+        out.append(f"        JOINT {j.id}, {segs[j.primary]}, {_vec(j.loc1)}, {segs[j.secondary]}, {_vec(j.loc2)},")
+        out.append(f"              {pairs}")
+    out.append("      ENDMODEL")
+    if fig.main is not None and fig.main != fig.root:
+        parent = fig.parent_joint_of(fig.main)
+        out.append(f"      FIGURE {model} MAIN JOINT {parent.id}")
+    out += ["", f"      STARTMOTION {motion}"]
+    for k, j in enumerate(fig.joints):
+        a = kept[0, k]
+        out.append(f"        JOINT {j.id} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
+        for n in range(1, len(kept)):
+            a = kept[n, k]
+            out.append(f"          FRAME {n * spacing} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
+    out.append("      ENDMOTION")
+    return "\n".join(out) + "\n"

@@ -1,0 +1,228 @@
+/* LIG GL: draws what the liganimate runtime computed, shaded like its rasterizer.
+ *
+ * Triangles come in segment coordinates with one grey level each (the
+ * rasterizer's flat shading: LIGHTNESS 0..100 -> grey 0..255, no lighting);
+ * segment matrices come from the runtime, one 3x4 row-major block per
+ * segment.  This file only multiplies vertices by those matrices: it never
+ * turns joint angles into transforms.
+ *
+ * The camera is LIG's: an eye looking at a target (the origin for VIEW),
+ * +Y up (-Z when looking straight along Y), and a view width measured in
+ * the plane through the target, so the picture matches the rasterizer's
+ * pixel for pixel up to rounding.  Shared by the viewer and the studio.
+ */
+'use strict';
+var LigGL = (function () {
+  var VS = 'attribute vec3 p; attribute vec3 c; uniform mat4 mvp; varying vec3 vc;' +
+    'void main() { vc = c; gl_Position = mvp * vec4(p, 1.0); }';
+  var FS = 'precision highp float; varying vec3 vc; void main() { gl_FragColor = vec4(vc, 1.0); }';
+  var PARALLEL_SINE = 1e-9;
+
+  function sub(a, b) { return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]; }
+  function dot(a, b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+  function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
+  function norm(a) { return Math.sqrt(dot(a, a)); }
+  function scale(a, k) { return [a[0] * k, a[1] * k, a[2] * k]; }
+
+  /* The camera's right, up and forward unit vectors, as runtime/camera.py builds them. */
+  function basis(cam) {
+    var v = sub(cam.target, cam.eye);
+    var d = norm(v);
+    var fwd = scale(v, 1 / d);
+    var hint = [0, 1, 0];
+    if (norm(cross(fwd, hint)) < PARALLEL_SINE) hint = [0, 0, -1];
+    var right = cross(fwd, hint);
+    right = scale(right, 1 / norm(right));
+    return { right: right, up: cross(right, fwd), fwd: fwd, distance: d };
+  }
+
+  /* Column-major model-view-projection matrix for a canvas of w x h pixels.
+   * cam.k is the view width divided by the eye's distance to the target.
+   * bounds = [cx, cy, cz, radius] of everything drawn (near and far planes). */
+  function projection(cam, w, h, bounds) {
+    var b = basis(cam);
+    var sx = 2 / cam.k, sy = sx * w / h;
+    var dc = dot(sub([bounds[0], bounds[1], bounds[2]], cam.eye), b.fwd);
+    var r = bounds[3] * 1.05 + 1e-9;
+    var far = Math.max(dc + r, 1e-6);
+    var near = Math.max(dc - r, far * 1e-4);
+    var r0 = b.right, u = b.up, f = b.fwd, e = cam.eye;
+    // View: camera x = right, y = up, z = -forward (GL looks down -z).
+    var V = [r0[0], u[0], -f[0], 0, r0[1], u[1], -f[1], 0, r0[2], u[2], -f[2], 0,
+      -dot(r0, e), -dot(u, e), dot(f, e), 1];
+    var A = -(far + near) / (far - near), B = -2 * far * near / (far - near);
+    var P = [sx, 0, 0, 0, 0, sy, 0, 0, 0, 0, A, -1, 0, 0, B, 0];
+    var M = new Float32Array(16);
+    for (var col = 0; col < 4; col++) {
+      for (var row = 0; row < 4; row++) {
+        var s = 0;
+        for (var k = 0; k < 4; k++) s += P[k * 4 + row] * V[col * 4 + k];
+        M[col * 4 + row] = s;
+      }
+    }
+    return { mvp: M, basis: b, sx: sx, sy: sy };
+  }
+
+  /* World positions of a mesh posed by segment matrices.
+   * local: Float32Array (M*9) in segment coordinates; link: segment of each
+   * triangle; mats: Float32Array holding L blocks of 12 from index m0. */
+  function transform(out, o, local, link, mats, m0) {
+    var n = link.length;
+    for (var t = 0; t < n; t++) {
+      var b = m0 + link[t] * 12;
+      var a00 = mats[b], a01 = mats[b + 1], a02 = mats[b + 2], a03 = mats[b + 3];
+      var a10 = mats[b + 4], a11 = mats[b + 5], a12 = mats[b + 6], a13 = mats[b + 7];
+      var a20 = mats[b + 8], a21 = mats[b + 9], a22 = mats[b + 10], a23 = mats[b + 11];
+      for (var v = 0; v < 3; v++) {
+        var i = t * 9 + v * 3;
+        var x = local[i], y = local[i + 1], z = local[i + 2];
+        out[o++] = a00 * x + a01 * y + a02 * z + a03;
+        out[o++] = a10 * x + a11 * y + a12 * z + a13;
+        out[o++] = a20 * x + a21 * y + a22 * z + a23;
+      }
+    }
+    return o;
+  }
+
+  /* Per-vertex colours: the grey of each triangle, or mixed with a tint where
+   * tintLink (a segment index, -1 for none) matches the triangle's segment. */
+  function colours(out, o, grey, link, tintLink, tint) {
+    var n = grey.length;
+    for (var t = 0; t < n; t++) {
+      var g = grey[t], r = g, gg = g, bb = g;
+      if (link !== null && link[t] === tintLink) {
+        r = (g + tint[0]) >> 1; gg = (g + tint[1]) >> 1; bb = (g + tint[2]) >> 1;
+      }
+      for (var v = 0; v < 3; v++) { out[o++] = r; out[o++] = gg; out[o++] = bb; }
+    }
+    return o;
+  }
+
+  function Renderer(canvas) {
+    var gl = canvas.getContext('webgl', { antialias: false, preserveDrawingBuffer: true, alpha: false });
+    if (!gl) throw new Error('this browser has no WebGL, which the viewer needs');
+    this.gl = gl;
+    this.canvas = canvas;
+    var prog = gl.createProgram();
+    [[gl.VERTEX_SHADER, VS], [gl.FRAGMENT_SHADER, FS]].forEach(function (s) {
+      var sh = gl.createShader(s[0]);
+      gl.shaderSource(sh, s[1]);
+      gl.compileShader(sh);
+      if (!gl.getShaderParameter(sh, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(sh));
+      gl.attachShader(prog, sh);
+    });
+    gl.linkProgram(prog);
+    if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+    this.prog = prog;
+    this.aP = gl.getAttribLocation(prog, 'p');
+    this.aC = gl.getAttribLocation(prog, 'c');
+    this.uM = gl.getUniformLocation(prog, 'mvp');
+    this.pos = gl.createBuffer();
+    this.col = gl.createBuffer();
+    this.capacity = 0;
+  }
+
+  /* Draw one picture.  frame = {pos: Float32Array, col: Uint8Array,
+   * ranges: [{first, count, cam}]} with first/count in vertices. */
+  Renderer.prototype.draw = function (frame, bounds) {
+    var gl = this.gl, c = this.canvas;
+    gl.viewport(0, 0, c.width, c.height);
+    gl.clearColor(1, 1, 1, 1);
+    gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+    gl.enable(gl.DEPTH_TEST);
+    // Equal depths: the later triangle wins, as in the rasterizer.
+    gl.depthFunc(gl.LEQUAL);
+    gl.useProgram(this.prog);
+    var n = frame.pos.length;
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.pos);
+    gl.bufferData(gl.ARRAY_BUFFER, frame.pos.subarray(0, n), gl.DYNAMIC_DRAW);
+    gl.enableVertexAttribArray(this.aP);
+    gl.vertexAttribPointer(this.aP, 3, gl.FLOAT, false, 0, 0);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.col);
+    gl.bufferData(gl.ARRAY_BUFFER, frame.col.subarray(0, n), gl.DYNAMIC_DRAW);
+    gl.enableVertexAttribArray(this.aC);
+    gl.vertexAttribPointer(this.aC, 3, gl.UNSIGNED_BYTE, true, 0, 0);
+    for (var i = 0; i < frame.ranges.length; i++) {
+      var r = frame.ranges[i];
+      if (!r.count) continue;
+      gl.uniformMatrix4fv(this.uM, false, projection(r.cam, c.width, c.height, bounds).mvp);
+      gl.drawArrays(gl.TRIANGLES, r.first, r.count);
+    }
+  };
+
+  /* The nearest triangle under canvas pixel (px, py) (CSS pixels from the
+   * top left of a canvas cssW x cssH), or -1.  pos holds world vertices. */
+  function pick(px, py, cssW, cssH, cam, pos, first, count) {
+    var b = basis(cam);
+    var sx = 2 / cam.k, sy = sx * cssW / cssH;
+    var nx = (2 * px / cssW - 1) / sx, ny = (1 - 2 * py / cssH) / sy;
+    var d = [b.fwd[0] + b.right[0] * nx + b.up[0] * ny, b.fwd[1] + b.right[1] * nx + b.up[1] * ny,
+      b.fwd[2] + b.right[2] * nx + b.up[2] * ny];
+    var o = cam.eye, best = Infinity, hit = -1;
+    var end = first + count;
+    for (var v = first; v < end; v += 3) {
+      var i = v * 3;
+      var e1x = pos[i + 3] - pos[i], e1y = pos[i + 4] - pos[i + 1], e1z = pos[i + 5] - pos[i + 2];
+      var e2x = pos[i + 6] - pos[i], e2y = pos[i + 7] - pos[i + 1], e2z = pos[i + 8] - pos[i + 2];
+      var hx = d[1] * e2z - d[2] * e2y, hy = d[2] * e2x - d[0] * e2z, hz = d[0] * e2y - d[1] * e2x;
+      var a = e1x * hx + e1y * hy + e1z * hz;
+      if (a > -1e-20 && a < 1e-20) continue;
+      var f = 1 / a;
+      var sX = o[0] - pos[i], sY = o[1] - pos[i + 1], sZ = o[2] - pos[i + 2];
+      var u = f * (sX * hx + sY * hy + sZ * hz);
+      if (u < 0 || u > 1) continue;
+      var qx = sY * e1z - sZ * e1y, qy = sZ * e1x - sX * e1z, qz = sX * e1y - sY * e1x;
+      var w = f * (d[0] * qx + d[1] * qy + d[2] * qz);
+      if (w < 0 || u + w > 1) continue;
+      var t = f * (e2x * qx + e2y * qy + e2z * qz);
+      if (t > 0 && t <= best) { best = t; hit = (v - first) / 3; }
+    }
+    return hit;
+  }
+
+  /* Orbit, pan and zoom about cam.target, keeping cam.k (the field of view). */
+  function orbit(cam, dYaw, dPitch) {
+    var v = sub(cam.eye, cam.target), d = norm(v);
+    var pitch = Math.asin(Math.max(-1, Math.min(1, v[1] / d)));
+    var yaw = Math.atan2(v[0], v[2]);
+    if (Math.abs(v[0]) < 1e-12 * d && Math.abs(v[2]) < 1e-12 * d) {
+      // Straight above or below: LIG's picture has -Z towards its top.
+      yaw = v[1] > 0 ? 0 : Math.PI;
+    }
+    yaw -= dYaw;
+    pitch = Math.max(-1.5697, Math.min(1.5697, pitch + dPitch));
+    cam.eye = [cam.target[0] + d * Math.cos(pitch) * Math.sin(yaw), cam.target[1] + d * Math.sin(pitch),
+      cam.target[2] + d * Math.cos(pitch) * Math.cos(yaw)];
+  }
+
+  function pan(cam, dx, dy, cssW) {
+    var b = basis(cam), k = cam.k * b.distance / cssW;
+    var m = [(-b.right[0] * dx + b.up[0] * dy) * k, (-b.right[1] * dx + b.up[1] * dy) * k,
+      (-b.right[2] * dx + b.up[2] * dy) * k];
+    cam.eye = [cam.eye[0] + m[0], cam.eye[1] + m[1], cam.eye[2] + m[2]];
+    cam.target = [cam.target[0] + m[0], cam.target[1] + m[1], cam.target[2] + m[2]];
+  }
+
+  function zoom(cam, factor) {
+    var v = sub(cam.eye, cam.target);
+    cam.eye = [cam.target[0] + v[0] * factor, cam.target[1] + v[1] * factor, cam.target[2] + v[2] * factor];
+  }
+
+  /* Typed arrays out of the page's base64 blob: refs are {o, n, t}. */
+  function decodeBase64(text) {
+    var s = atob(text.replace(/\s+/g, ''));
+    var n = s.length, out = new Uint8Array(n);
+    for (var i = 0; i < n; i++) out[i] = s.charCodeAt(i);
+    return out;
+  }
+  var KINDS = { f32: Float32Array, u8: Uint8Array, u16: Uint16Array, i32: Int32Array, u32: Uint32Array };
+  function view(bytes, ref) {
+    var K = KINDS[ref.t];
+    return new K(bytes.buffer, bytes.byteOffset + ref.o, ref.n);
+  }
+
+  return {
+    Renderer: Renderer, basis: basis, projection: projection, transform: transform, colours: colours,
+    pick: pick, orbit: orbit, pan: pan, zoom: zoom, decodeBase64: decodeBase64, view: view
+  };
+})();
