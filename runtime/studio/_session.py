@@ -1,0 +1,181 @@
+"""One studio session: the Generator, the library it saves, and the JSON the page exchanges.
+
+The page sends choices as ``{"action": ..., ...}`` objects; :meth:`Session.act`
+checks every field before anything changes and answers with the whole
+state (:meth:`Session.state`).  All the posing logic is the
+:class:`~._generator.Generator`'s; this module only translates.
+"""
+
+from __future__ import annotations
+
+import base64
+import os
+import threading
+
+import numpy as np
+
+from ._generator import MODES, POPULATION, SEED_MAX, Generator
+from ._library import library_text
+
+__all__ = ["ACTIONS", "RequestError", "Session"]
+
+ACTIONS = ("state", "next", "take", "freeze", "undo", "keep", "stand", "seed", "settings", "save")
+
+
+class RequestError(ValueError):
+    """A request the studio refuses: the page gets it as a 400 with this message."""
+
+
+def _b64(a) -> str:
+    return base64.b64encode(np.ascontiguousarray(a, dtype="<f4").tobytes()).decode("ascii")
+
+
+def _int(body: dict, key: str, lo: int, hi: int) -> int:
+    v = body.get(key)
+    if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+        raise RequestError(f"'{key}' must be a whole number from {lo} to {hi}")
+    return v
+
+
+class Session:
+    """The state behind one ``liganimate studio``.
+
+    Parameters
+    ----------
+    figure : Figure
+    model, motion : str
+        The names the saved library gives the model and the motion.
+    save_path : str
+        The one library file Save writes.
+    seed : int
+    spacing : int
+        Frames between kept poses in the saved motion.
+    """
+
+    def __init__(self, figure, model: str, motion: str, save_path: str, seed: int = 1, spacing: int = 24):
+        self.generator = Generator(figure, seed=seed)
+        self.model, self.motion = model, motion
+        self.save_path = os.path.abspath(save_path)
+        self.spacing = spacing
+        self.saved = False
+        self.lock = threading.Lock()
+
+    # ---------------------------------------------------------------- state
+    def state(self, message: str = "") -> dict:
+        """The whole state as the page shows it (JSON-ready)."""
+        g = self.generator
+        poses = np.concatenate([g.current[None], g.candidates])
+        X = g.transforms(poses)[:, :, :3, :]  # (10, L, 3, 4)
+        return {
+            "seed": g.seed, "generation": g.generation, "intensity": g.intensity, "mode": g.mode,
+            "kept": len(g.kept), "canUndo": g.can_undo, "frozen": g.frozen.tolist(),
+            "saved": self.saved, "savePath": self.save_path, "message": message,
+            "matrices": _b64(X),
+            "angles": np.round(poses, 4).tolist(),
+            "levels": g.levels.tolist(),
+        }
+
+    # -------------------------------------------------------------- actions
+    def act(self, body) -> dict:
+        """Apply one request from the page; return the new state.
+
+        Raises
+        ------
+        RequestError
+            For anything malformed: not an object, an unknown action, a
+            missing or out-of-range field.  Nothing has changed then.
+        """
+        if not isinstance(body, dict):
+            raise RequestError("the request must be a JSON object")
+        action = body.get("action")
+        if action not in ACTIONS:
+            raise RequestError(f"unknown action {str(action)[:40]!r}; the actions are " + ", ".join(ACTIONS))
+        g = self.generator
+        with self.lock:
+            message = getattr(self, "_do_" + action)(g, body)
+            return self.state(message or "")
+
+    def _settings(self, g, body) -> None:
+        intensity, mode = body.get("intensity"), body.get("mode")
+        if intensity is not None and (isinstance(intensity, bool) or not isinstance(intensity, (int, float))
+                                      or not 0 <= intensity <= 1):
+            raise RequestError("'intensity' must be a number from 0 to 1")
+        if mode is not None and mode not in MODES:
+            raise RequestError("'mode' must be 'flexion' or 'twist'")
+        if intensity is not None:
+            g.set_intensity(float(intensity))
+        if mode is not None:
+            g.set_mode(mode)
+
+    def _do_state(self, g, body):
+        return ""
+
+    def _do_settings(self, g, body):
+        self._settings(g, body)
+
+    def _do_next(self, g, body):
+        self._settings(g, body)
+        g.next_generation()
+        return f"generation {g.generation}"
+
+    def _link_joint(self, g, body) -> tuple:
+        link = _int(body, "link", 0, g.figure.n_links - 1)
+        joint = g.joint_of_link(link)
+        name = g.figure.links[link].label
+        if joint is None:
+            raise RequestError(f"{name} is the main link: no joint moves it")
+        return joint, name
+
+    def _do_take(self, g, body):
+        candidate = _int(body, "candidate", 0, POPULATION - 1)
+        joint, name = self._link_joint(g, body)
+        g.take(candidate, joint)
+        return f"took {name} (joint {g.figure.joints[joint].id}) from candidate {candidate + 1}"
+
+    def _do_freeze(self, g, body):
+        joint, name = self._link_joint(g, body)
+        g.toggle_frozen(joint)
+        return f"{name} {'will not move' if g.frozen[joint] else 'moves again'}"
+
+    def _do_undo(self, g, body):
+        return "undone" if g.undo() else "nothing to undo"
+
+    def _do_keep(self, g, body):
+        g.keep()
+        self.saved = False
+        return f"kept pose {len(g.kept)}"
+
+    def _do_stand(self, g, body):
+        g.stand()
+        return "standing"
+
+    def _do_seed(self, g, body):
+        g.set_seed(_int(body, "seed", 0, SEED_MAX))
+        return f"seed {g.seed}: generation 1"
+
+    def _do_save(self, g, body):
+        if not g.kept:
+            raise RequestError("keep a pose first: the saved motion is made of the kept poses")
+        text = library_text(g.figure, self.model, self.motion, g.kept, self.spacing,
+                            note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept.")
+        write_library(self.save_path, text)
+        self.saved = True
+        return f"saved {len(g.kept)} pose(s) to {self.save_path}"
+
+
+def write_library(path: str, text: str) -> None:
+    """Check that ``text`` compiles as a library at ``path``, then write it atomically.
+
+    Raises
+    ------
+    LigDiagnostics
+        If it does not compile (nothing is written then).
+    OSError
+        If it cannot be written (the old file stays).
+    """
+    from liganimate.compiler import compile_source
+    from liganimate.lang.source import prepare
+    from liganimate.runtime.exchange import write_files
+
+    compile_source(prepare(text, path), path=path)
+    write_files([(path, text.encode("utf-8"))])

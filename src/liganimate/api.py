@@ -1,0 +1,161 @@
+"""The Python entry point: ``liganimate.load("scene.lig").view()``.
+
+:func:`load` compiles a program (a file or its text) the way ``liganimate
+run`` does; the :class:`LoadedProgram` it returns runs the scenes once
+without drawing them and shows them in the browser viewer.  In Jupyter,
+a loaded program, or the :class:`View` of one of its scenes, displays as
+the viewer itself (``_repr_html_``), in a sandboxed frame.
+"""
+
+from __future__ import annotations
+
+import os
+
+from liganimate.lang.diagnostics import LigDiagnostics, format_diagnostic
+
+__all__ = ["LigProgramError", "LoadedProgram", "View", "load"]
+
+
+class LigProgramError(LigDiagnostics):
+    """A program that does not compile or run; ``str()`` is the diagnostics as the command line prints them."""
+
+    def __str__(self) -> str:
+        return "\n".join(format_diagnostic(d) for d in self.diagnostics)
+
+
+def _reraise(exc: LigDiagnostics):
+    raise LigProgramError(exc.diagnostics) from None
+
+
+class View:
+    """The viewer page for some scenes of a program.
+
+    Attributes
+    ----------
+    html : str
+        The complete, self-contained HTML document (what ``liganimate view`` writes).
+    """
+
+    def __init__(self, html: str, height: int = 560):
+        self.html = html
+        self.height = height
+
+    def save(self, path) -> str:
+        """Write the page to ``path`` atomically; return the path."""
+        from liganimate.runtime.exchange import write_files
+
+        write_files([(os.fspath(path), self.html.encode("utf-8"))])
+        return os.fspath(path)
+
+    def _repr_html_(self) -> str:
+        from liganimate.runtime.view import iframe
+
+        return iframe(self.html, self.height)
+
+
+class LoadedProgram:
+    """A compiled LIG ANIMATE program.
+
+    Attributes
+    ----------
+    name : str
+        The file name, or ``"<text>"``.
+    program : liganimate.runtime.host.Program
+        The compiled program (``check``, ``execute``, ``render``).
+    warnings : list of Diagnostic
+        The compiler's warnings.
+    """
+
+    def __init__(self, name: str, program, warnings: list):
+        self.name = name
+        self.program = program
+        self.warnings = warnings
+        self._scenes = None
+
+    def scenes(self) -> list:
+        """Run the program once without drawing; its shot scenes (``SceneTake``), cached.
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs.
+        """
+        if self._scenes is None:
+            from liganimate.runtime.exchange import collect
+
+            try:
+                self._scenes = collect(self.program)
+            except LigDiagnostics as exc:
+                _reraise(exc)
+        return self._scenes
+
+    def view(self, scene=None, height: int = 560) -> View:
+        """The viewer for every scene, or for the scene whose identifier is ``scene``.
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs.
+        ValueError
+            When the program shoots no scene, or none with that identifier.
+        """
+        from liganimate.runtime.view import viewer_html
+
+        takes = self.scenes()
+        if scene is not None:
+            takes = [t for t in takes if t.id == scene]
+            if not takes:
+                shot = ", ".join(str(t.id) for t in self.scenes()) or "none"
+                raise ValueError(f"the program shoots no scene {scene!r} (it shoots: {shot})")
+        if not takes:
+            raise ValueError("the program shoots no scene, so there is nothing to view")
+        title = os.path.basename(self.name) + ("" if scene is None else f", scene {scene}")
+        return View(viewer_html(takes, title), height)
+
+    def _repr_html_(self) -> str:
+        return self.view()._repr_html_()
+
+    def __repr__(self) -> str:
+        return f"<liganimate program {self.name!r}>"
+
+
+def load(path_or_text) -> LoadedProgram:
+    """Compile a LIG ANIMATE program from a file or from its text.
+
+    Parameters
+    ----------
+    path_or_text : str or os.PathLike
+        A path (a path object, a string naming an existing file, or a
+        one-line string ending in ``.lig``), or otherwise the program text
+        itself; a text's relative LOADs start from the current folder.
+
+    Returns
+    -------
+    LoadedProgram
+
+    Raises
+    ------
+    LigProgramError
+        When the program does not compile (its ``str()`` is the diagnostics).
+    OSError
+        When the file cannot be read.
+    """
+    from liganimate.compiler import compile_file, compile_text
+
+    if isinstance(path_or_text, os.PathLike):
+        path, text = os.fspath(path_or_text), None
+    elif not isinstance(path_or_text, str):
+        raise TypeError(f"load() takes a path or the program's text, not {type(path_or_text).__name__}")
+    elif "\n" not in path_or_text and (path_or_text.lower().endswith(".lig") or os.path.isfile(path_or_text)):
+        path, text = path_or_text, None
+    else:
+        path, text = None, path_or_text
+    try:
+        compiled = compile_file(path) if text is None else compile_text(text, "<text>")
+    except LigDiagnostics as exc:
+        _reraise(exc)
+    name = path if path is not None else "<text>"
+    namespace = {"__name__": "liganimate_program", "__file__": name}
+    # The compiler's own output; program text reaches it only through repr().
+    exec(compile(compiled.python, f"<liganimate {name}>", "exec"), namespace)  # noqa: S102
+    return LoadedProgram(name, namespace["program"], compiled.warnings)

@@ -1,0 +1,161 @@
+"""``liganimate view`` and ``liganimate studio``: scenes in the browser, and posing by eye.
+
+:func:`add_commands` registers both subcommands on the main command's
+subparsers.  Errors are diagnostics as everywhere in liganimate (exit 1, no
+traceback), and ``view`` writes its page only when the program has run
+cleanly, atomically.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+
+def _lig_name(text: str) -> str:
+    from liganimate.runtime.studio import lig_name
+
+    if not lig_name(text):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a LIG name a library can define "
+                                         "(a letter, then letters, digits and _; not a keyword)")
+    return text.upper()
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 2**32 - 1:
+        raise argparse.ArgumentTypeError(f"the seed must be a whole number from 0 to 4294967295, not {text!r}")
+    return value
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a port number (0 picks a free one)")
+    return value
+
+
+def _frames(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= 1_000_000:
+        raise argparse.ArgumentTypeError(f"the frames between kept poses must be 1 to 1000000, not {text!r}")
+    return value
+
+
+def add_commands(subparsers) -> None:
+    """Add ``view`` and ``studio`` to the ``liganimate`` command's subparsers."""
+    p = subparsers.add_parser("view", help="write a program's scenes as one HTML page with a 3D viewer",
+                              description="Run the program once without drawing and write a self-contained "
+                                          "HTML page that shows its scenes in 3D (see docs/viewer.md).")
+    p.add_argument("file")
+    p.add_argument("-o", "--output", metavar="OUT.html", help="default: <stem>.html in the current folder")
+    p.add_argument("--quiet", action="store_true", help="do not say what was written")
+    p.set_defaults(func=cmd_view)
+    p = subparsers.add_parser("studio", help="pose a model by eye with the posing thesis' Generator, in the browser",
+                              description="Start a local server (127.0.0.1 only) with the Generator of the thesis on "
+                                          "posing figures with interactive genetic algorithms (see docs/viewer.md).")
+    p.add_argument("file", nargs="?", help="a program whose model to pose (default: the standard library)")
+    p.add_argument("--model", type=_lig_name, help="the MODEL to pose (default HUMANOID, or the file's only model)")
+    p.add_argument("--save", metavar="LIB.lig", help="the library Save writes (default: <model>_poses.lig)")
+    p.add_argument("--motion", type=_lig_name, default="POSES", help="the saved MOTION's name (default POSES)")
+    p.add_argument("--frames", type=_frames, default=24, metavar="N",
+                   help="frames between kept poses in the saved motion (default 24)")
+    p.add_argument("--seed", type=_seed, help="the Generator's seed (default: a random one, shown)")
+    p.add_argument("--port", type=_port, default=0, help="the port (default: a free one, printed)")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser; just print the address")
+    p.add_argument("--verbose", action="store_true", help="log every request")
+    p.set_defaults(func=cmd_studio)
+
+
+def cmd_view(args) -> int:
+    """``liganimate view FILE [-o OUT.html]``."""
+    from liganimate.cli import _guarded, _print_diagnostics, load_program
+
+    def go():
+        from liganimate.runtime import exchange as X
+        from liganimate.runtime.errors import LigError
+        from liganimate.runtime.view import viewer_html
+
+        out = args.output or os.path.splitext(os.path.basename(args.file))[0] + ".html"
+        program, warnings = load_program(args.file)
+        _print_diagnostics(warnings)
+        run_warnings: list = []
+        scenes = X.collect(program, run_warnings)
+        _print_diagnostics(run_warnings)
+        if not scenes:
+            raise LigError("the program shoots no scene, so there is nothing to view.",
+                           "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES")
+        page = viewer_html(scenes, os.path.basename(args.file)).encode("utf-8")
+        X.write_files([(out, page)])
+        if not args.quiet:
+            size = f"{len(page) / 1e6:.1f} MB" if len(page) >= 1e5 else f"{len(page) / 1e3:.0f} kB"
+            sys.stderr.write(f"wrote {out} ({size}, {len(scenes)} scene(s))\n")
+        return 0
+
+    return _guarded(go)
+
+
+def cmd_studio(args) -> int:
+    """``liganimate studio [FILE] [--model NAME] ...``: serve until Ctrl-C."""
+    from liganimate.cli import _guarded
+
+    def go():
+        import secrets
+        import webbrowser
+
+        from liganimate.runtime.errors import LigError
+        from liganimate.runtime.studio import (
+            Session,
+            StudioServer,
+            serve,
+            studio_model,
+            studio_page,
+        )
+
+        fig, model, source = studio_model(args.file, args.model)
+        if args.motion == model:
+            raise LigError(f"the model and the motion cannot both be called {model}.",
+                           "give the motion another name with --motion")
+        save = os.path.abspath(args.save or f"{model.lower()}_poses.lig")
+        if not save.lower().endswith(".lig"):
+            raise LigError(f"{args.save} does not end in .lig, so LOAD would not take it.",
+                           "name the library file something.lig")
+        if not os.path.isdir(os.path.dirname(save)):
+            raise LigError(f"there is no folder {os.path.dirname(save)} to save {os.path.basename(save)} in.")
+        seed = args.seed if args.seed is not None else secrets.randbelow(2**32)
+        session = Session(fig, model, args.motion, save, seed=seed, spacing=args.frames)
+        server = StudioServer(session, studio_page(session.generator, model), port=args.port, quiet=not args.verbose)
+        print(f"liganimate studio: posing {model} from {source}, seed {seed}", flush=True)
+        print(f"  open {server.url}  (127.0.0.1 only; Ctrl-C stops the server)", flush=True)
+        print(f"  Save writes {save}", flush=True)
+        if not args.no_browser:
+            webbrowser.open(server.url)
+        try:
+            serve(server)
+        except KeyboardInterrupt:
+            print("\nliganimate studio: stopped", flush=True)
+        return 0
+
+    return _guarded(go)
+
+
+def main(argv=None) -> int:
+    """``python -m liganimate.view_cli view|studio ...`` (the same commands on their own)."""
+    parser = argparse.ArgumentParser(prog="liganimate")
+    add_commands(parser.add_subparsers(dest="command", required=True))
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
