@@ -9,38 +9,97 @@ runs, so building it never recurses.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Self
+
+_M12, _M24, _M64 = (1 << 12) - 1, (1 << 24) - 1, (1 << 64) - 1
+_START = _M24 | _M12 << 24  # the line and column bits of a packed Pos
+_int_new = int.__new__
 
 
-@dataclass(frozen=True, slots=True)
-class Pos:
-    """A source span: 1-based lines and columns, end exclusive."""
+def _zig(n: int) -> int:
+    return n << 1 if n >= 0 else ((-n) << 1) - 1
 
-    line: int
-    column: int
-    end_line: int
-    end_column: int
+
+def _unzig(z: int) -> int:
+    return z >> 1 if not z & 1 else -((z + 1) >> 1)
+
+
+class Pos(int):
+    """A source span: 1-based lines and columns, end exclusive.
+
+    Read it as ``pos.line``, ``pos.column``, ``pos.end_line`` and
+    ``pos.end_column``; make it as ``Pos(line, column, end_line, end_column)``.
+    It is a value: immutable, hashable, equal to another Pos with the same
+    four numbers.
+
+    A big program has millions of positions, so the four numbers are packed
+    into one int (48 bytes, where an object with four fields took 64 and
+    kept its line number alive in another 32). The usual span (line below
+    2**24, columns below 4096, at most 4095 lines long) packs into 60 bits;
+    any other is stored negated, each number zigzag-encoded in 64 bits.
+    """
+
+    __slots__ = ()
+
+    def __new__(cls, line: int, column: int, end_line: int, end_column: int) -> Self:
+        lines = end_line - line
+        # (a | b) >> k is 0 exactly when both are in [0, 2**k): one test for range and sign.
+        if not ((column | end_column | lines) >> 12 or line >> 24):
+            return _int_new(cls, line | column << 24 | end_column << 36 | lines << 48)
+        packed = 0
+        for shift, n in ((0, line), (64, column), (128, end_line), (192, end_column)):
+            z = _zig(n)
+            if z > _M64:
+                raise OverflowError(f"position {n} is out of range")
+            packed |= z << shift
+        return _int_new(cls, -1 - packed)
+
+    @property
+    def line(self) -> int:
+        """First line (1-based)."""
+        return self & _M24 if self >= 0 else _unzig((-1 - self) & _M64)
+
+    @property
+    def column(self) -> int:
+        """First column (1-based)."""
+        return self >> 24 & _M12 if self >= 0 else _unzig((-1 - self) >> 64 & _M64)
+
+    @property
+    def end_line(self) -> int:
+        """Last line."""
+        return (self & _M24) + (self >> 48) if self >= 0 else _unzig((-1 - self) >> 128 & _M64)
+
+    @property
+    def end_column(self) -> int:
+        """Column just after the end."""
+        return self >> 36 & _M12 if self >= 0 else _unzig((-1 - self) >> 192)
 
     def to(self, other: Pos) -> Pos:
         """The span from the start of ``self`` to the end of ``other``."""
+        if self >= 0 and other >= 0:
+            lines = (other & _M24) + (other >> 48) - (self & _M24)
+            if not lines >> 12:
+                return _int_new(Pos, (self & _START) | (other >> 36 & _M12) << 36 | lines << 48)
         return Pos(self.line, self.column, other.end_line, other.end_column)
 
+    def __bool__(self) -> bool:
+        return True  # a position, not a number: even NOWHERE
 
-def _init_pos(self, line: int, column: int, end_line: int, end_column: int) -> None:
-    _set_line(self, line)
-    _set_column(self, column)
-    _set_end_line(self, end_line)
-    _set_end_column(self, end_column)
+    def __repr__(self) -> str:
+        return f"Pos(line={self.line}, column={self.column}, end_line={self.end_line}, end_column={self.end_column})"
+
+    __str__ = __repr__
+
+    def __reduce__(self):
+        return (Pos, (self.line, self.column, self.end_line, self.end_column))
 
 
-# A frozen dataclass's __init__ assigns through object.__setattr__, which made
-# each Pos cost three times a plain object; a big program makes millions. The
-# slots' own setters do the same job; assigning to a field from outside still
-# raises FrozenInstanceError.
-_set_line, _set_column = Pos.line.__set__, Pos.column.__set__
-_set_end_line, _set_end_column = Pos.end_line.__set__, Pos.end_column.__set__
-_init_pos.__doc__ = Pos.__init__.__doc__
-_init_pos.__qualname__ = "Pos.__init__"
-Pos.__init__ = _init_pos  # type: ignore[method-assign]
+def token_pos(line: int, column: int, end_column: int) -> Pos:
+    """``Pos(line, column, line, end_column)``, quicker: the parser makes one for every name and number."""
+    if not ((column | end_column) >> 12 or line >> 24):
+        return _int_new(Pos, line | column << 24 | end_column << 36)
+    return Pos(line, column, line, end_column)
+
 
 NOWHERE = Pos(0, 0, 0, 0)
 

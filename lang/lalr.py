@@ -135,6 +135,7 @@ class Driver:
         pos = 0
         line, line_start = 1, 0
         tok = None
+        spellings: dict = {}
         while True:
             # ------------------------------------------------ next token
             m = scan(text, pos)
@@ -159,6 +160,13 @@ class Driver:
                     ttype = "PRIM_NAME" if word in primitives else "NAME"
             elif k == NUMBER:
                 ttype = "NUMBER"
+                # The syntax tree keeps each number's spelling: share the
+                # spellings that repeat (a bounded table, for endless distinct ones).
+                seen = spellings.get(value)
+                if seen is not None:
+                    value = seen
+                elif len(spellings) < 4096:
+                    spellings[value] = value
             elif k == OPERATOR:
                 ttype = choice.get((stack[-1], value))
                 if ttype is None:

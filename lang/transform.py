@@ -19,7 +19,7 @@ TOKENS = (Token, Tok)
 
 def _tpos(tok: Token) -> A.Pos:
     if type(tok) is Tok:
-        return A.Pos(tok[3], tok[4], tok[3], tok[5])
+        return A.token_pos(tok[3], tok[4], tok[5])
     return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column)
 
 
@@ -48,21 +48,20 @@ def _last_pos_of(x) -> A.Pos | None:
 
 def span(children) -> A.Pos:
     """The span covering all positioned children."""
-    # The usual shapes first (a token or a node at each end), without
-    # making a position for each end only to join them.
+    # The usual shapes first: a token or a node at each end.
     if children:
         first, last = children[0], children[-1]
         if type(first) is Tok:
-            line, column = first[3], first[4]
+            start = A.token_pos(first[3], first[4], first[5])
         elif isinstance(first, A.Node):
-            line, column = first.pos.line, first.pos.column
+            start = first.pos
         else:
-            line = None
-        if line is not None:
+            start = None
+        if start is not None:
             if type(last) is Tok:
-                return A.Pos(line, column, last[3], last[5])
+                return start.to(A.token_pos(last[3], last[4], last[5]))
             if isinstance(last, A.Node):
-                return A.Pos(line, column, last.pos.end_line, last.pos.end_column)
+                return start.to(last.pos)
     first = _pos_of(children)
     last = _last_pos_of(children)
     if first is None:
