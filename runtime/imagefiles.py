@@ -3,20 +3,24 @@
 Every writer is atomic: it writes a temporary file in the destination's
 folder and renames it over the destination only when complete, so a reader
 never sees a half-written file and a failed write leaves any earlier file
-intact.
+intact.  Whatever fails (creating, writing, flushing, syncing, closing or
+renaming), the temporary file is removed and the error names the file the
+caller asked for (see :class:`AtomicWriter`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import shutil
 import struct
 import subprocess
 import tempfile
 import zlib
+from collections.abc import Iterable
 from fractions import Fraction
-from typing import Iterable
+from typing import Self
 
 import numpy as np
 
@@ -175,7 +179,7 @@ def write_png(path, img, *, fsync: bool = True) -> None:
         crash the file is either the old one or the complete new one.
     """
     data = encode_png(img)
-    with _atomic(path, fsync) as f:
+    with AtomicWriter(path, fsync) as f:
         f.write(data)
 
 
@@ -239,7 +243,7 @@ def write_gif(path, frames_iter: Iterable, fps: float) -> int:
     canvas = Image.new("L", (size[1], size[0]))
     header, _ = GifImagePlugin.getheader(canvas, None, {"loop": 0, "duration": 1, "optimize": False})
     n = 0
-    with _atomic(path, True) as f:
+    with AtomicWriter(path) as f:
         for part in header:
             f.write(part)
         for frame in _chain_checked(first, frames, size):
@@ -288,8 +292,11 @@ def write_mp4(path, frames_iter: Iterable, fps: float) -> int:
     H, W = first.shape
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix="." + os.path.basename(path) + ".", suffix=".tmp")
-    os.close(fd)
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix="." + os.path.basename(path) + ".", suffix=".tmp")
+        os.close(fd)
+    except OSError as exc:
+        raise write_error(exc, path) from None
     # An exact rational rate, so e.g. 29.97 is not rounded by ffmpeg's parser.
     frac = Fraction(fps).limit_denominator(1_000_000)
     rate = f"{frac.numerator}/{frac.denominator}"
@@ -328,12 +335,15 @@ def write_mp4(path, frames_iter: Iterable, fps: float) -> int:
                     f"ffmpeg could not write the MP4 file {path} (exit status {rc}).",
                     hint=msg[-1] if msg else None,
                 )
-        with open(tmp, "rb+") as f:
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o666 & ~_UMASK)
-        os.replace(tmp, path)
+        try:
+            with open(tmp, "rb+") as f:
+                os.fsync(f.fileno())
+            os.chmod(tmp, 0o666 & ~_UMASK)
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise write_error(exc, path) from None
     finally:
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             os.remove(tmp)
     return n
 
@@ -395,25 +405,167 @@ def _chain_checked(first, rest, shape):
         yield frame
 
 
-@contextlib.contextmanager
-def _atomic(path, fsync: bool):
-    """An open binary file that replaces ``path`` only if the block succeeds."""
-    path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix="." + os.path.basename(path) + ".", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            yield f
-            f.flush()
-            if fsync:
-                os.fsync(f.fileno())
+# Plain words for the errors a full, read-only or forbidden destination gives.
+_ERRNO_WORDS = {
+    errno.ENOSPC: "no space left on device",
+    errno.EDQUOT: "disk quota exceeded",
+    errno.EFBIG: "the file grew larger than the system allows",
+    errno.EROFS: "the file system is read-only",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.EIO: "input/output error",
+    errno.ENOENT: "its folder does not exist",
+    errno.ENOTDIR: "part of its path is not a folder",
+    errno.EISDIR: "it is a folder",
+}
+
+
+def os_error_words(exc: OSError) -> str:
+    """A plain, lower-case phrase for an OSError ("no space left on device")."""
+    words = _ERRNO_WORDS.get(exc.errno)
+    if words is None:
+        text = exc.strerror or str(exc) or type(exc).__name__
+        words = text[:1].lower() + text[1:]
+    return words
+
+
+def write_error(exc: OSError, path) -> RenderError:
+    """The error to show for ``exc`` raised while writing ``path``: it names ``path``, not a temporary file."""
+    return RenderError(f"{os_error_words(exc)} while writing {os.fspath(path)}")
+
+
+class AtomicWriter:
+    """A file written under a temporary name and renamed over ``path`` by :meth:`commit`.
+
+    The temporary file (``.<name>.<random>.tmp``) lives in the destination's
+    folder, so the rename is atomic.  Data is written with ``os.write`` from
+    an in-memory buffer (no Python file object whose ``close`` could fail
+    half-way).  On any failure, and on :meth:`abort`, the temporary file is
+    unlinked before anything else is tried, so a full disk gets its space
+    back; :meth:`abort` may be called any number of times.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination; replaced if it exists.  It is also the name errors give.
+    fsync : bool, optional
+        Flush the data to disk before the rename (default), so that after a
+        crash the file is either the old one or the complete new one.
+    buffer : int, optional
+        Bytes gathered before each ``os.write``.
+
+    Raises
+    ------
+    RenderError
+        From any method, when the system refuses: the message names ``path``
+        and says why in words ("no space left on device while writing out/a.gif").
+    """
+
+    def __init__(self, path, fsync: bool = True, buffer: int = 1 << 18):
+        self.path = os.fspath(path)
+        self._fsync = fsync
+        self._limit = buffer
+        self._buf = bytearray()
+        self._fd = -1
+        self._tmp = None
+        folder = os.path.dirname(os.path.abspath(self.path))
+        try:
+            self._fd, self._tmp = tempfile.mkstemp(dir=folder, prefix="." + os.path.basename(self.path) + ".",
+                                                   suffix=".tmp")
+        except OSError as exc:
+            raise write_error(exc, self.path) from None
+
+    @property
+    def temporary(self):
+        """The temporary file's path while it exists, else None."""
+        return self._tmp
+
+    def write(self, data) -> None:
+        """Append bytes (or any buffer) to the file."""
+        if self._tmp is None:
+            raise ValueError("write to a finished AtomicWriter")
+        self._buf += data
+        if len(self._buf) >= self._limit:
+            self._guarded(self._drain)
+
+    def commit(self) -> None:
+        """Write what is buffered, sync, and rename the file over the destination."""
+        if self._tmp is None:
+            raise ValueError("commit of a finished AtomicWriter")
+        self._guarded(self._finish)
+
+    def abort(self) -> None:
+        """Remove the temporary file and release the descriptor; never raises an OSError."""
+        tmp, fd = self._tmp, self._fd
+        self._tmp, self._fd, self._buf = None, -1, bytearray()
+        # Unlink first: if closing fails (or is interrupted) the space is already given back.
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        if fd >= 0:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+    def _guarded(self, step) -> None:
+        try:
+            step()
+        except OSError as exc:
+            self.abort()
+            raise write_error(exc, self.path) from None
+        except BaseException:
+            self.abort()
+            raise
+
+    def _drain(self) -> None:
+        view = memoryview(self._buf)
+        try:
+            while view:
+                n = os.write(self._fd, view)
+                if n <= 0:  # a regular file never does this; do not spin if one does
+                    raise OSError(errno.EIO, "write wrote nothing")
+                view = view[n:]
+        finally:
+            view.release()
+        self._buf.clear()
+
+    def _finish(self) -> None:
+        self._drain()
+        if self._fsync:
+            os.fsync(self._fd)
         # mkstemp creates the file 0600; give it the permissions a plain open() would.
-        os.chmod(tmp, 0o666 & ~_UMASK)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(tmp)
-        raise
+        os.fchmod(self._fd, 0o666 & ~_UMASK)
+        fd, self._fd = self._fd, -1
+        os.close(fd)  # close can report a late write error (NFS, quotas): before the rename
+        os.replace(self._tmp, self.path)
+        self._tmp = None
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, kind, exc, tb) -> None:
+        if kind is None:
+            self.commit()
+        else:
+            self.abort()
+
+
+def _atomic(path, fsync: bool) -> AtomicWriter:
+    """An open binary file that replaces ``path`` only if the ``with`` block succeeds."""
+    return AtomicWriter(path, fsync)
+
+
+def fsync_folder(path) -> None:
+    """Make the renames done in folder ``path`` durable (a no-op where folders cannot be opened)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass  # some file systems refuse to sync a folder; the files themselves are synced
+    finally:
+        os.close(fd)
 
 
 # os.umask can only be read by setting it; do that once, at import, rather

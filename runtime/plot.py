@@ -13,7 +13,7 @@ import io
 import numpy as np
 
 from .errors import LigError
-from .imagefiles import _atomic
+from .imagefiles import AtomicWriter
 
 # Samples across the whole motion: enough for smooth curves over a few
 # hundred frames, bounded so that ``1000000000 * WALK`` still plots at once.
@@ -30,7 +30,7 @@ def sample_times(length: float, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     if length <= 0:
         return np.zeros(1)
     if length <= max_samples / 4:
-        return np.linspace(0.0, length, int(round(length * 4)) + 1)
+        return np.linspace(0.0, length, round(length * 4) + 1)
     return np.linspace(0.0, length, max_samples)
 
 
@@ -92,7 +92,7 @@ def plot_motion(rt, name: str, out_path: str) -> None:
     buffer = io.BytesIO()
     # No metadata: the same motion gives the same bytes.
     fig.savefig(buffer, format="png", metadata={"Software": None})
-    with _atomic(out_path, True) as fh:
+    with AtomicWriter(out_path) as fh:
         fh.write(buffer.getvalue())
 
 

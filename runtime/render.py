@@ -6,6 +6,12 @@ then the images are rasterized and written by a pool of worker processes
 (several images a task, so the cost of handing work over stays small), or
 in this process for scenes of only a few images.  At most a few batches are
 in flight at once, so memory stays flat however long a scene is.
+
+Faults: the output options are checked and the outputs locked before the
+first image (:mod:`.outputs`); worker processes ignore SIGINT and SIGTERM
+and die with this process; :meth:`Renderer.close` always waits for the
+images being written (bounded), stops the workers and removes temporary
+files, so an interrupted or failed render leaves only whole files.
 """
 
 from __future__ import annotations
@@ -14,13 +20,31 @@ import json
 import os
 import signal
 import sys
+import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
 from .camera import Camera
-from .imagefiles import find_ffmpeg, read_png, write_gif, write_mp4, write_png
-from .pose import joint_angles, mesh_table, static_triangles, world_transforms, world_triangles
+from .errors import RenderError
+from .imagefiles import (
+    AtomicWriter,
+    find_ffmpeg,
+    fsync_folder,
+    read_png,
+    write_gif,
+    write_mp4,
+    write_png,
+)
+from .outputs import KEYWORD_NAMES, OutputLock, check_outputs
+from .pose import (
+    joint_angles,
+    mesh_table,
+    static_triangles,
+    world_transforms,
+    world_triangles,
+)
 from .raster import Framebuffer, rasterize
 from .values import Graphical, grey_levels
 
@@ -31,6 +55,9 @@ CHUNK = 8
 # Bounds of the memory of evaluated joint angles: (model, motion) pairs, frames each.
 _ANGLE_MODELS = 64
 _ANGLE_FRAMES = 4096
+# Seconds close() waits for the images being drawn before it kills the workers.
+_CLOSE_WAIT = 30.0
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class Renderer:
@@ -51,13 +78,21 @@ class Renderer:
     workers : int or None
         Processes rasterizing in parallel (default: the machine's cores, at
         most 8); 1 draws everything in this process.
+
+    Raises
+    ------
+    RenderError
+        Before anything is written: an output option that cannot be
+        honoured (see :func:`.outputs.check_outputs`), MP4 without ffmpeg,
+        or an output another run is writing (see :class:`.outputs.OutputLock`).
     """
 
     def __init__(self, out_dir, size=(640, 480), gif=None, mp4=None, poses=None, fps=24.0, quiet=False,
                  workers=None, stdout=None, progress=None):
+        check_outputs(out_dir, gif, mp4, poses, fps, KEYWORD_NAMES)
         self.out_dir = out_dir
         self.size = (int(size[0]), int(size[1]))
-        self.gif, self.mp4, self.fps = gif, mp4, fps
+        self.gif, self.mp4, self.fps = gif, mp4, float(fps)
         if mp4:
             # No ffmpeg, no render: say so before any file is written.
             find_ffmpeg()
@@ -75,13 +110,15 @@ class Renderer:
         self.scene_id = None
         self.scene_total = 0
         self.progress = progress if progress is not None else (not quiet and sys.stderr.isatty())
-        self._poses_tmp = None
         self._poses_fh = None
+        self._closed = False
+        self.lock = OutputLock(out_dir, (gif, mp4, poses))
         if poses:
-            d = os.path.dirname(os.path.abspath(poses))
-            os.makedirs(d, exist_ok=True)
-            self._poses_tmp = os.path.join(d, f".{os.path.basename(poses)}.{os.getpid()}.tmp")
-            self._poses_fh = open(self._poses_tmp, "w", encoding="utf-8")
+            try:
+                self._poses_fh = AtomicWriter(poses)
+            except BaseException:
+                self.lock.release()
+                raise
 
     # --------------------------------------------------------------- scenes
     def begin_scene(self, scene_id) -> None:
@@ -196,7 +233,7 @@ class Renderer:
             segments.append({"link": link.name, "joint": parent.id if parent is not None else None,
                              "matrix": [_r(x) for x in X[i].reshape(-1)]})
         rec = {"scene": scene, "tick": tick, "image": image, "model": name, "joints": joints, "segments": segments}
-        self._poses_fh.write(json.dumps(rec, separators=(", ", ": ")) + "\n")
+        self._poses_fh.write((json.dumps(rec, separators=(", ", ": ")) + "\n").encode("utf-8"))
 
     def _submit(self, path, draws) -> None:
         self._chunk.append((path, draws))
@@ -212,14 +249,26 @@ class Renderer:
         if not chunk:
             return
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
-            self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init)
+            self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init,
+                                            initargs=(os.getpid(),))
+            self._worker_procs: list = []
+            # The first submit forks the workers.  With SIGINT and SIGTERM blocked
+            # meanwhile, a signal cannot reach a worker before it has set itself to
+            # ignore them; this process receives it once the mask is restored.
+            old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+            try:
+                self.futures.append(self.pool.submit(draw_images, self.size, chunk))
+                self._worker_procs = list((getattr(self.pool, "_processes", None) or {}).values())
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, old)
+            return
         if self.pool is None:
             draw_images(self.size, chunk)
             return
         self.futures.append(self.pool.submit(draw_images, self.size, chunk))
         # Enough in flight to keep every worker busy, no more (memory stays flat).
         while len(self.futures) > 2 * self.workers:
-            self.futures.pop(0).result()
+            _result(self.futures.pop(0))
 
     def _show_progress(self) -> None:
         if self.progress:
@@ -231,21 +280,22 @@ class Renderer:
     def finish(self) -> None:
         """Wait for every image, then write the GIF, MP4 and pose record."""
         self._send()
-        for f in self.futures:
-            f.result()
-        self.futures = []
+        while self.futures:
+            _result(self.futures.pop(0))
         if self.progress and self.images:
             sys.stderr.write("\n")
         if self._poses_fh is not None:
-            self._poses_fh.flush()
-            os.fsync(self._poses_fh.fileno())
-            self._poses_fh.close()
+            self._poses_fh.commit()
             self._poses_fh = None
-            os.replace(self._poses_tmp, self.poses_path)
         if self.gif and self.images:
             write_gif(self.gif, self._frames(), self.fps)
         if self.mp4 and self.images:
             write_mp4(self.mp4, self._frames(), self.fps)
+        # Each file was synced before its rename; syncing the folders makes the renames durable too.
+        folders = {os.path.join(self.out_dir, f"scene{scene_id}") for scene_id, _ in self.scenes}
+        folders |= {os.path.dirname(os.path.abspath(p)) for p in (self.gif, self.mp4, self.poses_path) if p}
+        for folder in sorted(folders) + [self.out_dir]:
+            fsync_folder(folder)
 
     def _frames(self):
         """Every image written, in order, read back one at a time."""
@@ -254,21 +304,62 @@ class Renderer:
                 yield read_png(os.path.join(self.out_dir, f"scene{scene_id}", f"{i:05d}.png"))
 
     def close(self) -> None:
-        """Release the worker pool and any half-written pose record."""
-        if self.pool is not None:
-            self.pool.shutdown(wait=True, cancel_futures=True)
-            self.pool = None
-        if self._poses_fh is not None:
-            self._poses_fh.close()
-            self._poses_fh = None
+        """Stop the workers and release everything; after an error or an interruption, leave only whole files.
+
+        Images already being drawn are waited for (at most ``_CLOSE_WAIT``
+        seconds, then their workers are killed), images not started are
+        dropped, the unfinished pose record and any temporary file are
+        removed, and the outputs' locks are released.  Safe to call more
+        than once; each step runs even if an earlier one fails.
+        """
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._stop_pool()
+        finally:
             try:
-                os.unlink(self._poses_tmp)
-            except OSError:
-                pass
+                if self._poses_fh is not None:
+                    self._poses_fh.abort()
+                    self._poses_fh = None
+                self.lock.sweep(self.out_dir, (self.gif, self.mp4, self.poses_path))
+            finally:
+                self.lock.release()
+
+    def _stop_pool(self) -> None:
+        pool, self.pool = self.pool, None
+        self.futures, self._chunk = [], []
+        if pool is None:
+            return
+        procs = self._worker_procs
+        pool.shutdown(wait=False, cancel_futures=True)
+        deadline = time.monotonic() + _CLOSE_WAIT
+        for p in procs:
+            p.join(max(0.0, deadline - time.monotonic()))
+        for p in procs:
+            if p.is_alive():
+                p.kill()  # stuck (a hung disk?): its temporary file is swept afterwards
+                p.join(5.0)
 
 
-def _worker_init() -> None:
-    """Set up a worker process: leave Ctrl-C to the main process, keep freed memory for reuse.
+def _result(future):
+    """A worker's result; a worker that died (killed, out of memory) is a RenderError, not a crash report."""
+    try:
+        return future.result()
+    except BrokenProcessPool:
+        raise RenderError("a worker process drawing the images stopped unexpectedly (killed, or out of memory); "
+                          "the images written before it are complete") from None
+
+
+def _worker_init(parent: int) -> None:
+    """Set up a worker process: signals are the parent's business, die with it, keep freed memory for reuse.
+
+    SIGINT and SIGTERM are ignored: the parent stops handing out work and
+    waits for the images being drawn, so every file is whole; workers dying
+    of KeyboardInterrupt mid-task would only print tracebacks.  If the
+    parent dies without stopping the pool (SIGKILL), the kernel kills the
+    worker (``PR_SET_PDEATHSIG`` on Linux) rather than leave it waiting for
+    work forever.
 
     Each image allocates and frees the same few large arrays; by default
     glibc hands large blocks back to the kernel and gets them again as fresh
@@ -276,10 +367,9 @@ def _worker_init() -> None:
     the MALLOC_MMAP_THRESHOLD_ and MALLOC_TRIM_THRESHOLD_ environment
     variables do at start-up) keeps them in the heap.
     """
-    # Ctrl-C is the main process's business: it stops handing out work and
-    # waits for the images being drawn, so every file is whole; workers
-    # dying of KeyboardInterrupt mid-task would only print tracebacks.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for s in _SIGNALS:
+        signal.signal(s, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent while it forked us
     try:
         import ctypes
 
@@ -287,6 +377,11 @@ def _worker_init() -> None:
         mallopt = libc.mallopt
     except (OSError, AttributeError):
         return  # not glibc
+    if sys.platform.startswith("linux"):
+        PR_SET_PDEATHSIG = 1
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        if os.getppid() != parent:
+            os._exit(1)  # the parent died before the death signal was armed
     M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
     mallopt(M_MMAP_THRESHOLD, 32 << 20)
     mallopt(M_TRIM_THRESHOLD, 256 << 20)

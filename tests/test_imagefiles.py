@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import struct
 import subprocess
@@ -79,10 +80,10 @@ def test_png_write_is_atomic(tmp_path, monkeypatch):
     old = path.read_bytes()
 
     def fail(fd):
-        raise OSError("disk full")
+        raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(imagefiles.os, "fsync", fail)
-    with pytest.raises(OSError):
+    with pytest.raises(RenderError, match=f"^no space left on device while writing {path}$"):
         write_png(path, np.full((4, 4), 255, np.uint8))
     assert path.read_bytes() == old  # the old file is intact
     assert leftovers(tmp_path) == []  # and no temporary file remains
@@ -221,3 +222,108 @@ def test_mp4_ffmpeg_failure_is_a_render_error(tmp_path, monkeypatch):
         write_mp4(path, frames(3), fps=10)
     assert path.read_bytes() == b"old"
     assert leftovers(tmp_path) == []
+
+
+# --------------------------------------------------------------------------
+# Faults: whatever step fails, the temporary file goes and the error names the file
+
+
+def _failing_at(monkeypatch, name, when=1, err=errno.ENOSPC):
+    """Make imagefiles' os.<name> raise OSError(err) on its ``when``-th call (1-based) from now on."""
+    real = getattr(imagefiles.os, name)
+    calls = []
+
+    def fake(*args, **kw):
+        calls.append(args)
+        if len(calls) >= when:
+            raise OSError(err, os.strerror(err))
+        return real(*args, **kw)
+
+    monkeypatch.setattr(imagefiles.os, name, fake)
+    return calls
+
+
+@pytest.mark.parametrize("step", ["write", "fsync", "fchmod", "close", "replace"])
+def test_atomic_writer_cleans_up_whatever_step_fails(tmp_path, monkeypatch, step):
+    path = tmp_path / "poses.jsonl"
+    path.write_bytes(b"old")
+    calls = _failing_at(monkeypatch, step)
+    with pytest.raises(RenderError) as info:
+        with imagefiles.AtomicWriter(path, buffer=4) as f:
+            f.write(b"0123456789" * 100)
+    assert calls, f"os.{step} was never called"
+    assert info.value.message == f"no space left on device while writing {path}"
+    assert ".tmp" not in info.value.message
+    monkeypatch.undo()
+    assert path.read_bytes() == b"old"
+    assert leftovers(tmp_path) == []
+
+
+def test_atomic_writer_unlinks_before_closing(tmp_path, monkeypatch):
+    # A full disk gets its space back even when close() itself fails (the old
+    # writer raised from close() before reaching its unlink, keeping 3 MB).
+    seen = []
+    real_close = os.close
+
+    def close(fd):
+        seen.append(leftovers(tmp_path))
+        real_close(fd)
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    writer = imagefiles.AtomicWriter(tmp_path / "a.gif")
+    writer.write(b"x" * 10)
+    monkeypatch.setattr(imagefiles.os, "close", close)
+    writer.abort()
+    writer.abort()  # idempotent
+    assert seen == [[]]
+    assert leftovers(tmp_path) == []
+
+
+def test_atomic_writer_interrupted_leaves_nothing(tmp_path, monkeypatch):
+    def interrupt(fd, data):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(imagefiles.os, "write", interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        with imagefiles.AtomicWriter(tmp_path / "a.png") as f:
+            f.write(b"data")
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("code, words", [(errno.EDQUOT, "disk quota exceeded"), (errno.EROFS, "read-only"),
+                                         (errno.EFBIG, "larger than the system allows")])
+def test_write_errors_are_plain_words_naming_the_file(tmp_path, monkeypatch, code, words):
+    _failing_at(monkeypatch, "write", err=code)
+    path = tmp_path / "x.gif"
+    with pytest.raises(RenderError, match=f"{words}.* while writing {path}$"):
+        write_gif(path, frames(3), fps=10)
+    monkeypatch.undo()
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_folder_that_refuses_new_files_is_named(tmp_path):
+    path = tmp_path / "missing" / "a.png"
+    with pytest.raises(RenderError, match=f"its folder does not exist while writing {path}$"):
+        write_png(path, np.zeros((2, 2), np.uint8))
+
+
+def test_gif_on_a_full_file_system_in_a_subprocess(tmp_path):
+    # A real write failure, not a patched one: RLIMIT_FSIZE makes write() fail
+    # with EFBIG past 20 kB (SIGXFSZ ignored), as a full disk fails with ENOSPC.
+    code = f"""
+import resource, signal, sys
+import numpy as np
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+from liganimate.runtime.errors import RenderError
+from liganimate.runtime.imagefiles import write_gif
+rng = np.random.default_rng(0)
+try:
+    write_gif({str(tmp_path / "big.gif")!r}, (rng.integers(0, 256, (64, 64), dtype=np.uint8) for _ in range(40)), 10)
+except RenderError as exc:
+    print(exc.message)
+"""
+    out = subprocess.run([__import__("sys").executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == f"the file grew larger than the system allows while writing {tmp_path / 'big.gif'}"
+    assert os.listdir(tmp_path) == []

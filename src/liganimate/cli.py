@@ -3,15 +3,20 @@
 Every user error is printed as a diagnostic (``file:line:col``, the line, a
 caret, a sentence, a hint) and the command exits with status 1; no Python
 traceback reaches the user, and nothing is written when a program is wrong.
+Output options (``-o``, ``--gif``, ``--mp4``, ``--poses``, ``--fps``) are
+checked before the program is compiled.  SIGINT and SIGTERM stop a command
+cleanly (exit status 130 and 143), leaving only whole files.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 
 from liganimate import __version__
+from liganimate.runtime import interrupts
 
 EXIT_USER_ERROR = 1
 EXIT_INTERNAL = 3
@@ -53,12 +58,34 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--gif", metavar="FILE", help="also write an animated GIF")
     p.add_argument("--mp4", metavar="FILE", help="also write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)")
     p.add_argument("--poses", metavar="FILE", help="write the pose record (JSON Lines, see docs/poses.md)")
-    p.add_argument("--fps", type=float, default=24.0, help="frame rate of the GIF and MP4 (default 24)")
+    p.add_argument("--fps", default="24", help="frame rate of the GIF and MP4, 0.01 to 1000 (default 24)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
-def _render(program, warnings, args, stem: str) -> int:
-    out = args.out or f"{stem}_frames"
+def _check_render_options(args, stem: str) -> str:
+    """Refuse output options that cannot be honoured, before compiling; return the frames folder.
+
+    Nothing is written here: the folder and lock files are made when
+    rendering starts.  An output another run is writing is refused now too.
+    """
+    from liganimate.runtime.imagefiles import find_ffmpeg
+    from liganimate.runtime.outputs import (
+        CLI_NAMES,
+        check_fps,
+        check_outputs,
+        refuse_if_locked,
+    )
+
+    out = args.out if args.out is not None else f"{stem}_frames"
+    args.fps = check_fps(args.fps, "--fps")
+    check_outputs(out, args.gif, args.mp4, args.poses, args.fps, CLI_NAMES)
+    if args.mp4:
+        find_ffmpeg()
+    refuse_if_locked(out, (args.gif, args.mp4, args.poses))
+    return out
+
+
+def _render(program, warnings, args, out: str) -> int:
     _print_diagnostics(warnings)
     warnings_run = program.check()
     _print_diagnostics(warnings_run)
@@ -70,9 +97,14 @@ def _render(program, warnings, args, stem: str) -> int:
 
 
 def _guarded(fn):
-    """Run a command, turning diagnostics into exit status 1 and bugs into a short report."""
+    """Run a command, turning diagnostics into exit status 1 and bugs into a short report.
+
+    KeyboardInterrupt (and :class:`~liganimate.runtime.interrupts.Interrupted`)
+    goes through, to :func:`_stopping`.
+    """
     from liganimate.lang.diagnostics import LigDiagnostics
     from liganimate.runtime.errors import LigError
+    from liganimate.runtime.imagefiles import os_error_words
 
     try:
         return fn()
@@ -91,11 +123,9 @@ def _guarded(fn):
         os.dup2(devnull, sys.stdout.fileno())
         return 0
     except OSError as exc:
-        sys.stderr.write(f"liganimate: error: {exc.strerror or exc}: {exc.filename or ''}\n")
+        where = f" ({exc.filename})" if exc.filename else ""
+        sys.stderr.write(f"liganimate: error: {os_error_words(exc)}{where}\n")
         return EXIT_USER_ERROR
-    except KeyboardInterrupt:
-        sys.stderr.write("\nliganimate: interrupted; every file already written is complete\n")
-        return 130
     except RecursionError:
         sys.stderr.write("liganimate: error: the program is nested too deeply to compile\n")
         return EXIT_USER_ERROR
@@ -107,11 +137,42 @@ def _guarded(fn):
         return EXIT_INTERNAL
 
 
+def _stopping(exc: KeyboardInterrupt) -> int:
+    """Report a stop by SIGINT (Ctrl-C) or SIGTERM; the exit status a shell gives a command it stopped."""
+    interrupts.ignore_signals()  # a second signal must not interrupt this message
+    if getattr(exc, "signum", None) == signal.SIGTERM:
+        sys.stderr.write("\nliganimate: terminated (SIGTERM); every file already written is complete\n")
+        return 143
+    sys.stderr.write("\nliganimate: interrupted; every file already written is complete\n")
+    return 130
+
+
+def _stoppable(fn, whole_process: bool) -> int:
+    """Run ``fn`` with SIGINT and SIGTERM turned into one clean stop (see runtime/interrupts.py).
+
+    When the command is the whole process (``argv`` from the command line),
+    a signal after it has finished is ignored: the process is only exiting,
+    and a KeyboardInterrupt there would print a traceback.  Called with an
+    explicit ``argv`` from other Python code, the usual handlers come back.
+    """
+    try:
+        interrupts.stop_on_signals()
+        status = fn()
+    except KeyboardInterrupt as exc:
+        return _stopping(exc)
+    if whole_process:
+        interrupts.ignore_signals()
+    else:
+        interrupts.restore_signals()
+    return status
+
+
 def cmd_run(args) -> int:
     def go():
-        program, warnings = load_program(args.file)
         stem = os.path.splitext(os.path.basename(args.file))[0]
-        return _render(program, warnings, args, stem)
+        out = _check_render_options(args, stem)
+        program, warnings = load_program(args.file)
+        return _render(program, warnings, args, out)
 
     return _guarded(go)
 
@@ -235,14 +296,20 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Entry point of the ``liganimate`` command."""
-    args = build_parser().parse_args(argv)
-    return args.func(args)
+    def go():
+        args = build_parser().parse_args(argv)
+        return args.func(args)
+
+    return _stoppable(go, argv is None)
 
 
 def run_program_cli(program, argv=None) -> int:
     """``python compiled.py [-o DIR] ...``: render a compiled module."""
     parser = argparse.ArgumentParser(prog=os.path.basename(sys.argv[0]), description=f"Render {program.name}.")
     _add_render_options(parser)
-    args = parser.parse_args(argv)
-    stem = os.path.splitext(os.path.basename(program.name))[0]
-    return _guarded(lambda: _render(program, [], args, stem))
+    def go():
+        args = parser.parse_args(argv)
+        stem = os.path.splitext(os.path.basename(program.name))[0]
+        return _guarded(lambda: _render(program, [], args, _check_render_options(args, stem)))
+
+    return _stoppable(go, argv is None)
