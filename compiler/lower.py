@@ -32,7 +32,22 @@ _ZERO = {
 # Inline range tests of + - * results (lang/numbers.py): a chained comparison,
 # false for NaN, costs a fraction of a call; only a result out of range calls
 # the runtime, which reports it at the operation.
-_BOUND = {T.INTEGER: repr(N.INT_MAX), T.REAL: repr(N.REAL_MAX)}
+# The bounds are module globals (_lo_I <= x <= _hi_I): a global costs about
+# what a constant does, and the generated text stays short.
+_BOUND = {T.INTEGER: ("_lo_I", "_hi_I"), T.REAL: ("_lo_R", "_hi_R")}
+_BOUND_DEFS = (
+    f"_lo_I, _hi_I = {-N.INT_MAX!r}, {N.INT_MAX!r}  # INTEGER range (lang/numbers.py)",
+    f"_lo_R, _hi_R = {-N.REAL_MAX!r}, {N.REAL_MAX!r}  # REAL range",
+    "",
+    "",
+    "def _ck(x, kind, at):",
+    '    """x, the value of a + - * expression, if it is in range (kind: I or R, and the operator)."""',
+    '    if (_lo_I <= x <= _hi_I) if kind[0] == "I" else (_lo_R <= x <= _hi_R):',
+    "        return x",
+    "    _host.overflow(program, x, kind, at)",
+    "",
+)
+_KIND = {T.INTEGER: "I", T.REAL: "R", T.VECTOR: "V"}
 _CHECKED = (T.INTEGER, T.REAL, T.VECTOR)
 _ARITH = ("+", "-", "*")
 
@@ -51,6 +66,11 @@ class Lowerer:
         self.doc_name = module_doc_name
         self.canvas = None
         self.tmp = 0
+        # > 0 inside code that runs many times (DO bodies, scene bodies,
+        # primitives): there + - * results are range-checked inline, which
+        # runs fastest; elsewhere by a call, which CPython compiles several
+        # times faster (a conditional expression costs ~40 us to compile).
+        self.hot = 0
 
     # ------------------------------------------------------------- basics
     def at(self, node) -> int:
@@ -84,6 +104,7 @@ class Lowerer:
             "from liganimate.runtime import host as _host",
             "",
             f"_SOURCE_NAME = {self.doc_name!r}",
+            *_BOUND_DEFS,
             "",
         ]
         body_start = len(self.lines)
@@ -139,7 +160,7 @@ class Lowerer:
             else:
                 code = self.expr(default)
                 if scope.types.get(p) == T.REAL and not isinstance(default, tuple) and self.type_of(default) == T.INTEGER:
-                    code = f"float({code})"  # a REAL parameter holds a REAL
+                    code = _as_real(default, code)  # a REAL parameter holds a REAL
                 self.emit(f"{p} = {code}")
             self.indent -= 1
         for var, t in sorted(scope.types.items()):
@@ -147,7 +168,9 @@ class Lowerer:
                 self.emit(f"{var} = {_ZERO[t]}")
         self.emit("_g = rt.canvas()")
         self.scope_types = scope.types
+        self.hot += 1
         self.block(pdef.body, "primitive")
+        self.hot -= 1
         self.emit("return _g.result()")
         self.scope_types = None
         self.indent -= 1
@@ -177,7 +200,7 @@ class Lowerer:
         value = self.expr(s.value)
         scope_t = self.var_type(target)
         if scope_t == T.REAL and self.type_of(s.value) == T.INTEGER:
-            value = f"float({value})"
+            value = _as_real(s.value, value)
         self.emit(f"{target} = {value}")
 
     def var_type(self, name: str):
@@ -203,10 +226,12 @@ class Lowerer:
         step = self.expr(s.step) if s.step is not None else "1"
         start = self.expr(s.start)
         if self.var_type(s.var.name) == T.REAL and self.type_of(s.start) == T.INTEGER:
-            start = f"float({start})"  # a REAL variable counts in REALs
+            start = _as_real(s.start, start)  # a REAL variable counts in REALs
         self.emit(f"for {s.var.name} in rt.do_range({start}, {self.expr(s.stop)}, {step}, {self.at(s)}):")
         self.indent += 1
+        self.hot += 1
         self.block(s.body, where)
+        self.hot -= 1
         self.indent -= 1
 
     def s_If(self, s, where):
@@ -307,7 +332,9 @@ class Lowerer:
         self.indent += 1
         if animated:
             self.emit(f"{_tuple_target(animated)} = _base")
+        self.hot += 1
         self.block(s.body, "scene-body")
+        self.hot -= 1
         pairs = "".join(f"({n!r}, {n}), " for n in animated)
         self.emit(f"rt.end_tick(({pairs}))")
         self.indent -= 1
@@ -406,11 +433,13 @@ class Lowerer:
             if not root:
                 return f"({text})"
             single = not (_in_chain(e.left, t, self) or _in_chain(e.right, t, self))
-            kind = t + (e.op if single else "")
+            kind = _KIND[t] + (e.op if single else "")
             if t == T.VECTOR:
                 return f"rt.vector_ok({text}, {self.at(e)}, {kind!r})"
-            b = _BOUND[t]
-            return f"(_n if -{b} <= (_n := {text}) <= {b} else rt.overflow(_n, {kind!r}, {self.at(e)}))"
+            if not self.hot:
+                return f"_ck({text}, {kind!r}, {self.at(e)})"
+            lo, hi = _BOUND[t]
+            return f"(_n if {lo} <= (_n := {text}) <= {hi} else rt.overflow(_n, {kind!r}, {self.at(e)}))"
         left, right = self.expr(e.left), self.expr(e.right)
         if e.op == "/":
             return f"rt.div({left}, {right}, {self.at(e.op_pos)})"
@@ -454,7 +483,7 @@ class Lowerer:
                 value = given[slot.keyword]
                 code = self.expr(value)
                 if sig.param_types.get(slot.keyword) == T.REAL and self.type_of(value) == T.INTEGER:
-                    code = f"float({code})"  # a REAL parameter holds a REAL
+                    code = _as_real(value, code)  # a REAL parameter holds a REAL
                 args.append(f"{slot.param}={code}")
         pdef = self.c.primitives[e.name][0]
         own = pdef is not None or e.name in self.c.loaded_primitives
@@ -485,6 +514,13 @@ class Lowerer:
         if isinstance(c, A.Not):
             return f"(not {self.cond(c.operand)})"
         return f"({self.expr(c.left)} {_CMP[c.op]} {self.expr(c.right)})"
+
+
+def _as_real(e, code: str) -> str:
+    """Code for an INTEGER expression's value as a REAL (a literal is converted here, once)."""
+    if isinstance(e, A.Num) and not isinstance(e.value, N.BadLiteral):
+        return repr(float(e.value))
+    return f"float({code})"
 
 
 def _in_chain(e, t, lowerer) -> bool:

@@ -38,15 +38,13 @@ class Arithmetic:
     def overflow(self, value, kind, at):
         """Report the value of a chain of ``+ - *`` that is outside the language's numbers.
 
-        ``kind`` is the chain's static type, followed by its operator when
-        the chain is that one operation (``'REAL*'``).
+        ``kind`` is the chain's static type (``I``, ``R``), followed by its
+        operator when the chain is that one operation (``'R*'``).
         """
-        if kind.startswith("REAL") and isinstance(value, int):
-            value = math.inf  # a REAL-typed expression holding a huge whole number
-        exc = N.overflow(value, _RESULT.get(kind[-1], "the value of this expression"))
+        exc = overflow_error(value, kind)
         self.fail(at, exc.message, exc.hint)
 
-    def vector_ok(self, v, at, kind="VECTOR"):
+    def vector_ok(self, v, at, kind="V"):
         """``v`` if its components are finite, else a diagnostic at ``at`` (``kind`` as for :meth:`overflow`)."""
         if _finite_vec(v):
             return v
@@ -186,6 +184,13 @@ class Arithmetic:
 
     def f_Z(self, a, at):
         return a[2]
+
+
+def overflow_error(value, kind) -> N.NumberError:
+    """The error for a + - * value out of range (``kind`` as for :meth:`Arithmetic.overflow`)."""
+    if kind[0] == "R" and isinstance(value, int):
+        value = math.inf  # a REAL-typed expression holding a huge whole number
+    return N.overflow(value, _RESULT.get(kind[-1], "the value of this expression"))
 
 
 def _real_steps(start, stop, step):

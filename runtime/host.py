@@ -120,6 +120,15 @@ class Program:
         return rt
 
 
+def overflow(program: Program, value, kind, at):
+    """Report a + - * value out of range from a compiled module's own check (``_ck``), at ``at``."""
+    from .arithmetic import overflow_error
+
+    exc = overflow_error(value, kind)
+    raise LigDiagnostics([Diagnostic(program.name, Pos(*program.positions[at]), exc.message, exc.hint,
+                                     source=program.source)])
+
+
 def main(program: Program, argv=None) -> int:
     """``python compiled.py -o DIR``: render a compiled module (same options as ``liganimate run``)."""
     from liganimate.cli import run_program_cli
