@@ -18,6 +18,13 @@ noisy; other load only ever slows a round down):
 * A cold ``liganimate check examples/appendix_a.lig`` in a new process,
   against ``python -c "import numpy, lark"`` (the floor any Python tool
   using them pays) and ``python -c pass``. Target: under 0.5 s.
+* Scale: programs of 1,000, 10,000 and 50,000 lines in two styles (short
+  assignment lines ``Xn = n``, and the thesis style above), parsed and
+  compiled in process; reported as microseconds per line at each size,
+  so that a cost growing faster than the program shows as a rising
+  figure. The 50,000-line programs are also compiled in a fresh process
+  to report peak memory per line of source (issue 14 asks for memory a
+  small multiple of the source: under 500 MB for a million short lines).
 
 Usage: ``python benchmarks/compile.py [--quick]``. The last line printed is
 one JSON object holding the figures.
@@ -48,7 +55,8 @@ def thesis_style_program(lines: int = 10_000) -> str:
     """
     import re
 
-    text = open(APPENDIX_A, encoding="utf-8").read()
+    with open(APPENDIX_A, encoding="utf-8") as fh:
+        text = fh.read()
     head_end = text.index("      END\n") + len("      END\n")  # the PRIMITIVE BOX
     body = text[head_end:text.index("*     SHOOTSCENE")]
     names = ["HEAD", "BODY", "TORSO", "FARM", "BARM", "FLEG", "BLEG", "FOOT", "LOCATN", "DISTAN",
@@ -59,7 +67,7 @@ def thesis_style_program(lines: int = 10_000) -> str:
     k = 0
     while total + body.count("\n") <= lines:
         k += 1
-        copy = word.sub(lambda m: f"{m.group(1)}{k}", body).replace("INITIALIZE SCENE 1", f"INITIALIZE SCENE {k}")
+        copy = word.sub(lambda m, k=k: f"{m.group(1)}{k}", body).replace("INITIALIZE SCENE 1", f"INITIALIZE SCENE {k}")
         out.append(copy)
         total += copy.count("\n")
     out.append("\n" * (lines - total) + "      SHOOTSCENES\n      STOP\n      END\n")
@@ -86,20 +94,86 @@ def big_program(lines: int = 10_000) -> str:
     return "\n".join(out[:lines]) + "\n"
 
 
-def best(fn, rounds: int) -> float:
-    """The shortest of ``rounds`` timings of ``fn()``, in seconds."""
+def short_lines_program(lines: int) -> str:
+    """``lines`` short assignment lines (``X17 = 17``) over a hundred variables, as issue 14's stress test."""
+    return "".join(f"X{i % 100} = {i}\n" for i in range(lines))
+
+
+#: The scale sizes and styles.
+SIZES = (1_000, 10_000, 50_000)
+STYLES = {"short": short_lines_program, "thesis": thesis_style_program}
+
+
+def scale_times(rounds: int) -> dict:
+    """Parse and compile CPU time per line (microseconds) for each style and size.
+
+    CPU time, not wall time: these runs are long enough for other load on a
+    shared machine to stretch a wall-clock round, never a CPU-time one.
+    """
+    from liganimate.compiler import compile_text
+    from liganimate.lang import parser as P
+
+    out = {}
+    for style, make in STYLES.items():
+        for n in SIZES:
+            text = make(n)
+            lines = text.count("\n")
+            rounds_n = rounds if n < 50_000 else max(1, rounds // 2)
+            t_parse = best(lambda: P.parse(text, f"{style}.lig"), rounds_n, clock=time.process_time)  # noqa: B023
+            t_compile = best(lambda: compile_text(text, f"{style}.lig"), rounds_n, clock=time.process_time)  # noqa: B023
+            out[f"{style}_{n}"] = {"lines": lines, "parse_us_per_line": round(t_parse / lines * 1e6, 2),
+                                   "compile_us_per_line": round(t_compile / lines * 1e6, 2)}
+    return out
+
+
+# Peak resident memory in KiB. Linux's VmHWM belongs to the process image; ru_maxrss
+# survives exec, so a child started from this (big) process would report our peak.
+_PEAK = """
+import resource, sys
+sys.path.insert(0, {bench!r})
+import compile as bench
+from liganimate.compiler import compile_text
+from liganimate.lang.parser import build_parser
+
+def peak():
+    try:
+        with open("/proc/self/status") as fh:
+            return next(int(l.split()[1]) for l in fh if l.startswith("VmHWM:"))
+    except (OSError, StopIteration):
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+
+build_parser()
+text = bench.STYLES[{style!r}]({lines})
+before = peak()
+compile_text(text, "scale.lig")
+print(peak() - before, len(text.encode()))
+"""
+
+
+def peak_bytes_per_line(style: str, lines: int) -> tuple:
+    """(peak memory growth per line, bytes of source per line) of compiling one program, in a fresh process."""
+    code = _PEAK.format(bench=os.path.dirname(os.path.abspath(__file__)), style=style, lines=lines)
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False)
+    if r.returncode != 0:
+        raise SystemExit(f"measuring peak memory failed:\n{r.stderr}")
+    grew_kib, size = (int(x) for x in r.stdout.split())
+    return grew_kib * 1024 / lines, size / lines
+
+
+def best(fn, rounds: int, clock=time.perf_counter) -> float:
+    """The shortest of ``rounds`` timings of ``fn()``, in seconds (``clock``: wall time, or CPU time)."""
     times = []
     for _ in range(rounds):
-        t = time.perf_counter()
+        t = clock()
         fn()
-        times.append(time.perf_counter() - t)
+        times.append(clock() - t)
     return min(times)
 
 
 def cold(cmd: list, rounds: int) -> float:
     """The shortest wall time of running ``cmd`` in a new process."""
     def once():
-        r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, check=False)
         if r.returncode != 0:
             raise SystemExit(f"{' '.join(cmd)} failed:\n{r.stderr}")
     return best(once, rounds)
@@ -114,13 +188,13 @@ def main(argv=None) -> int:
     cold_rounds = 3 if args.quick else 10
 
     from lark import Lark
-
     from liganimate.compiler import compile_text
     from liganimate.lang import parser as P
     from liganimate.lang.source import prepare
     from liganimate.lang.transform import ToAst
 
-    text = open(APPENDIX_A, encoding="utf-8").read()
+    with open(APPENDIX_A, encoding="utf-8") as fh:
+        text = fh.read()
     P.build_parser()
     compiled = compile_text(text, APPENDIX_A)
     grammar = resources.files("liganimate.lang").joinpath("lig.lark").read_text(encoding="utf-8")
@@ -164,6 +238,18 @@ def main(argv=None) -> int:
     print(f"cold liganimate check appendix_a.lig: {t_check:.3f} s; python -c 'import numpy, lark' {t_floor:.3f} s; "
           f"python -c pass {t_python0:.3f} s")
 
+    scale = scale_times(big_rounds)
+    for style in STYLES:
+        row = [scale[f"{style}_{n}"] for n in SIZES]
+        print(f"{style} lines, parse / compile per line: " + "; ".join(
+            f"{r['lines']:,}: {r['parse_us_per_line']:.1f} / {r['compile_us_per_line']:.1f} us" for r in row))
+    peaks = {}
+    for style in STYLES:
+        per_line, source = peak_bytes_per_line(style, SIZES[-1])
+        peaks[style] = {"peak_bytes_per_line": round(per_line), "source_bytes_per_line": round(source, 1)}
+        print(f"{style} {SIZES[-1]:,} lines in a fresh process: peak memory grows {per_line:.0f} bytes a line "
+              f"({per_line / source:.0f}x the source)")
+
     figures = {
         "appendix_a_compile_ms": round(t_ours * 1e3, 2),
         "appendix_a_parse_ms": round(t_parse * 1e3, 2),
@@ -178,6 +264,10 @@ def main(argv=None) -> int:
         "cold_check_s": round(t_check, 3),
         "cold_import_numpy_lark_s": round(t_floor, 3),
         "cold_python_s": round(t_python0, 3),
+        "scale": scale,
+        "scale_growth_short_50k_over_1k": round(scale["short_50000"]["compile_us_per_line"]
+                                               / scale["short_1000"]["compile_us_per_line"], 2),
+        "scale_peak": peaks,
         "targets_met": {
             "appendix_a_under_20ms": t_ours < 0.020,
             "10000_lines_under_1s": t_thesis < 1.0,

@@ -82,8 +82,10 @@ class Driver:
             raise ValueError("terminal callbacks are not supported")
         rule_index: dict = {}
         self.rules: list = []  # (number of symbols, the rule's name, callback or None for "keep the child")
-        self.actions: dict = {}  # state -> {symbol: next state, or ~rule to reduce}
-        for state, row in table.states.items():
+        self.actions: list = []  # state -> {symbol: next state, or ~rule to reduce}
+        if sorted(table.states) != list(range(len(table.states))):
+            raise ValueError("the parse table's states are not numbered 0..n-1")
+        for state, row in sorted(table.states.items()):
             acts = {}
             for symbol, (action, arg) in row.items():
                 if action is Shift:
@@ -94,7 +96,7 @@ class Driver:
                         i = rule_index[arg] = len(self.rules)
                         self.rules.append(self._rule(arg, callbacks[arg]))
                     acts[symbol] = ~i
-            self.actions[state] = acts
+            self.actions.append(acts)
         self.start = table.start_states["start"]
         self.end = table.end_states["start"]
         self.scanner = Scanner(lark.terminals, table.states)
@@ -126,7 +128,8 @@ class Driver:
         scanner = self.scanner
         keywords = scanner.tables.keywords
         choice = scanner._choice
-        stack = [self.start]
+        state = self.start
+        stack = [state]
         values: list = []
         push_state = stack.append
         push_value = values.append
@@ -141,7 +144,7 @@ class Driver:
             m = scan(text, pos)
             k = m.lastindex if m is not None else None
             if not k:
-                scanner.unexpected_character(text, pos, line, stack[-1])
+                scanner.unexpected_character(text, pos, line, state)
             start = m.start(k)
             if start != pos:
                 nl = count("\n", pos, start)
@@ -153,7 +156,7 @@ class Driver:
             if k == WORD:
                 word = value.upper()
                 if word in keywords:
-                    ttype = scanner.keyword(word, stack[-1], text, end)
+                    ttype = scanner.keyword(word, state, text, end)
                     if ttype == "NAME" and word in primitives:
                         ttype = "PRIM_NAME"
                 else:
@@ -168,9 +171,9 @@ class Driver:
                 elif len(spellings) < 4096:
                     spellings[value] = value
             elif k == OPERATOR:
-                ttype = choice.get((stack[-1], value))
+                ttype = choice.get((state, value))
                 if ttype is None:
-                    ttype, value, end = scanner._operator(value, start, stack[-1])
+                    ttype, value, end = scanner._operator(value, start, state)
             elif k == STRING:
                 ttype = "STRING"
             elif k == DOLLAR:
@@ -182,20 +185,23 @@ class Driver:
             pos = end
             # ------------------------------------------------ feed it
             while True:
-                code = actions[stack[-1]].get(ttype)
+                code = actions[state].get(ttype)
                 if code is None:
-                    raise self._unexpected(tok.as_lark(), stack[-1])
+                    raise self._unexpected(tok.as_lark(), state)
                 if code >= 0:
                     push_state(code)
                     push_value(tok)
+                    state = code
                     break
                 size, origin, callback = rules[~code]
                 if callback is None:
                     # A run of one-child ?rules (expr <- sum <- product ...):
                     # where it ends depends only on these three, so take it in one step.
-                    key = (stack[-2], stack[-1], ttype)
+                    key = (stack[-2], state, ttype)
                     top = chains.get(key)
-                    stack[-1] = top if top is not None else self._chain(key)
+                    if top is None:
+                        top = self._chain(key)
+                    stack[-1] = state = top
                     continue
                 if size:
                     children = values[-size:]
@@ -204,7 +210,8 @@ class Driver:
                 else:
                     children = []
                 push_value(callback(children))
-                push_state(actions[stack[-1]][origin])
+                state = actions[stack[-1]][origin]
+                push_state(state)
         end_tok = Token.new_borrow_pos("$END", "", tok.as_lark()) if tok is not None else Token("$END", "", 0, 1, 1)
         while True:
             code = actions[stack[-1]].get("$END")
