@@ -113,6 +113,7 @@ class Generator:
     # -------------------------------------------------------------- actions
     def set_seed(self, seed: int) -> None:
         """Start over at generation 1 with a new seed (the current pose and kept poses stay)."""
+        seed = self._valid_seed(seed)
         self._push()
         self._restart(seed)
 
@@ -189,10 +190,14 @@ class Generator:
         return None if parent is None else self.figure.joint_index(parent.id)
 
     # ------------------------------------------------------------- private
-    def _restart(self, seed) -> None:
+    @staticmethod
+    def _valid_seed(seed) -> int:
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= SEED_MAX:
             raise ValueError(f"the seed must be a whole number from 0 to {SEED_MAX}, not {seed!r}")
-        self.seed = int(seed)
+        return int(seed)
+
+    def _restart(self, seed) -> None:
+        self.seed = self._valid_seed(seed)
         self._rng = np.random.Generator(np.random.PCG64(self.seed))
         self.generation = 0
         self._generate()

@@ -87,6 +87,9 @@ class _Handler(BaseHTTPRequestHandler):
         if not self.server.quiet:
             sys.stderr.write("studio: " + (format % args) + "\n")
 
+    def version_string(self) -> str:
+        return self.server_version
+
     def _send(self, status: int, body: bytes, ctype: str, extra: dict | None = None) -> None:
         self.send_response(status)
         self.send_header("Content-Type", ctype)
@@ -112,6 +115,12 @@ class _Handler(BaseHTTPRequestHandler):
     def send_error(self, code, message=None, explain=None):
         """Errors found by the base class (bad request line, headers) as JSON, and the connection closed."""
         self.close_connection = True
+        if int(code) >= 500:
+            code = 400  # e.g. 505 for "HTTP/9.9": to us a malformed request like any other
+        if getattr(self, "request_version", "HTTP/0.9") == "HTTP/0.9":
+            # A request line too broken to name its version: answer with a
+            # status line anyway (HTTP/0.9 answers have none).
+            self.request_version = "HTTP/1.0"
         try:
             self._error(int(code), message or self.responses.get(code, ("error",))[0])
         except OSError:

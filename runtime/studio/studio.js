@@ -139,9 +139,14 @@
 
   /* ---------------------------------------------------------- pointer input */
   var drag = null;
+  /* The link under a pointer, in the canvas's content box (inside its border). */
   function linkAt(v, e) {
-    var r = v.canvas.getBoundingClientRect();
-    var tri = LigGL.pick(e.clientX - r.left, e.clientY - r.top, r.width, r.height, cam, v.pos, 0, v.pos.length / 3);
+    var c = v.canvas, r = c.getBoundingClientRect();
+    return linkAtPixel(v, e.clientX - r.left - c.clientLeft, e.clientY - r.top - c.clientTop);
+  }
+  function linkAtPixel(v, x, y) {
+    var c = v.canvas;
+    var tri = LigGL.pick(x, y, c.clientWidth, c.clientHeight, cam, v.pos, 0, v.pos.length / 3);
     return tri < 0 ? -1 : mesh.link[tri];
   }
   function hook(v) {
@@ -193,13 +198,18 @@
   window.ligStudio = {
     state: function () { return state; },
     busy: function () { return pending > 0; },
-    /* Canvas pixel of a link's middle in a view (the tests click there). */
+    /* A point of a view well inside a link (the link all round it), as
+     * offsets from the canvas element's centre: where the tests click. */
     linkPoint: function (viewIndex, link) {
-      var v = views[viewIndex], r = v.canvas.getBoundingClientRect();
-      for (var y = 2; y < r.height; y += 2) {
-        for (var x = 2; x < r.width; x += 2) {
-          var tri = LigGL.pick(x, y, r.width, r.height, cam, v.pos, 0, v.pos.length / 3);
-          if (tri >= 0 && mesh.link[tri] === link) return [x, y];
+      var v = views[viewIndex], c = v.canvas, w = c.clientWidth, h = c.clientHeight;
+      for (var y = 4; y < h - 4; y += 2) {
+        for (var x = 4; x < w - 4; x += 2) {
+          if (linkAtPixel(v, x, y) !== link) continue;
+          if (linkAtPixel(v, x - 3, y) === link && linkAtPixel(v, x + 3, y) === link &&
+              linkAtPixel(v, x, y - 3) === link && linkAtPixel(v, x, y + 3) === link) {
+            var r = c.getBoundingClientRect();
+            return [x + c.clientLeft - r.width / 2, y + c.clientTop - r.height / 2];
+          }
         }
       }
       return null;

@@ -148,12 +148,12 @@
     box.textContent = lines.join('\n');
   }
 
+  /* The segment under canvas pixel (px, py) of the content box, or null. */
   function pickAt(px, py) {
-    var r = canvas.getBoundingClientRect();
     var best = null, bestT = Infinity;
     for (var i = 0; i < frame.spans.length; i++) {
       var sp = frame.spans[i];
-      var tri = LigGL.pick(px, py, r.width, r.height, sp.cam, frame.pos, sp.first, sp.count);
+      var tri = LigGL.pick(px, py, canvas.clientWidth, canvas.clientHeight, sp.cam, frame.pos, sp.first, sp.count);
       if (tri < 0) continue;
       // Nearest along the ray: compare by the triangle's centre depth.
       var b = LigGL.basis(sp.cam), v = (sp.first + tri * 3) * 3, p = frame.pos;
@@ -247,6 +247,7 @@
   });
   canvas.addEventListener('pointermove', function (e) {
     var r = canvas.getBoundingClientRect();
+    var px = e.clientX - r.left - canvas.clientLeft, py = e.clientY - r.top - canvas.clientTop;
     if (drag) {
       var dx = e.clientX - drag.x, dy = e.clientY - drag.y;
       if (!drag.moved && Math.abs(dx) + Math.abs(dy) < 3) return;
@@ -255,18 +256,18 @@
         var s = scenes[state.scene], c = sceneCamera(s, tickRange(s, state.image)[0]);
         state.userCam = { eye: c.eye.slice(), target: c.target.slice(), k: c.k };
       }
-      if (drag.pan) LigGL.pan(state.userCam, dx, dy, r.width);
+      if (drag.pan) LigGL.pan(state.userCam, dx, dy, canvas.clientWidth);
       else LigGL.orbit(state.userCam, dx * 0.01, dy * 0.01);
       draw();
       return;
     }
-    var hit = pickAt(e.clientX - r.left, e.clientY - r.top);
+    var hit = pickAt(px, py);
     if (!same(hit, state.hover)) { state.hover = hit; draw(); }
   });
   canvas.addEventListener('pointerup', function (e) {
     if (drag && !drag.moved) {
       var r = canvas.getBoundingClientRect();
-      var hit = pickAt(e.clientX - r.left, e.clientY - r.top);
+      var hit = pickAt(e.clientX - r.left - canvas.clientLeft, e.clientY - r.top - canvas.clientTop);
       state.pinned = hit && !same(hit, state.pinned) ? hit : null;
       draw();
     }
