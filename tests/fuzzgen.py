@@ -48,6 +48,10 @@ EXTREMES = [
     "LOG(5e-324)", "ABS(1e308*10-1e308*10)", "MAX(1e308*10, 0)", "MIN(1e308*10-1e308*10, 1)",
     "NORM((1e200, 1e200, 1e200))", "NORM((1e308*10, 0, 0))", f"REAL({_BIG})", "REAL(1e309)",
     "DOT((1e200, 1e200, 1e200), (1e200, 1e200, 1e200))", "X(CROSS((1e308, 0, 0), (0, 1e308, 0)))",
+    "-1e309", "1e-400", "1e308*-10", "-(1e308*10)+(1e308*10)", "1e-100", "1e-101", "0.5e-100",
+    # Either side of the language's limits (lang/numbers.py): geometry, angles, keyframes, scene length.
+    "1e12", "1000000000000.5", "999999999999.9999", "1e9", "1000000001", "1000000", "1000001",
+    "10000000", "10000001",
 ]
 
 # Slots: «N:default» a number, «V:(x, y, z)» a vector, «P:(lo, hi)» a pair of extremes.
@@ -183,11 +187,17 @@ TEMPLATES = {
         MOVE JOINTS «N:1», «N:2»
         TRANSLATE INTO SHIFT
       ENDREACH
+      STARTREACH R3 MODEL ARM FRAME «N:2» FROM R2
+        GOAL JOINT 2 TO «V:(0.5, -1.0, 0)»
+        MOVE CHAIN «N:2»
+        SOLVER CCD
+        ITERATIONS «N:20»
+      ENDREACH
       INITIALIZE SCENE 1
           VIEW POINT = (0.0, -0.5, -6.0)
           VIEW WIDTH = 4.0
       STARTSCENE LENGTH 2
-          ANIMATE ARM FROM 0 TO «N:1» USING R + R2
+          ANIMATE ARM FROM 0 TO «N:1» USING R + R2 + R3
       ENDSCENE
       SHOOTSCENES
 """,
@@ -222,6 +232,26 @@ TEMPLATES = {
 """,
 }
 TEMPLATES["scene"] = _FIGURE + _SCENE + "      SHOOTSCENES\n"
+TEMPLATES["library"] = """\
+      LOAD HUMANOID, WALK, WAVE FROM 'humanoid'
+      LOAD ROBOT, ROBOT_WALK FROM 'robot'
+      MODEL H, R
+      MOTION M1, M2
+      H :- HUMANOID <SCALE MODEL «N:1.0», TRANS «V:(0.0, 0.0, 0.0)»>
+      R :- ROBOT <SCALE EXTREMES «N:1.0», ROT Y «N:90»>
+      M1 = STRIP «N:2» * WALK, «N:1», «N:31», «N:32»
+      M2 := SYNCHRONIZE M1, WAVE <SCALE FRAMES «N:1»>
+      FIGURE H MAIN LINK R_FOOT
+      INITIALIZE SCENE 1
+          VIEW POINT = «V:(0.0, 1.0, 8.0)»
+          VIEW WIDTH = «N:5.0»
+      STARTSCENE LENGTH «N:2» SAMEFRAME «N:1»
+          ANIMATE H FROM «N:0» TO «N:1» USING M2
+          ANIMATE R FROM «N:0» TO «N:1» USING ROBOT_WALK REPEAT
+          H :- H <TRANS «V:(0.05, 0.0, 0.0)»>
+      ENDSCENE
+      SHOOTSCENES
+"""
 
 
 def slots(template: str) -> list:

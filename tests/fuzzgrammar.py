@@ -83,6 +83,7 @@ _FUNCTIONS = {
 _NUMBERS = ["0", "1", "2", "3", "0.5", "1.5", "2.5", "10", "45", "90", "180", "360", "0.25", ".5", "7",
             "135°", "30°", "1e3", "0.0", "1.0"]
 _ODD_NUMBERS = ["1e6", "99999", "1e308", "1e-5", "0.000001", "123456789", "1e30", "4e2°"]
+_EDGE_NUMBERS = ["1e309", "5e-324", "9223372036854775808", "1" + "0" * 400, "1e12", "1e9", "0.0000", "0e0"]
 _SMALL = ["0", "1", "2", "1", "2", "3"]
 _INTERPOLATIONS = ["LINEAR", "ACCDCC", "ACCELERATE", "DECELERATE", "LINEAR", "BOUNCE"]
 _SOLVERS = ["DLS", "TRANSPOSE", "CCD", "NEWTON"]
@@ -304,8 +305,9 @@ class Expander:
     def number(self, kind) -> str:
         if kind == INT:
             return self.rng.choice(_SMALL)
-        if self.rng.random() < 0.05:
-            return self.rng.choice(_ODD_NUMBERS)
+        r = self.rng.random()
+        if r < 0.05:
+            return self.rng.choice(_ODD_NUMBERS if r < 0.04 else _EDGE_NUMBERS)
         return self.rng.choice(_NUMBERS)
 
     def cased(self, word: str) -> str:
@@ -584,7 +586,7 @@ class Expander:
                 if self.pattern_items == 1:  # a pattern begins with the primitive's name
                     return f"'{self.prim_now or 'PEG'}'"
                 return rng.choice(["'AT'", "','", "'SIZE'", f"'{self.prim_now or 'PEG'}'"])
-            return rng.choice(["'hello'", "''", "'A = '", "'°'"])
+            return rng.choice(["'hello'", "''", "'A = '", "'°'", "'{'", "'é\u2028'", "'\\n'"])
         if sym == "DOLLAR_NAME":
             return "$" + self.name_of(MODEL)
         if sym == "TYPE_KW":
@@ -689,19 +691,31 @@ def _atom_weight(alias, symbols: list, kind) -> float:
     return 0.5  # ( expr )
 
 
+#: Rare layout between tokens: a continuation line, comments (one with a
+#: line separator, one spanning lines), a tab, a form feed.
+_ODD_BLANKS = ["\n" + " " * 9, " { a comment } ", " {é ° \u2028 x} ", " {two\n lines} ", "\t", "\f "]
+#: Rare lines between statements: a FORTRAN comment, a blank line with spaces, a CRLF line end.
+_ODD_LINES = ["\nC a comment line", "\nc  ROT X 1e309 {", "\n   \t ", "\r"]
+
+
 def layout(tokens: list, rng) -> str:
-    """Join tokens with blanks; a statement starts a new, indented line (column 1 is for C comments)."""
+    """Join tokens with blanks; a statement starts a new, indented line (column 1 is for C comments).
+
+    Now and then the layout is odd (comments, tabs, CR, a line flagged
+    with ``*`` in column 1, as the thesis' listings flag extensions).
+    """
     indent = "      "
     out = [indent]
     for tok in tokens:
         if tok is None:
             if len(out) > 1:
-                out.append("\n" + indent + " " * rng.randrange(4))
+                r = rng.random()
+                if r < 0.02:
+                    out.append(rng.choice(_ODD_LINES))
+                out.append("\n" + ("*" + indent[1:] if r > 0.99 else indent) + " " * rng.randrange(4))
             continue
         if len(out) > 1 and not out[-1].startswith("\n"):
-            r = rng.random()
-            out.append(" " if r < 0.97 else ("\n" + indent + "   " if r < 0.99 else
-                                              (" { a comment } " if r < 0.995 else "\t")))
+            out.append(" " if rng.random() < 0.98 else rng.choice(_ODD_BLANKS))
         out.append(tok)
     return "".join(out).rstrip() + "\n"
 

@@ -38,6 +38,7 @@ import signal
 import tempfile
 import time
 import traceback
+import unicodedata
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -174,7 +175,14 @@ def _bad_diagnostic(diags) -> str | None:
                 return f"diagnostic with Python text in it: {text!r}"
         if not d.message.strip():
             return "diagnostic with an empty sentence"
-        format_diagnostic(d)  # what the CLI prints; must not raise
+        if d.source is not None and d.pos.line <= d.source.count("\n"):
+            line = d.source.split("\n")[d.pos.line - 1]
+            if d.pos.column > len(line) + 1:
+                return f"diagnostic at column {d.pos.column} of a line of {len(line)} characters: {d.message}"
+        shown = format_diagnostic(d)  # what the CLI prints; must not raise
+        raw = [c for c in shown if c != "\n" and unicodedata.category(c) in ("Cc", "Zl", "Zp")]
+        if raw:
+            return f"diagnostic prints control characters raw ({raw[0]!r}): {d.message}"
     return None
 
 

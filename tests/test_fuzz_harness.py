@@ -132,3 +132,16 @@ def test_a_failing_case_raises_with_the_minimised_program(monkeypatch):
     monkeypatch.setattr(Runtime, "f_COS", lambda self, x, at: {}["boom"])
     with pytest.raises(AssertionError, match="(?s)minimised program.*COS"):
         fuzzrun.assert_runs_or_is_diagnosed("      X = 1\n      Y = COS(X)\n      PRINT Y\n", budget=10)
+
+
+def test_a_caret_past_the_line_or_a_raw_control_character_is_a_bad_diagnostic():
+    src = "      X = 1\n"
+    assert fuzzrun._bad_diagnostic([Diagnostic("f.lig", Pos(1, 40, 1, 41), "far out", source=src)])
+    assert fuzzrun._bad_diagnostic([Diagnostic("f.lig", Pos(1, 12, 1, 13), "just after", source=src)]) is None
+    esc = "      X = \x1b[2J 1\n"
+    found = fuzzrun._bad_diagnostic([Diagnostic("f.lig", Pos(1, 7, 1, 8), "odd", source=esc)])
+    # Escaped by format_diagnostic (the fix) or reported here; never printed raw unnoticed.
+    from liganimate.lang.diagnostics import format_diagnostic
+
+    assert (found is not None) == ("\x1b" in format_diagnostic(Diagnostic("f.lig", Pos(1, 7, 1, 8), "odd",
+                                                                           source=esc)))
