@@ -380,12 +380,15 @@ def find_ffmpeg() -> str:
 
 
 def _check_fps(fps) -> float:
+    from .outputs import MAX_FPS, MIN_FPS
+
     try:
         f = float(fps)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         f = float("nan")
-    if not (f > 0 and np.isfinite(f)):
-        raise RenderError(f"Frames per second must be a positive number, not {fps!r}.")
+    # GIF delays are 16-bit hundredths of a second: a slower rate cannot be stored.
+    if not (MIN_FPS <= f <= MAX_FPS):
+        raise RenderError(f"Frames per second must be from {MIN_FPS:g} to {MAX_FPS:g}, not {fps!r}.")
     return f
 
 
@@ -414,9 +417,6 @@ _ERRNO_WORDS = {
     errno.EACCES: "permission denied",
     errno.EPERM: "permission denied",
     errno.EIO: "input/output error",
-    errno.ENOENT: "its folder does not exist",
-    errno.ENOTDIR: "part of its path is not a folder",
-    errno.EISDIR: "it is a folder",
 }
 
 
@@ -431,7 +431,14 @@ def os_error_words(exc: OSError) -> str:
 
 def write_error(exc: OSError, path) -> RenderError:
     """The error to show for ``exc`` raised while writing ``path``: it names ``path``, not a temporary file."""
-    return RenderError(f"{os_error_words(exc)} while writing {os.fspath(path)}")
+    path = os.fspath(path)
+    if exc.errno == errno.EISDIR:
+        return RenderError(f"{path} is a folder, not a file")
+    if exc.errno == errno.ENOENT:
+        return RenderError(f"cannot write {path}: the folder {os.path.dirname(path) or '.'} does not exist")
+    if exc.errno == errno.ENOTDIR:
+        return RenderError(f"cannot write {path}: part of its path is not a folder")
+    return RenderError(f"{os_error_words(exc)} while writing {path}")
 
 
 class AtomicWriter:

@@ -32,35 +32,38 @@ class Interrupted(KeyboardInterrupt):
         super().__init__(signum)
         self.signum = signum
 
-    @property
-    def exit_status(self) -> int:
-        """128 + the signal's number, as a shell reports a command stopped by it (130, 143)."""
-        return 128 + int(self.signum)
-
-    @property
-    def name(self) -> str:
-        """The signal's name, e.g. ``SIGTERM``."""
-        return signal.Signals(self.signum).name
-
 
 _owner = None  # the process whose handlers these are (a forked child ignores them)
 _stopping = False
+_received: list = []  # every signal noted since stop_on_signals, in the order handled
 
 
 def _on_signal(signum, frame) -> None:
     global _stopping
-    if os.getpid() != _owner or _stopping:
-        # A forked worker before its own set-up, or a signal after the first: the stop is under way.
-        return
+    if os.getpid() != _owner:
+        return  # a forked worker before its own set-up
+    _received.append(signum)
+    if _stopping:
+        return  # the stop is under way: note the signal, let the cleanup finish
     _stopping = True
-    ignore_signals()
     raise Interrupted(signum)
 
 
 def ignore_signals() -> None:
-    """Ignore SIGINT and SIGTERM from now on in this process (cleanup must run to its end)."""
-    for s in SIGNALS:
-        signal.signal(s, signal.SIG_IGN)
+    """From now on SIGINT and SIGTERM are only noted (cleanup must run to its end).
+
+    The handler stays installed rather than becoming SIG_IGN: CPython
+    raises "Signal N ignored due to race condition" for a signal already
+    received when its handler is changed to SIG_IGN, which is exactly the
+    case of two signals at once.
+    """
+    global _stopping
+    _stopping = True
+
+
+def stopped_by() -> int:
+    """The signal to report for the stop: SIGTERM if one came at all (termination was asked), else SIGINT."""
+    return signal.SIGTERM if signal.SIGTERM in _received else signal.SIGINT
 
 
 def stop_on_signals() -> bool:
@@ -74,6 +77,7 @@ def stop_on_signals() -> bool:
     if threading.current_thread() is not threading.main_thread():
         return False
     _owner, _stopping = os.getpid(), False
+    _received.clear()
     for s in SIGNALS:
         if signal.getsignal(s) is not signal.SIG_IGN:
             signal.signal(s, _on_signal)
@@ -91,4 +95,4 @@ def restore_signals() -> None:
     _owner = None
 
 
-__all__ = ["Interrupted", "ignore_signals", "restore_signals", "stop_on_signals"]
+__all__ = ["Interrupted", "ignore_signals", "restore_signals", "stop_on_signals", "stopped_by"]

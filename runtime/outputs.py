@@ -85,7 +85,7 @@ def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None)
             continue
         path = os.fspath(path)
         opt = names[key]
-        _check_file(path, opt)
+        _check_file(path, opt, out_dir)
         real = os.path.realpath(path)
         if real == os.path.realpath(out_dir):
             raise RenderError(f"{opt} {path} is the frames folder ({names['out']} {out_dir}); give another file name")
@@ -112,7 +112,7 @@ def _check_folder(path: str, opt: str) -> None:
         raise RenderError(f"{opt} {path} cannot be written: permission denied for {probe}")
 
 
-def _check_file(path: str, opt: str) -> None:
+def _check_file(path: str, opt: str, out_dir) -> None:
     if not path:
         raise RenderError(f"{opt} is empty; give a file name")
     if path.endswith(os.sep) or os.path.isdir(path):
@@ -122,6 +122,8 @@ def _check_file(path: str, opt: str) -> None:
         raise RenderError(f"{opt} {path} exists and is not a regular file")
     folder = os.path.dirname(os.path.abspath(path))
     shown = os.path.dirname(path) or "."
+    if folder == os.path.abspath(out_dir) and not os.path.lexists(folder):
+        return  # in the frames folder, which the render creates (and _check_folder has vetted)
     if not os.path.isdir(folder):
         what = "is not a folder" if os.path.lexists(folder) else "does not exist"
         raise RenderError(f"{opt} {path} cannot be written: the folder {shown} {what}")

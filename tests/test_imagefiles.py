@@ -142,9 +142,19 @@ def test_gif_errors_leave_nothing(tmp_path):
         write_gif(path, [], fps=10)
     with pytest.raises(RenderError, match="Frame 1"):
         write_gif(path, [np.zeros((4, 4), np.uint8), np.zeros((5, 4), np.uint8)], fps=10)
-    with pytest.raises(RenderError):
-        write_gif(path, frames(2), fps=0)
+    for fps in (0, -1, float("nan"), float("inf"), 0.001, 1e6):
+        with pytest.raises(RenderError, match="Frames per second must be from 0.01 to 1000"):
+            write_gif(path, frames(2), fps=fps)
     assert os.listdir(tmp_path) == []
+
+
+def test_gif_at_the_slowest_and_fastest_rates(tmp_path):
+    # 0.01 fps is 10,000 hundredths a frame, within a GIF's 16-bit delay.
+    for fps, delay in ((0.01, 100_000), (1000, 0)):
+        write_gif(tmp_path / "a.gif", frames(2), fps=fps)
+        with Image.open(tmp_path / "a.gif") as im:
+            assert im.n_frames == 2
+            assert im.info.get("duration", 0) == delay
 
 
 # --------------------------------------------------------------------------
@@ -248,9 +258,8 @@ def test_atomic_writer_cleans_up_whatever_step_fails(tmp_path, monkeypatch, step
     path = tmp_path / "poses.jsonl"
     path.write_bytes(b"old")
     calls = _failing_at(monkeypatch, step)
-    with pytest.raises(RenderError) as info:
-        with imagefiles.AtomicWriter(path, buffer=4) as f:
-            f.write(b"0123456789" * 100)
+    with pytest.raises(RenderError) as info, imagefiles.AtomicWriter(path, buffer=4) as f:
+        f.write(b"0123456789" * 100)
     assert calls, f"os.{step} was never called"
     assert info.value.message == f"no space left on device while writing {path}"
     assert ".tmp" not in info.value.message
@@ -284,9 +293,8 @@ def test_atomic_writer_interrupted_leaves_nothing(tmp_path, monkeypatch):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(imagefiles.os, "write", interrupt)
-    with pytest.raises(KeyboardInterrupt):
-        with imagefiles.AtomicWriter(tmp_path / "a.png") as f:
-            f.write(b"data")
+    with pytest.raises(KeyboardInterrupt), imagefiles.AtomicWriter(tmp_path / "a.png") as f:
+        f.write(b"data")
     assert os.listdir(tmp_path) == []
 
 
@@ -301,9 +309,11 @@ def test_write_errors_are_plain_words_naming_the_file(tmp_path, monkeypatch, cod
     assert os.listdir(tmp_path) == []
 
 
-def test_a_folder_that_refuses_new_files_is_named(tmp_path):
+def test_a_missing_folder_or_a_folder_in_the_way_is_named(tmp_path):
+    with pytest.raises(RenderError, match=f"^{tmp_path} is a folder, not a file$"):
+        write_png(tmp_path, np.zeros((2, 2), np.uint8))
     path = tmp_path / "missing" / "a.png"
-    with pytest.raises(RenderError, match=f"its folder does not exist while writing {path}$"):
+    with pytest.raises(RenderError, match=f"^cannot write {path}: the folder {path.parent} does not exist$"):
         write_png(path, np.zeros((2, 2), np.uint8))
 
 
@@ -323,7 +333,8 @@ try:
 except RenderError as exc:
     print(exc.message)
 """
-    out = subprocess.run([__import__("sys").executable, "-c", code], capture_output=True, text=True, timeout=60)
+    out = subprocess.run([__import__("sys").executable, "-c", code], check=False, capture_output=True, text=True,
+                         timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == f"the file grew larger than the system allows while writing {tmp_path / 'big.gif'}"
     assert os.listdir(tmp_path) == []

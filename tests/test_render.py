@@ -259,12 +259,32 @@ def test_two_runs_write_identical_bytes(tmp_path):
     assert leftovers(tmp_path) == []
 
 
-def test_interrupted_render_leaves_only_whole_files(tmp_path):
+# How each stop is sent: Ctrl-C at a terminal reaches the whole process
+# group; `timeout -s INT` sends SIGINT to the command and then to its group
+# within a millisecond (two signals; the second used to land in the cleanup
+# and print a traceback); `timeout` and `kill` send SIGTERM to the command alone.
+STOPS = {
+    "ctrl-c": ([("group", signal.SIGINT)], 130, "interrupted; every file already written is complete"),
+    "two-sigints": ([("pid", signal.SIGINT), ("group", signal.SIGINT)], 130,
+                    "interrupted; every file already written is complete"),
+    "sigint-twice-to-the-command": ([("pid", signal.SIGINT), ("pid", signal.SIGINT)], 130,
+                                    "interrupted; every file already written is complete"),
+    "sigterm": ([("pid", signal.SIGTERM)], 143, "terminated (SIGTERM); every file already written is complete"),
+    "sigterm-then-sigint": ([("pid", signal.SIGTERM), ("group", signal.SIGINT)], 143,
+                            "terminated (SIGTERM); every file already written is complete"),
+}
+
+
+@pytest.mark.parametrize("stop", list(STOPS))
+def test_interrupted_render_leaves_only_whole_files(tmp_path, stop):
+    sends, status, message = STOPS[stop]
     src = program(tmp_path, 100_000)
     out = tmp_path / "out"
+    args = ["--gif", "a.gif", "--poses", "p.jsonl"]
+    if have_ffmpeg():
+        args += ["--mp4", "a.mp4"]
     proc = subprocess.Popen([sys.executable, "-m", "liganimate", "run", str(src), "-o", "out", "--size", "160x120",
-                             "--gif", "a.gif", "--poses", "p.jsonl"],
-                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             *args], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
@@ -272,20 +292,66 @@ def test_interrupted_render_leaves_only_whole_files(tmp_path):
             break
         time.sleep(0.05)
     assert proc.poll() is None, proc.communicate()
-    os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C at a terminal reaches the whole process group
+    workers = children(proc.pid)
+    assert len(workers) >= 1  # the pool is up (two cores or more), and is what must not survive
+    for to, sig in sends:
+        (os.killpg if to == "group" else os.kill)(proc.pid, sig)
     _, err = proc.communicate(timeout=120)
-    assert proc.returncode == 130, err
-    assert "interrupted; every file already written is complete" in err
-    assert "Traceback" not in err
+    assert proc.returncode == status, err
+    assert err == f"\nliganimate: {message}\n"
     written = pngs(out)
     assert 40 < len(written) < 100_000
     for p in written:
         assert read_png(p).shape == (120, 160)
-    # Frames are numbered without gaps; the GIF and pose record of an
+    # Frames are numbered without gaps; the GIF, MP4 and pose record of an
     # unfinished render are never written.
     assert [p.name for p in written] == [f"{i:05d}.png" for i in range(len(written))]
     assert not (tmp_path / "a.gif").exists() and not (tmp_path / "p.jsonl").exists()
+    assert not (tmp_path / "a.mp4").exists()
     assert leftovers(tmp_path) == []
+    assert [p.name for p in tmp_path.rglob("*lock")] == []
+    # No worker outlives the run (they used to linger, re-parented to PID 1, after SIGTERM).
+    assert wait_gone(workers, 5) == []
+
+
+# --------------------------------------------------------------------------
+# Process trees: which workers a run has, and whether they are gone
+
+
+def _state_and_start(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+    except (FileNotFoundError, ProcessLookupError):
+        return None
+    return fields[0], fields[19]  # state, start time
+
+
+def children(pid) -> list:
+    """(pid, start time) of each live child of ``pid``."""
+    kids = []
+    try:
+        tasks = os.listdir(f"/proc/{pid}/task")
+    except FileNotFoundError:
+        return []
+    for t in tasks:
+        try:
+            with open(f"/proc/{pid}/task/{t}/children") as f:
+                kids += [int(k) for k in f.read().split()]
+        except FileNotFoundError:
+            continue
+    return [(k, s[1]) for k in kids if (s := _state_and_start(k)) is not None]
+
+
+def wait_gone(procs, seconds) -> list:
+    """Wait until none of ``procs`` (from :func:`children`) runs; return those still running."""
+    deadline = time.monotonic() + seconds
+    while True:
+        alive = [(p, start) for p, start in procs
+                 if (s := _state_and_start(p)) is not None and s[0] != "Z" and s[1] == start]
+        if not alive or time.monotonic() > deadline:
+            return alive
+        time.sleep(0.02)
 
 
 # --------------------------------------------------------------------------

@@ -123,7 +123,7 @@ def _guarded(fn):
         os.dup2(devnull, sys.stdout.fileno())
         return 0
     except OSError as exc:
-        where = f" ({exc.filename})" if exc.filename else ""
+        where = f": {exc.filename}" if exc.filename else ""
         sys.stderr.write(f"liganimate: error: {os_error_words(exc)}{where}\n")
         return EXIT_USER_ERROR
     except RecursionError:
@@ -140,7 +140,7 @@ def _guarded(fn):
 def _stopping(exc: KeyboardInterrupt) -> int:
     """Report a stop by SIGINT (Ctrl-C) or SIGTERM; the exit status a shell gives a command it stopped."""
     interrupts.ignore_signals()  # a second signal must not interrupt this message
-    if getattr(exc, "signum", None) == signal.SIGTERM:
+    if interrupts.stopped_by() == signal.SIGTERM:
         sys.stderr.write("\nliganimate: terminated (SIGTERM); every file already written is complete\n")
         return 143
     sys.stderr.write("\nliganimate: interrupted; every file already written is complete\n")
