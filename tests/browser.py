@@ -81,12 +81,12 @@ class Browser:
         return np.asarray(Image.open(io.BytesIO(data)).convert("RGB"))[..., 0]
 
     def requests(self) -> list:
-        """URLs of every request the page made since the browser started (needs ``log_network``)."""
+        """Every request since the last call, as (URL, URL of the document that made it) (needs ``log_network``)."""
         import json
 
-        urls = []
+        out = []
         for entry in self.driver.get_log("performance"):
             msg = json.loads(entry["message"])["message"]
             if msg.get("method") == "Network.requestWillBeSent":
-                urls.append(msg["params"]["request"]["url"])
-        return urls
+                out.append((msg["params"]["request"]["url"], msg["params"].get("documentURL", "")))
+        return out
