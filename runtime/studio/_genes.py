@@ -249,11 +249,16 @@ def alternatives(ax: JointAxes, seed: np.ndarray, mode: str, first: bool, max_di
 
 
 def _coarsest(ok: np.ndarray, level: np.ndarray, need: int) -> np.ndarray:
-    """Indices where ``ok``, keeping only the coarsest levels that together hold ``need``."""
-    counts = np.cumsum(np.bincount(level[ok], minlength=int(level.max()) + 1))
+    """Indices where ``ok``, keeping only the coarsest levels that together hold ``need``.
+
+    ``level`` is non-decreasing (the tessellations list their points level
+    by level), so each level is one slice.
+    """
+    ends = np.searchsorted(level, np.arange(1, int(level[-1]) + 2))
+    counts = np.cumsum(np.add.reduceat(ok, np.r_[0, ends[:-1]]))
     enough = np.flatnonzero(counts >= need)
-    last = int(enough[0]) if len(enough) else len(counts) - 1
-    return np.flatnonzero(ok & (level <= last))
+    end = int(ends[enough[0]]) if len(enough) else len(ok)
+    return np.flatnonzero(ok[:end])
 
 
 def _on_circle(ax: JointAxes, axis: int, seed: np.ndarray, first: bool, max_distance: float,
@@ -277,20 +282,23 @@ def _on_sphere(ax: JointAxes, seed: np.ndarray, first: bool, max_distance: float
     points, level = _spheres.sphere()
     sp, sf = float(seed[ax.pivot]), float(seed[ax.flexion])
     here = directions(ax, [sp], [sf])[0]
-    distance = np.degrees(np.arccos(np.clip(points @ here, -1.0, 1.0)))
+    cosine = points @ here
+    # Compared as cosines, so that only the points kept need an arccos.
+    other = cosine < np.cos(np.radians(1e-6))
     if first:
         valid, pivot_all, flexion_all = _within_extremes(ax, points)
-        idx = _coarsest(valid & (distance > 1e-6), level, need)
+        idx = _coarsest(valid & other, level, need)
         pivot, flexion = pivot_all[idx], flexion_all[idx]
     else:
-        idx = _coarsest((distance > 1e-6) & (distance <= max_distance + 1e-9), level, need)
+        idx = _coarsest(other & (cosine >= np.cos(np.radians(max_distance)) - 1e-12), level, need)
         sol = _solutions_cached(ax, points)[:, idx]  # (2, n, 2)
         cost = [np.abs(wrap(sol[k, :, 0] - sp)) + np.abs(wrap(sol[k, :, 1] - sf)) for k in (0, 1)]
         chosen = np.where((cost[1] < cost[0])[:, None], sol[1], sol[0])
         pivot, flexion = _near(chosen[:, 0], sp), _near(chosen[:, 1], sf)
+    distance = np.degrees(np.arccos(np.clip(cosine[idx], -1.0, 1.0)))
     values = np.stack([pivot, flexion], axis=-1)
     plain = np.abs(wrap(values[:, 0] - sp)) < 1e-6
-    order = _order(level[idx], plain, distance[idx], values)
+    order = _order(level[idx], plain, distance, values)
     return Alternatives((ax.pivot, ax.flexion), values[order], level[idx][order])
 
 
