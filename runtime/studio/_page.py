@@ -66,7 +66,8 @@ def studio_page(generator, title: str) -> str:
                  "grey": blob.add(table.grey, np.uint8)},
         # Candidates reach further than the standing figure: room for them.
         "bounds": [float(c) for c in centre] + [radius * 2.0],
-        "camera": {"eye": [float(c) for c in eye], "target": [float(c) for c in centre], "k": 2.3 / 3.2},
+        # A view width of 3.4 radii: room for limbs swung out to their full length.
+        "camera": {"eye": [float(c) for c in eye], "target": [float(c) for c in centre], "k": 3.4 / 3.2},
     }
     return fill(_own("studio.html"), {
         "VERSION": html.escape(__version__),

@@ -202,11 +202,23 @@
      * offsets from the canvas element's centre: where the tests click. */
     linkPoint: function (viewIndex, link) {
       var v = views[viewIndex], c = v.canvas, w = c.clientWidth, h = c.clientHeight;
-      for (var y = 4; y < h - 4; y += 2) {
-        for (var x = 4; x < w - 4; x += 2) {
-          if (linkAtPixel(v, x, y) !== link) continue;
-          if (linkAtPixel(v, x - 3, y) === link && linkAtPixel(v, x + 3, y) === link &&
-              linkAtPixel(v, x, y - 3) === link && linkAtPixel(v, x, y + 3) === link) {
+      var b = LigGL.basis(cam), sx = 2 / cam.k, sy = sx * w / h, p = v.pos, spots = [];
+      // Where the link's triangles' middles land on the canvas.
+      for (var t = 0; t < mesh.link.length; t++) {
+        if (mesh.link[t] !== link) continue;
+        var d = [0, 1, 2].map(function (k) { return (p[t * 9 + k] + p[t * 9 + 3 + k] + p[t * 9 + 6 + k]) / 3 - cam.eye[k]; });
+        var z = d[0] * b.fwd[0] + d[1] * b.fwd[1] + d[2] * b.fwd[2];
+        if (z <= 0) continue;
+        var xc = d[0] * b.right[0] + d[1] * b.right[1] + d[2] * b.right[2];
+        var yc = d[0] * b.up[0] + d[1] * b.up[1] + d[2] * b.up[2];
+        spots.push([Math.round((xc * sx / z + 1) * w / 2), Math.round((1 - yc * sy / z) * h / 2)]);
+      }
+      for (var m = 3; m >= 0; m--) {
+        for (var i = 0; i < spots.length; i++) {
+          var x = spots[i][0], y = spots[i][1];
+          if (x < m || y < m || x >= w - m || y >= h - m) continue;
+          if (linkAtPixel(v, x, y) === link && linkAtPixel(v, x - m, y) === link && linkAtPixel(v, x + m, y) === link &&
+              linkAtPixel(v, x, y - m) === link && linkAtPixel(v, x, y + m) === link) {
             var r = c.getBoundingClientRect();
             return [x + c.clientLeft - r.width / 2, y + c.clientTop - r.height / 2];
           }

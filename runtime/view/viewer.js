@@ -179,8 +179,11 @@
     var dpr = window.devicePixelRatio || 1;
     var w, h;
     if (fixed) { w = fixed[0]; h = fixed[1]; dpr = 1; } else {
+      // The largest 4:3 picture that fits, like `liganimate run`'s default 640x480:
+      // VIEW WIDTH spans the picture's width, so the aspect decides what is seen.
       var box = el('stage').getBoundingClientRect();
-      w = Math.max(64, Math.floor(box.width)); h = Math.max(48, Math.floor(box.height));
+      w = Math.max(64, Math.floor(Math.min(box.width, box.height * 4 / 3)));
+      h = Math.max(48, Math.floor(w * 3 / 4));
     }
     canvas.style.width = w + 'px';
     canvas.style.height = h + 'px';
