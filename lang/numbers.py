@@ -171,6 +171,15 @@ def describe(x) -> str:
     return f"{x:g}"
 
 
+def magnitude(x: float) -> str:
+    """A size for a message: ``%g`` when finite, words otherwise (never 'inf' or 'nan')."""
+    if math.isnan(x):
+        return "an undefined amount"
+    if math.isinf(x):
+        return f"more than {_REAL_MAX_TEXT}"
+    return f"{x:g}"
+
+
 def overflow(value, what: str = "the result") -> NumberError:
     """The error for an arithmetic result outside the language's numbers (the caller raises it)."""
     if isinstance(value, int):

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from liganimate.lang.numbers import GEOMETRY_MAX, GEOMETRY_MIN
+from liganimate.lang.numbers import GEOMETRY_MAX, GEOMETRY_MIN, magnitude
 
 from .errors import LigError
 from .values import Graphical
@@ -35,7 +35,7 @@ _REACH_MAX = 256
 
 
 def _fmt(x: float) -> str:
-    return "not a number" if math.isnan(x) else f"{x:g}"
+    return magnitude(x)
 
 
 def check_graphical(g: Graphical, what: str = "this object") -> Graphical:

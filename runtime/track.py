@@ -18,7 +18,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
-from liganimate.lang.numbers import MAX_ANGLE, MAX_FRAME, MIN_FRAME_GAP
+from liganimate.lang.numbers import MAX_ANGLE, MAX_FRAME, MIN_FRAME_GAP, magnitude
 from liganimate.runtime import interpolation
 from liganimate.runtime.errors import MotionError
 
@@ -831,7 +831,7 @@ def check_frames(frames: np.ndarray, cause: str) -> None:
         return
     last = frames[-1]
     if not last <= MAX_FRAME:
-        raise MotionError(f"{cause} puts a keyframe at frame {last:g}, beyond the last frame allowed, {MAX_FRAME:g}",
+        raise MotionError(f"{cause} puts a keyframe at frame {magnitude(last)}, beyond the last frame allowed, {MAX_FRAME:g}",
                           hint="a keyframe's frame is at most 1E9")
     gaps = np.diff(frames, prepend=0.0)
     close = (gaps > 0) & (gaps < MIN_FRAME_GAP)
@@ -845,7 +845,7 @@ def check_angles(values: np.ndarray, cause: str) -> None:
     """Angles within ``±MAX_ANGLE`` degrees, else MotionError naming ``cause``."""
     far = float(np.max(np.abs(values))) if np.size(values) else 0.0
     if not far <= MAX_ANGLE:
-        raise MotionError(f"{cause} makes an angle of {far:g} degrees, beyond the largest allowed, {MAX_ANGLE:g}",
+        raise MotionError(f"{cause} makes an angle of {magnitude(far)} degrees, beyond the largest allowed, {MAX_ANGLE:g}",
                           hint="angles are in degrees; a joint's extremes clip them anyway")
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from liganimate.lang.numbers import GEOMETRY_MAX
+from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
 
 from .errors import LigError
 
@@ -139,7 +139,7 @@ class Canvas:
             raise LigError(f"a polygon needs at least three corners; this one has {len(pts)}")
         far = max(abs(c) for p in pts for c in p)
         if not far <= GEOMETRY_MAX:
-            raise LigError(f"this polygon has a corner {far:g} units along an axis, beyond the limit of "
+            raise LigError(f"this polygon has a corner {magnitude(far)} units along an axis, beyond the limit of "
                            f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
         self.polys.append((np.asarray(pts, dtype=np.float64), self.light))
 
@@ -263,7 +263,7 @@ def box(centre, width, height, depth, light) -> Graphical:
     w, h, d = float(width), float(height), float(depth)
     far = float(np.max(np.abs(c))) + max(abs(w), abs(h), abs(d))
     if not far <= GEOMETRY_MAX:
-        raise LigError(f"this BOX reaches {far:g} units from the origin along an axis, beyond the limit of "
+        raise LigError(f"this BOX reaches {magnitude(far)} units from the origin along an axis, beyond the limit of "
                        f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
     light = _clip_lightness(light)
     l1, l2 = light, light * 1.5
