@@ -25,7 +25,7 @@ from lark.lexer import Token
 from lark.parse_tree_builder import ChildFilterLALR_NoPlaceholders, ExpandSingleChild
 from lark.parsers.lalr_analysis import Shift
 
-from .lexer import _SCAN, DOLLAR, NUMBER, OPERATOR, STRING, WORD, Scanner, Tok
+from .lexer import DOLLAR, NUMBER, OPERATOR, SCAN, STRING, WORD, Scanner, Tok
 
 
 class _Inlined(tuple):
@@ -40,11 +40,11 @@ class _Inlined(tuple):
     children = property(itemgetter(0))
 
 
+_new_tuple = tuple.__new__
+
+
 def _inline(children: list) -> _Inlined:
     return _new_tuple(_Inlined, (children,))
-
-
-_new_tuple = tuple.__new__
 
 
 def _inlined(callback):
@@ -133,7 +133,7 @@ class Driver:
         values: list = []
         push_state = stack.append
         push_value = values.append
-        scan = _SCAN.match
+        scan = SCAN.match
         count = text.count
         pos = 0
         line, line_start = 1, 0

@@ -31,7 +31,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedToken
 from lark.lexer import Lexer
 
 _SKIP = r"(?:[ \t\f\r\n]+|\{[^}]*\})*"
-_SCAN = re.compile(
+SCAN = re.compile(
     _SKIP
     + r"(?:(?P<w>[A-Za-z][A-Za-z0-9_]*)"
     + r"|(?P<n>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?°?)"
@@ -41,7 +41,7 @@ _SCAN = re.compile(
     + r"|(?P<end>\Z))"
 )
 _NEWLINE = "\n"
-#: _SCAN's groups, by number (Match.lastindex).
+#: SCAN's groups, by number (Match.lastindex).
 WORD, NUMBER, STRING, DOLLAR, OPERATOR, END = range(1, 7)
 
 # Operator spellings, longest first, and the terminals each may be (in Lark's order).
@@ -199,7 +199,7 @@ class Scanner:
         """
         pos = 0
         line, line_start = 1, 0
-        scan = _SCAN.match
+        scan = SCAN.match
         tables = self.tables
         keywords = tables.keywords
         choice = self._choice
