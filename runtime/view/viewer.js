@@ -61,7 +61,9 @@
   var frame = { pos: new Float32Array(0), col: new Uint8Array(0), ranges: [], spans: [] };
 
   function sceneCamera(s, tick) {
-    var c = s.cams, i = Math.min(tick, Math.max(0, s.length - 1)) * 4;
+    var c = s.cams, i = Math.min(tick, c.length / 4 - 1) * 4;
+    // A scene of no ticks has no camera: LIG's default VIEW.
+    if (i < 0) return { eye: [0, 0, 10], target: [0, 0, 0], k: 1 };
     var eye = [c[i], c[i + 1], c[i + 2]];
     var d = Math.sqrt(eye[0] * eye[0] + eye[1] * eye[1] + eye[2] * eye[2]);
     return { eye: eye, target: [0, 0, 0], k: c[i + 3] / d };
@@ -125,7 +127,8 @@
   function showFrame() {
     var s = scenes[state.scene], tr = tickRange(s, state.image);
     el('frame').textContent = 'frame ' + state.image + ' / ' + (s.images - 1);
-    el('tick').textContent = tr[0] === tr[1] ? 'tick ' + tr[0] : 'ticks ' + tr[0] + '\u2013' + tr[1];
+    el('tick').textContent = tr[1] < tr[0] ? 'no ticks' : tr[0] === tr[1] ? 'tick ' + tr[0] :
+      'ticks ' + tr[0] + '\u2013' + tr[1];
     el('scrub').value = String(state.image);
   }
 

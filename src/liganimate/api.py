@@ -10,6 +10,7 @@ the viewer itself (``_repr_html_``), in a sandboxed frame.
 from __future__ import annotations
 
 import os
+from typing import NoReturn
 
 from liganimate.lang.diagnostics import LigDiagnostics, format_diagnostic
 
@@ -23,7 +24,7 @@ class LigProgramError(LigDiagnostics):
         return "\n".join(format_diagnostic(d) for d in self.diagnostics)
 
 
-def _reraise(exc: LigDiagnostics):
+def _reraise(exc: LigDiagnostics) -> NoReturn:
     raise LigProgramError(exc.diagnostics) from None
 
 
@@ -70,7 +71,7 @@ class LoadedProgram:
         self.name = name
         self.program = program
         self.warnings = warnings
-        self._scenes = None
+        self._scenes: list | None = None
 
     def scenes(self) -> list:
         """Run the program once without drawing; its shot scenes (``SceneTake``), cached.
@@ -84,9 +85,10 @@ class LoadedProgram:
             from liganimate.runtime.exchange import collect
 
             try:
-                self._scenes = collect(self.program)
+                scenes = collect(self.program)
             except LigDiagnostics as exc:
                 _reraise(exc)
+            self._scenes = scenes
         return self._scenes
 
     def view(self, scene=None, height: int = 560) -> View:
