@@ -204,8 +204,12 @@ def _real_steps(start, stop, step):
     if not q > 0:  # also NaN
         return
     if q <= 2.0**62:
-        for i in range(math.floor(q)):
-            yield float(start + i * step)
+        if isinstance(start, float) and isinstance(step, float):
+            for i in range(math.floor(q)):
+                yield start + i * step
+        else:
+            for i in range(math.floor(q)):
+                yield float(start + i * step)
         return
     i = 0
     while True:
