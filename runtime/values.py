@@ -261,7 +261,7 @@ def box(centre, width, height, depth, light) -> Graphical:
     """
     c = np.asarray(centre, dtype=np.float64)
     w, h, d = float(width), float(height), float(depth)
-    far = float(np.max(np.abs(c))) + max(abs(w), abs(h), abs(d))
+    far = float(np.max(np.abs(c))) + max(abs(w), abs(h), abs(d)) / 2  # its corners are c +- size / 2
     if not far <= GEOMETRY_MAX:
         raise LigError(f"this BOX reaches {magnitude(far)} units from the origin along an axis, beyond the limit of "
                        f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
