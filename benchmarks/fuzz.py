@@ -320,7 +320,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="a run of under a minute")
     parser.add_argument("--cases", type=int, help="cases to run (default 100000, or 2000 with --quick)")
     parser.add_argument("--budget", type=float, help="stop starting cases after this many seconds "
-                                                     "(default none, or 40 with --quick)")
+                                                     "(default none, or 35 with --quick)")
     parser.add_argument("--seed", type=int, default=1986)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--generators", default="grammar,numbers,splice",
@@ -337,7 +337,7 @@ def main(argv=None) -> int:
         if name not in fuzzgen.GENERATORS and name != "mutate":
             parser.error(f"unknown generator {name!r}")
     args.cases = args.cases or (2000 if args.quick else 100_000)
-    args.budget = args.budget if args.budget is not None else (40.0 if args.quick else float("inf"))
+    args.budget = args.budget if args.budget is not None else (35.0 if args.quick else float("inf"))
     args.minimise = args.minimise if args.minimise is not None else (3 if args.quick else 10_000)
     args.minimise_budget = args.minimise_budget or (4.0 if args.quick else 30.0)
     # One thread per worker for numpy's BLAS: the workers are the parallelism.

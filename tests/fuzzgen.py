@@ -11,7 +11,8 @@ hypothesis' ``st.randoms()`` in the tests -- and returns program text.
   programs with extreme values: 1e308, 1e309, -0.0, 5e-324, 2**63,
   401- and 5,000-digit integers, infinities and NaNs made by arithmetic;
 * :func:`splice_program` splices lines and blocks of examples/*.lig and
-  stdlib/*.lig into each other at random places.
+  stdlib/*.lig into each other at random places;
+* :func:`wild_program` is a grammar-expanded program with extreme numbers.
 
 Cases must stay fast: the generators keep scenes a few ticks long and DO
 loops a few trips long. The one exception is on purpose: an extreme value
@@ -28,7 +29,8 @@ import re
 
 from fuzzgrammar import grammar_program
 
-__all__ = ["EXTREMES", "GENERATORS", "TEMPLATES", "grammar_program", "number_program", "splice_program"]
+__all__ = ["EXTREMES", "GENERATORS", "TEMPLATES", "grammar_program", "number_program", "splice_program",
+           "wild_program"]
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -399,5 +401,12 @@ def splice_program(rng) -> str:
     return _LENGTH.sub(lambda m: m.group(1) + str(min(int(m.group(2)), MAX_LENGTH)), text)
 
 
+def wild_program(rng) -> str:
+    """A grammar-expanded program in which a quarter of the numbers are extreme (:data:`EXTREMES`)."""
+    wild = [v if re.fullmatch(r"[0-9.eE+°]+", v) else f"({v})" for v in EXTREMES]
+    return grammar_program(rng, wild, 0.25)
+
+
 #: The generators by name, as the benchmark and the tests call them.
-GENERATORS = {"grammar": grammar_program, "numbers": number_program, "splice": splice_program}
+GENERATORS = {"grammar": grammar_program, "numbers": number_program, "splice": splice_program,
+              "wild": wild_program}

@@ -253,8 +253,9 @@ class Expander:
 
     MAX_DEPTH = 32
 
-    def __init__(self, rng, names: dict):
+    def __init__(self, rng, names: dict, wild: tuple = (), wild_rate: float = 0.0):
         self.rng = rng
+        self.wild, self.wild_rate = wild, wild_rate  # extra numbers, and how often one is taken
         self.g = grammar()
         self.exports = stdlib_exports()
         self.names = {k: list(v) for k, v in names.items()}
@@ -305,6 +306,8 @@ class Expander:
     def number(self, kind) -> str:
         if kind == INT:
             return self.rng.choice(_SMALL)
+        if self.wild and self.rng.random() < self.wild_rate:
+            return self.rng.choice(self.wild)
         r = self.rng.random()
         if r < 0.05:
             return self.rng.choice(_ODD_NUMBERS if r < 0.04 else _EDGE_NUMBERS)
@@ -720,15 +723,17 @@ def layout(tokens: list, rng) -> str:
     return "".join(out).rstrip() + "\n"
 
 
-def grammar_program(rng) -> str:
+def grammar_program(rng, wild: tuple = (), wild_rate: float = 0.0) -> str:
     """A random program expanded from lang/lig.lark (see the module's docstring).
 
     Most programs start with a prelude that declares, and usually assigns,
-    the names the expansion draws from.
+    the names the expansion draws from. A number slot takes one of ``wild``
+    (number tokens or parenthesised expressions) with probability ``wild_rate``.
     """
     r = rng.random()
     prelude = "" if r < 0.1 else (DECLARATIONS if r < 0.3 else DECLARATIONS + VALUES)
-    ex = Expander(rng, PRELUDE_NAMES if prelude else {k: v[:1] for k, v in PRELUDE_NAMES.items()})
+    ex = Expander(rng, PRELUDE_NAMES if prelude else {k: v[:1] for k, v in PRELUDE_NAMES.items()},
+                  tuple(wild), wild_rate)
     ex.expand("start", 0)
     while ex.labels and rng.random() < 0.9:
         ex.tokens += [None, ex.labels.pop(), "CONTINUE"]

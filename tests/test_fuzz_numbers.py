@@ -18,6 +18,7 @@ from hypothesis import HealthCheck, Phase, event, given, settings
 from hypothesis import strategies as st
 
 CASES = 600
+WILD_CASES = 200
 
 
 def test_every_template_runs_at_its_defaults():
@@ -52,4 +53,15 @@ def test_a_filled_slot_changes_only_that_slot():
 @given(rng=st.randoms(use_true_random=False))
 def test_extreme_numbers_are_diagnosed_or_handled(rng):
     out = fuzzrun.assert_runs_or_is_diagnosed(fuzzgen.number_program(rng))
+    event(out.kind)
+
+
+@settings(max_examples=WILD_CASES, derandomize=True, deadline=None, database=None,
+          phases=(Phase.explicit, Phase.generate),
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.large_base_example])
+@given(rng=st.randoms(use_true_random=False))
+def test_extreme_numbers_anywhere_in_grammar_programs_are_diagnosed_or_handled(rng):
+    # The templates put extremes where a program is known to work; here they
+    # land wherever the grammar has a number, a quarter of the time.
+    out = fuzzrun.assert_runs_or_is_diagnosed(fuzzgen.wild_program(rng))
     event(out.kind)

@@ -16,7 +16,7 @@ import fuzzrun
 from hypothesis import HealthCheck, Phase, event, given, settings
 from hypothesis import strategies as st
 
-CASES = 400
+CASES = 600
 
 
 def test_the_corpus_has_the_examples_and_libraries_and_their_blocks():
