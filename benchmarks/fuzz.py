@@ -2,8 +2,9 @@
 
 Runs the generators of tests/fuzzgen.py -- grammar expansion of
 lang/lig.lark, extreme-number templates, cross-file splices of the
-examples and standard libraries (and, with ``--generators``, the line and
-token mutations of benchmarks/fuzz_compile.py) -- in a pool of worker
+examples and standard libraries, grammar programs with extreme numbers
+("wild"), and with ``--generators mutate`` the line and token mutations
+of benchmarks/fuzz_compile.py -- in a pool of worker
 processes. Each case is compiled, checked and rendered at 16x12 exactly as
 tests/fuzzrun.py does it, and sorted into ok, diagnosed, error, slow, or
 one of the failures:
@@ -323,8 +324,8 @@ def main(argv=None) -> int:
                                                      "(default none, or 35 with --quick)")
     parser.add_argument("--seed", type=int, default=1986)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
-    parser.add_argument("--generators", default="grammar,numbers,splice",
-                        help="comma-separated: grammar, numbers, splice, mutate")
+    parser.add_argument("--generators", default="grammar,numbers,splice,wild",
+                        help="comma-separated: grammar, numbers, splice, wild, mutate")
     parser.add_argument("--limit", type=float, default=2.0, help="seconds per case before it counts as slow")
     parser.add_argument("--memory", type=int, default=1024, help="MB of address space a case may add")
     parser.add_argument("--minimise", type=int, help="failure groups to minimise (default all, 3 with --quick)")
