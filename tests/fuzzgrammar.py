@@ -583,7 +583,9 @@ class Expander:
             return self.number(kind)
         if sym == "STRING":
             if rule == "load_stmt":
-                return f"'{self.library}'" if rng.random() < 0.95 else "'nowhere'"
+                # Now and then: no such library, the program itself (a cycle), a folder, a system file.
+                odd = ["'nowhere'", "'fuzz.lig'", "'fuzz'", "'.'", "''", "'/etc/hostname'", "'../stdlib/shapes'"]
+                return f"'{self.library}'" if rng.random() < 0.93 else rng.choice(odd)
             if rule == "pat_item":
                 self.pattern_items += 1
                 if self.pattern_items == 1:  # a pattern begins with the primitive's name
