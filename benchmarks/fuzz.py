@@ -125,9 +125,11 @@ class Pool:
         return {"proc": p, "conn": parent, "task": None, "deadline": 0.0}
 
     def idle(self) -> list:
+        """The workers without a task."""
         return [w for w in self.workers if w["task"] is None]
 
     def submit(self, w, task, hard: float) -> None:
+        """Hand ``task`` to worker ``w``; it is killed if no answer comes within ``hard`` seconds."""
         w["task"] = task
         w["deadline"] = time.monotonic() + hard
         w["conn"].send(task)
@@ -168,6 +170,7 @@ class Pool:
         self.workers[i] = self._start()
 
     def close(self) -> None:
+        """Stop every worker and take the largest resident set any of them reached."""
         for w in self.workers:
             try:
                 if w["task"] is None:
@@ -183,6 +186,7 @@ class Pool:
 
 
 def run(args) -> dict:
+    """Run the cases; return counts per generator, failure groups, minimised programs, time and memory."""
     generators = args.generators.split(",")
     pool = Pool(args.workers, args.limit, args.memory << 20)
     hard = args.limit * 3 + 10
@@ -249,6 +253,7 @@ def minimise_groups(pool: Pool, groups: dict, args) -> dict:
 
 
 def report(res: dict, args) -> dict:
+    """Print the table and the failure groups; return the summary for the final JSON line."""
     counts, groups = res["counts"], res["groups"]
     total = dict.fromkeys(ALL_OUTCOMES, 0)
     for per in counts.values():

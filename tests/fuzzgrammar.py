@@ -291,6 +291,7 @@ class Expander:
         return self.rng.choice(pool)
 
     def kind_of(self, name: str):
+        """The kind of a pooled name, or None for a name the pools do not know."""
         for kind, names in self.names.items():
             if name in names:
                 return kind
@@ -304,6 +305,7 @@ class Expander:
             self.names[what].append(name)
 
     def number(self, kind) -> str:
+        """A NUMBER token: small for INT slots, else mostly sensible, now and then odd or extreme."""
         if kind == INT:
             return self.rng.choice(_SMALL)
         if self.wild and self.rng.random() < self.wild_rate:
@@ -314,6 +316,7 @@ class Expander:
         return self.rng.choice(_NUMBERS)
 
     def cased(self, word: str) -> str:
+        """``word``, in mixed case now and then (keywords are case-insensitive)."""
         if self.case_flips and self.rng.random() < 0.3:
             return "".join(c.lower() if self.rng.random() < 0.5 else c for c in word)
         return word

@@ -16,9 +16,8 @@ The run is derandomized (the same cases every time) and takes about 15 s.
 from __future__ import annotations
 
 from hypothesis import HealthCheck, event, given, settings
-from mutations import SOURCES, example, fuzz, mutated, mutations
-
 from liganimate.lang.diagnostics import LigDiagnostics
+from mutations import SOURCES, example, fuzz, mutated, mutations
 
 EXAMPLES = 600
 
