@@ -8,32 +8,36 @@ the ``liganimate.interpolations`` entry-point group; those are only imported
 the first time a name is not found, so importing liganimate stays fast.
 
 LINEAR is special: its ease curve is the straight line, but the motion layer
-replaces it with a trapezoidal velocity profile (see ``docs/semantics-motion.md``).
-Every other method is used with its exact ease curve ("fixed shape").
+replaces it with a trapezoidal velocity profile.  Every other method is used
+with its exact ease curve ("fixed shape") where its neighbours meet it at
+its natural velocities ``(D/T) e'(0)`` and ``(D/T) e'(1)``, and as a
+monotone cubic Hermite where the velocity adjustment gives it others (see
+``docs/semantics-motion.md`` and ``liganimate.runtime.track``).
 """
 
 from __future__ import annotations
 
 import importlib.metadata
 import warnings
-from typing import Callable, Protocol, runtime_checkable
+from collections.abc import Callable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 ENTRY_POINT_GROUP = "liganimate.interpolations"
 
 __all__ = [
-    "ENTRY_POINT_GROUP",
-    "InterpolationMethod",
-    "Method",
-    "LINEAR",
+    "ACCDCC",
     "ACCELERATE",
     "DECELERATE",
-    "ACCDCC",
-    "register",
-    "unregister",
+    "ENTRY_POINT_GROUP",
+    "LINEAR",
+    "InterpolationMethod",
+    "Method",
     "get",
     "names",
+    "register",
+    "unregister",
 ]
 
 
@@ -82,7 +86,7 @@ class Method:
         Each maps an ndarray of shape (N,) to an ndarray of shape (N,).
     """
 
-    __slots__ = ("name", "reverse", "_e", "_de", "_d2e")
+    __slots__ = ("_d2e", "_de", "_e", "name", "reverse")
 
     def __init__(
         self,

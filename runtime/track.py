@@ -137,6 +137,53 @@ def _harmonic(s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
     return out
 
 
+HERMITE_CAP = 3.0
+"""Largest boundary velocity, in units of its segment's mean slope, a cubic segment may take.
+
+Fritsch and Carlson: a cubic Hermite piece whose end slopes lie in
+``[0, 3]`` times its mean slope is monotone, so it never leaves the range
+of the two keyframes it joins.
+"""
+
+# How a segment's end takes part in its knot's velocity (see _knot_velocity).
+_WANTS, _FLEXIBLE, _LINEAR, _REST = 1, 2, 3, 4
+
+
+def _knot_velocity(s1, s2, kind_l, kind_r, w_l, w_r, cap_l, cap_r) -> np.ndarray:
+    """Velocity shared by the two segments meeting at each interior knot.
+
+    Parameters
+    ----------
+    s1, s2 : ndarray, shape (M, 3)
+        Mean slopes ``D/T`` of the segment before and after each knot.
+    kind_l, kind_r : ndarray of int, shape (M,)
+        How each side's end behaves: ``_WANTS`` (a fixed-shape method whose
+        ease has a non-zero slope there, proposing its natural velocity),
+        ``_FLEXIBLE`` (ease slope 0 at that end only: ACCELERATE's start,
+        DECELERATE's end; it takes whatever its neighbour brings),
+        ``_LINEAR`` or ``_REST`` (slope 0 at both ends: ACCDCC).
+    w_l, w_r : ndarray, shape (M, 3)
+        Natural velocities proposed by ``_WANTS`` sides.
+    cap_l, cap_r : ndarray, shape (M,)
+        Largest velocity each side accepts, in units of its own slope, so
+        that it stays between its keyframes (``T/r`` for LINEAR, 3 otherwise).
+
+    Returns
+    -------
+    ndarray, shape (M, 3)
+        0 where the slopes differ in sign (an extreme) or a side rests.
+    """
+    kl, kr = kind_l[:, None], kind_r[:, None]
+    wants_l, wants_r = kl == _WANTS, kr == _WANTS
+    v = np.where(wants_l & wants_r, _harmonic(w_l, w_r),
+                 np.where(wants_l, w_l, np.where(wants_r, w_r, _harmonic(s1, s2))))
+    # Two flexible ends (DECELERATE into a keyframe, ACCELERATE out) rest, as both names say.
+    v = np.where(((kl == _FLEXIBLE) & (kr == _FLEXIBLE)) | (kl == _REST) | (kr == _REST), 0.0, v)
+    same = ((s1 > 0) & (s2 > 0)) | ((s1 < 0) & (s2 < 0))
+    limit = np.minimum(cap_l[:, None] * np.abs(s1), cap_r[:, None] * np.abs(s2))
+    return np.where(same, np.clip(v, -limit, limit), 0.0)
+
+
 class _Prepared(NamedTuple):
     F: np.ndarray  # (K+1,) knot frames, knot 0 is the start at frame 0
     V: np.ndarray  # (K+1, 3) knot values
@@ -144,10 +191,11 @@ class _Prepared(NamedTuple):
     D: np.ndarray  # (K, 3) segment displacements
     code: np.ndarray  # (K,) index into kinds
     kinds: tuple  # distinct method objects
-    Vs: np.ndarray  # (K, 3) LINEAR boundary velocity at segment start
-    Ve: np.ndarray  # (K, 3) LINEAR boundary velocity at segment end
+    Vs: np.ndarray  # (K, 3) boundary velocity at segment start
+    Ve: np.ndarray  # (K, 3) boundary velocity at segment end
     c: np.ndarray  # (K, 3) LINEAR cruise speed
     r: np.ndarray  # (K,) LINEAR ramp length actually used
+    herm: np.ndarray  # (K, 3) fixed-shape segment-axes drawn as a cubic Hermite
 
 
 class Leaf(Track):
@@ -211,23 +259,35 @@ class Leaf(Track):
         # Natural boundary velocities of fixed-shape segments: (D/T) e'(0), (D/T) e'(1).
         nat0 = np.zeros((K, 3))
         nat1 = np.zeros((K, 3))
+        e0 = np.zeros(K)
+        e1 = np.zeros(K)
         for j, m in enumerate(kinds):
             _, de, _ = m.ease(np.array([0.0, 1.0]))
             sel = code == j
+            e0[sel], e1[sel] = de[0], de[1]
             nat0[sel] = slope[sel] * de[0]
             nat1[sel] = slope[sel] * de[1]
-        Vs = np.zeros((K, 3))
-        Ve = np.zeros((K, 3))
+        Vs = np.where(lin[:, None], 0.0, nat0)
+        Ve = np.where(lin[:, None], 0.0, nat1)
         if K > 1:
-            # Knot i+1 joins segment i and i+1; a zero-length neighbour is a step (velocity 0).
-            inner = _harmonic(slope[:-1], slope[1:])
-            both = (pos[:-1] & pos[1:])[:, None]
-            Vs[1:] = np.where(both, np.where(lin[:-1, None], inner, nat1[:-1]), 0.0)
-            Ve[:-1] = np.where(both, np.where(lin[1:, None], inner, nat0[1:]), 0.0)
+            # Knot i+1 joins segment i and i+1; a zero-length neighbour is a step (boundary kept).
+            both = pos[:-1] & pos[1:]
+            side = np.where(lin, _LINEAR, np.where(e0 + e1 == 0.0, _REST, 0))
+            kind_l = np.where(side[:-1] != 0, side[:-1], np.where(e1[:-1] > 0, _WANTS, _FLEXIBLE))
+            kind_r = np.where(side[1:] != 0, side[1:], np.where(e0[1:] > 0, _WANTS, _FLEXIBLE))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                cap = np.where(lin, T / np.minimum(self.ramps, T / 2.0), HERMITE_CAP)
+            knot = _knot_velocity(slope[:-1], slope[1:], kind_l, kind_r,
+                                  e1[:-1, None] * slope[:-1], e0[1:, None] * slope[1:], cap[:-1], cap[1:])
+            Ve[:-1] = np.where(both[:, None], knot, Ve[:-1])
+            Vs[1:] = np.where(both[:, None], knot, Vs[1:])
         r = np.minimum(self.ramps, T / 2.0)
         c = np.zeros((K, 3))
         c[pos] = (D[pos] - r[pos, None] * (Vs[pos] + Ve[pos]) / 2.0) / (T[pos] - r[pos])[:, None]
-        self._prep = _Prepared(F, V, T, D, code, tuple(kinds), Vs, Ve, c, r)
+        # A fixed-shape segment keeps its exact ease curve where both boundary
+        # velocities are its natural ones; elsewhere it is the cubic Hermite.
+        herm = ~lin[:, None] & ((Vs != nat0) | (Ve != nat1)) & pos[:, None]
+        self._prep = _Prepared(F, V, T, D, code, tuple(kinds), Vs, Ve, c, r, herm)
         return self._prep
 
     def sample(self, t: np.ndarray) -> Samples:
@@ -359,19 +419,51 @@ def _trapezoid(p: _Prepared, s: np.ndarray, ts: np.ndarray, full: bool = True):
     return x, v, a
 
 
+def _hermite(p: _Prepared, s, tau: np.ndarray, sig: np.ndarray, full: bool):
+    """Cubic Hermite piece from ``(F[s], V[s], Vs)`` to ``(F[s+1], V[s+1], Ve)``; (x, v, a).
+
+    Each half is measured from its nearer keyframe with the same arithmetic
+    as the mirrored segment would use, so reversal stays exact and both
+    keyframes are reached bit for bit.
+    """
+    T = _col(p.T[s])
+    D, Vs, Ve = p.D[s], p.Vs[s], p.Ve[s]
+    u, w = tau / T, sig / T
+    # x = V0 + D (3u^2 - 2u^3) + T (Vs u w^2 - Ve u^2 w), written from either end.
+    xs = p.V[s] + D * (u * u * (3.0 - 2.0 * u)) + T * (Vs * u * w * w - Ve * u * u * w)
+    xe = p.V[s + 1] + (-D) * (w * w * (3.0 - 2.0 * w)) + T * ((-Ve) * w * u * u - (-Vs) * w * w * u)
+    x = np.where(tau <= sig, xs, xe)
+    if not full:
+        return x, None, None
+    v = D / T * (6.0 * u * w) + Vs * (w * w - 2.0 * u * w) + Ve * (u * u - 2.0 * u * w)
+    a = (D / T * (6.0 - 12.0 * u) + Vs * (6.0 * u - 4.0) + Ve * (6.0 * u - 2.0)) / T
+    return x, v, a
+
+
 def _fixed(p: _Prepared, m, s: np.ndarray, ts: np.ndarray, full: bool = True):
-    """Fixed-shape segments: v0 + D e(u).  Returns (x, v, a); v and a are None unless ``full``."""
-    tau, _sig, v0, v1 = _gather(p, s, ts)
+    """Fixed-shape segments: v0 + D e(u), or the Hermite where velocities were adjusted.
+
+    Returns (x, v, a); v and a are None unless ``full``.
+    """
+    tau, sig, v0, v1 = _gather(p, s, ts)
     T = _col(p.T[s])
     D = p.D[s]
     u = np.clip(tau / T, 0.0, 1.0)
+    herm = p.herm[s]
     if not full:
         e = _ease_value(m, u[:, 0])[:, None]
-        return np.where(u <= 0.5, v0 + D * e, v1 - D * (1.0 - e)), None, None
+        x = np.where(u <= 0.5, v0 + D * e, v1 - D * (1.0 - e))
+        if herm.any():
+            x = np.where(herm, _hermite(p, s, np.maximum(tau, 0.0), np.maximum(sig, 0.0), False)[0], x)
+        return x, None, None
     e, de, d2e = m.ease(u[:, 0])
     e, de, d2e = e[:, None], de[:, None], d2e[:, None]
     x = np.where(u <= 0.5, v0 + D * e, v1 - D * (1.0 - e))
-    return x, D / T * de, D / (T * T) * d2e
+    v, a = D / T * de, D / (T * T) * d2e
+    if herm.any():
+        hx, hv, ha = _hermite(p, s, np.maximum(tau, 0.0), np.maximum(sig, 0.0), True)
+        x, v, a = np.where(herm, hx, x), np.where(herm, hv, v), np.where(herm, ha, a)
+    return x, v, a
 
 
 def _fixed_increasing(p: _Prepared, m, k: int, ts: np.ndarray) -> np.ndarray:
@@ -381,6 +473,8 @@ def _fixed_increasing(p: _Prepared, m, k: int, ts: np.ndarray) -> np.ndarray:
     (``u <= 0.5``) come first: each formula is evaluated on its own rows
     only, with the same arithmetic, value for value.
     """
+    if p.herm[k].any():
+        return _fixed(p, m, np.full(len(ts), k), ts, False)[0]
     tau = (ts - p.F[k])[:, None]
     D = p.D[k]
     u = np.clip(tau / p.T[k], 0.0, 1.0)
