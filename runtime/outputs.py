@@ -57,7 +57,7 @@ def check_fps(fps, name: str = "--fps") -> float:
     return f
 
 
-def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None) -> None:
+def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None, make_poses_folder=False) -> None:
     """Refuse output options that could not be honoured, before anything is computed or written.
 
     Parameters
@@ -70,6 +70,10 @@ def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None)
         Frame rate of the GIF and MP4.
     names : dict, optional
         How to name each option in messages (default :data:`KEYWORD_NAMES`).
+    make_poses_folder : bool, optional
+        The pose record's folder may be missing too, because the caller
+        creates it (``Program.render(poses=...)`` always has); the command
+        line refuses a missing folder for every file alike.
 
     Raises
     ------
@@ -85,7 +89,11 @@ def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None)
             continue
         path = os.fspath(path)
         opt = names[key]
-        _check_file(path, opt, out_dir)
+        folder = os.path.dirname(os.path.abspath(path))
+        if key == "poses" and make_poses_folder and not os.path.lexists(folder):
+            _check_folder(os.path.dirname(path), opt)
+        else:
+            _check_file(path, opt, out_dir)
         real = os.path.realpath(path)
         if real == os.path.realpath(out_dir):
             raise RenderError(f"{opt} {path} is the frames folder ({names['out']} {out_dir}); give another file name")

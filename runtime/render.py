@@ -32,6 +32,7 @@ from .imagefiles import (
     AtomicWriter,
     find_ffmpeg,
     fsync_folder,
+    os_error_words,
     read_png,
     write_gif,
     write_mp4,
@@ -89,7 +90,7 @@ class Renderer:
 
     def __init__(self, out_dir, size=(640, 480), gif=None, mp4=None, poses=None, fps=24.0, quiet=False,
                  workers=None, stdout=None, progress=None):
-        check_outputs(out_dir, gif, mp4, poses, fps, KEYWORD_NAMES)
+        check_outputs(out_dir, gif, mp4, poses, fps, KEYWORD_NAMES, make_poses_folder=True)
         self.out_dir = out_dir
         self.size = (int(size[0]), int(size[1]))
         self.gif, self.mp4, self.fps = gif, mp4, float(fps)
@@ -112,6 +113,11 @@ class Renderer:
         self.progress = progress if progress is not None else (not quiet and sys.stderr.isatty())
         self._poses_fh = None
         self._closed = False
+        if poses:
+            try:
+                os.makedirs(os.path.dirname(os.path.abspath(poses)), exist_ok=True)
+            except OSError as exc:
+                raise RenderError(f"cannot create the folder of {poses}: {os_error_words(exc)}") from None
         self.lock = OutputLock(out_dir, (gif, mp4, poses))
         if poses:
             try:

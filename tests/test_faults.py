@@ -251,3 +251,48 @@ def test_errno_words_keep_unknown_errors_readable():
 
     assert os_error_words(OSError(errno.ENOSPC, "No space left on device")) == "no space left on device"
     assert os_error_words(OSError(errno.ENXIO, "No such device or address")) == "no such device or address"
+
+
+# --------------------------------------------------------------------------
+# Signals: the first stops, the rest are noted
+
+
+def test_a_second_signal_during_cleanup_is_only_noted():
+    # `timeout -s INT` sends two SIGINTs a millisecond apart; the second used to
+    # raise KeyboardInterrupt inside the cleanup of the first and print a traceback.
+    from liganimate.runtime import interrupts
+
+    before = {s: signal.getsignal(s) for s in interrupts.SIGNALS}
+    cleaned = []
+    try:
+        assert interrupts.stop_on_signals()
+        with pytest.raises(interrupts.Interrupted) as info:
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(10)  # the handler raises here
+            finally:
+                os.kill(os.getpid(), signal.SIGINT)
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.05)  # both handlers run now, inside the cleanup, and must not raise
+                cleaned.append("done")
+        assert info.value.signum == signal.SIGINT
+        assert cleaned == ["done"]
+        # A SIGTERM among them makes the stop a termination (exit status 143).
+        assert interrupts.stopped_by() == signal.SIGTERM
+    finally:
+        for s, handler in before.items():
+            signal.signal(s, handler)
+
+
+def test_the_library_still_makes_the_pose_records_folder(tmp_path):
+    # Program.render(poses=...) has always created the record's folder; the command line refuses a missing one.
+    from liganimate.cli import load_program
+
+    prog, _ = load_program(str(program(tmp_path, 3)))
+    prog.render(str(tmp_path / "frames"), size=(8, 6), poses=str(tmp_path / "new" / "p.jsonl"), quiet=True, workers=1)
+    assert len((tmp_path / "new" / "p.jsonl").read_text().splitlines()) == 3
+    with pytest.raises(RenderError, match=r"^poses= .*/swing.lig/x/y cannot be created: .*/swing.lig is a file, "
+                                          "not a folder$"):
+        prog.render(str(tmp_path / "frames"), poses=str(tmp_path / "swing.lig" / "x" / "y" / "p.jsonl"), quiet=True)
+    with pytest.raises(RenderError, match=r"^poses= .*/p.jsonl cannot be written: the folder .*swing.lig is not a folder$"):
+        prog.render(str(tmp_path / "frames"), poses=str(tmp_path / "swing.lig" / "p.jsonl"), quiet=True)

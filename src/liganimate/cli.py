@@ -190,12 +190,12 @@ def cmd_check(args) -> int:
 def cmd_compile(args) -> int:
     def go():
         from liganimate.compiler import compile_file
-        from liganimate.runtime.imagefiles import _atomic
+        from liganimate.runtime.imagefiles import AtomicWriter
 
         compiled = compile_file(args.file)
         _print_diagnostics(compiled.warnings)
         out = args.output or os.path.splitext(os.path.basename(args.file))[0] + ".py"
-        with _atomic(out, True) as fh:
+        with AtomicWriter(out) as fh:
             fh.write(compiled.python.encode("utf-8"))
         return 0
 
@@ -207,13 +207,13 @@ def cmd_archive(args) -> int:
         from liganimate.compiler import compile_source
         from liganimate.compiler.archive import archive_text
         from liganimate.lang.source import prepare
-        from liganimate.runtime.imagefiles import _atomic
+        from liganimate.runtime.imagefiles import AtomicWriter
 
         out = args.output or os.path.splitext(os.path.basename(args.file))[0] + "_lib.lig"
         text = archive_text(args.file, out)
         # The archive must itself load cleanly before it replaces anything.
         compile_source(prepare(text, out), path=os.path.abspath(out))
-        with _atomic(out, True) as fh:
+        with AtomicWriter(out) as fh:
             fh.write(text.encode("utf-8"))
         print(f"wrote {out}", file=sys.stderr)
         return 0
