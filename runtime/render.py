@@ -297,7 +297,10 @@ class Renderer:
             write_gif(self.gif, self._frames(), self.fps)
         if self.mp4 and self.images:
             write_mp4(self.mp4, self._frames(), self.fps)
-        # Each file was synced before its rename; syncing the folders makes the renames durable too.
+        self._sync_folders()
+
+    def _sync_folders(self) -> None:
+        """Each file was synced before its rename; syncing the folders makes the renames durable too."""
         folders = {os.path.join(self.out_dir, f"scene{scene_id}") for scene_id, _ in self.scenes}
         folders |= {os.path.dirname(os.path.abspath(p)) for p in (self.gif, self.mp4, self.poses_path) if p}
         for folder in sorted(folders) + [self.out_dir]:
@@ -329,6 +332,7 @@ class Renderer:
                     self._poses_fh.abort()
                     self._poses_fh = None
                 self.lock.sweep(self.out_dir, (self.gif, self.mp4, self.poses_path))
+                self._sync_folders()  # the frames of an interrupted run survive a power loss too
             finally:
                 self.lock.release()
 
