@@ -12,6 +12,8 @@ Python's keywords, builtins or the generated machinery.
 
 from __future__ import annotations
 
+import re
+
 from liganimate.lang import ast as A
 from liganimate.lang import numbers as N
 
@@ -51,6 +53,14 @@ _KIND = {T.INTEGER: "I", T.REAL: "R", T.VECTOR: "V"}
 _CHECKED = (T.INTEGER, T.REAL, T.VECTOR)
 _ARITH = ("+", "-", "*")
 
+# A program with more top-level statements than this is lowered into many
+# functions of about CHUNK_LINES lines, each compiled on its own (see
+# Lowerer.main_chunks and runtime/loader.py): CPython needs about 1.5 KB a
+# line to compile one function and frees it only at the end.
+CHUNK_STATEMENTS = 1000
+CHUNK_LINES = 1000
+_WORD = re.compile(r"(?<![\w.])[A-Z][A-Z0-9_]*\b")
+
 _CMP = {"=": "==", "<>": "!=", "/=": "!=", "<": "<", ">": ">", "<=": "<=", ">=": ">="}
 
 
@@ -71,6 +81,10 @@ class Lowerer:
         # runs fastest; elsewhere by a call, which CPython compiles several
         # times faster (a conditional expression costs ~40 us to compile).
         self.hot = 0
+        prog = checked.program
+        # A big main program becomes many functions whose variables are module globals.
+        self.chunked = len(prog.body) + len(checked.main.types) > CHUNK_STATEMENTS
+        self.main_names = set(checked.main.types)
 
     # ------------------------------------------------------------- basics
     def at(self, node) -> int:
@@ -120,17 +134,26 @@ class Lowerer:
             if pdef is not None:
                 self.primitive(pdef, sig, scope)
                 self.emit("")
-        self.emit("def _main(rt):")
-        self.indent += 1
-        self.emit(repr(f"The main program of {self.doc_name}."))
-        for name, t in sorted(self.c.main.types.items()):
-            self.emit(f"{name} = {_ZERO[t]}")
-        self.block(prog.body, "main")
-        self.emit("return locals()")
-        self.indent -= 1
-        self.emit("")
+        if self.chunked:
+            self.main_chunks(prog.body)
+        else:
+            self.emit("def _main(rt):")
+            self.indent += 1
+            self.emit(repr(f"The main program of {self.doc_name}."))
+            for name, t in sorted(self.c.main.types.items()):
+                self.emit(f"{name} = {_ZERO[t]}")
+            self.block(prog.body, "main")
+            self.emit("return locals()")
+            self.indent -= 1
+            self.emit("")
         body = self.lines[body_start:]
-        positions = ["_AT = ("] + [f"    {p!r}," for p in self.positions] + [")", ""]
+        del self.lines[body_start:]
+        if len(self.positions) > CHUNK_STATEMENTS:
+            # Packed (see host.Program): a tuple literal this long costs CPython seconds and gigabytes.
+            packed = " ".join(f"{a} {b} {c} {d}" for a, b, c, d in self.positions)
+            positions = [f"_AT = {packed!r}", ""]
+        else:
+            positions = ["_AT = ("] + [f"    {p!r}," for p in self.positions] + [")", ""]
         tail = [
             "",
             f"program = _host.Program(_SOURCE_NAME, _AT, _main, {self.source_literal()})",
@@ -140,6 +163,47 @@ class Lowerer:
             "",
         ]
         return "\n".join(head + positions + body + tail)
+
+    def main_chunks(self, body: list) -> None:
+        """Emit the main program of a big program as top-level functions of about CHUNK_LINES lines.
+
+        Its variables are the module's globals, so that every function sees
+        them; the functions are split only between top-level statements.
+        """
+        self.emit("def _variables():")
+        self.emit('    """The program variables: LIG names are upper case, generated names are not."""')
+        self.emit('    return {k: v for k, v in globals().items() if k.isupper() and not k.startswith("_")}')
+        self.emit("")
+        chunks, start = [], len(self.lines)
+        self.indent += 1
+        inits = [f"{name} = {_ZERO[t]}" for name, t in sorted(self.c.main.types.items())]
+        for item in inits + list(body):
+            if isinstance(item, str):
+                self.emit(item)
+            else:
+                getattr(self, "s_" + type(item).__name__)(item, "main")
+            if len(self.lines) - start >= CHUNK_LINES:
+                chunks.append(self.lines[start:])
+                del self.lines[start:]
+        if len(self.lines) > start:
+            chunks.append(self.lines[start:])
+            del self.lines[start:]
+        self.indent -= 1
+        for k, lines in enumerate(chunks):
+            self.emit(f"def _main_{k}(rt):")
+            # Every upper-case word of the chunk that is a variable: a chunk
+            # that assigns one without `global` would make it its own local.
+            names = set(_WORD.findall("\n".join(lines))) & self.main_names
+            if names:
+                self.emit(f"    global {', '.join(sorted(names))}")
+            self.lines.extend(lines)
+            self.emit("")
+        self.emit("def _main(rt):")
+        self.emit("    " + repr(f"The main program of {self.doc_name}."))
+        for k in range(len(chunks)):
+            self.emit(f"    _main_{k}(rt)")
+        self.emit("    return _variables()")
+        self.emit("")
 
     def source_literal(self) -> str:
         return repr(self.c.program.source)
@@ -316,7 +380,7 @@ class Lowerer:
         self.emit(f"def {fn}(_snap):")
         self.indent += 1
         if assigned:
-            self.emit(f"nonlocal {', '.join(sorted(assigned))}")
+            self.emit(f"{'global' if self.chunked else 'nonlocal'} {', '.join(sorted(assigned))}")
         if snap:
             # The scene sees its models as they were where it was defined;
             # the program's own variables get their values back afterwards.
@@ -377,7 +441,10 @@ class Lowerer:
 
     def s_Stop(self, s, where):
         # In the main program, hand the variables over so Python users see them.
-        self.emit("rt.stop(locals())" if where == "main" and getattr(self, "scope_types", None) is None else "rt.stop(None)")
+        if where == "main" and getattr(self, "scope_types", None) is None:
+            self.emit("rt.stop(_variables())" if self.chunked else "rt.stop(locals())")
+        else:
+            self.emit("rt.stop(None)")
 
     def s_Load(self, s, where):
         index, names = self.c.loads.get(id(s), (None, ()))
@@ -440,6 +507,8 @@ class Lowerer:
                 return f"_ck({text}, {kind!r}, {self.at(e)})"
             lo, hi = _BOUND[t]
             return f"(_n if {lo} <= (_n := {text}) <= {hi} else rt.overflow(_n, {kind!r}, {self.at(e)}))"
+        if e.op == "+" and self.type_of(e.left) == T.MOTION:
+            return self._motion_sum(e)
         left, right = self.expr(e.left), self.expr(e.right)
         if e.op == "/":
             return f"rt.div({left}, {right}, {self.at(e.op_pos)})"
@@ -447,9 +516,25 @@ class Lowerer:
             return f"rt.mod({left}, {right}, {self.at(e.op_pos)})"
         if e.op == "*" and self.type_of(e.right) == T.MOTION:
             return f"rt.repeat({left}, {right}, {self.at(e)})"
-        if e.op == "+" and self.type_of(e.left) == T.MOTION:
-            return f"rt.concat({left}, {right}, {self.at(e)})"
         return f"({left} {e.op} {right})"
+
+    def _motion_sum(self, e) -> str:
+        """``A + B + C`` grouped to the right, as the thesis' BNF
+        (``<motion term> + <motion express>``) does; the parser groups it to the left.
+
+        + is associative, so this changes no pose; it keeps the listing of
+        PRINT and describe() in the thesis' shape.  Operands are still
+        evaluated left to right.
+        """
+        ops = []
+        while isinstance(e, A.BinOp) and e.op == "+" and self.type_of(e.left) == T.MOTION:
+            ops.append(e)
+            e = e.left
+        operands = [self.expr(e)] + [self.expr(op.right) for op in reversed(ops)]
+        text = operands[-1]
+        for operand, op in zip(reversed(operands[:-1]), ops):
+            text = f"rt.concat({operand}, {text}, {self.at(op)})"
+        return text
 
     def _chained(self, e, t) -> str:
         """An operand inside a checked chain of type ``t``: unchecked if it continues the chain."""

@@ -116,9 +116,10 @@ class Motion:
     ``n * m`` and the methods below.  All operations return new motions.
     """
 
-    __slots__ = ("_derived", "_expr", "_length", "_tracks")
+    __slots__ = ("_derived", "_expr", "_length", "_open", "_tail", "_tracks")
 
-    def __init__(self, tracks: Mapping[int, tr.Track], expr: tuple, length: float | None = None):
+    def __init__(self, tracks: Mapping[int, tr.Track], expr: tuple, length: float | None = None,
+                 gaps: tuple[Iterable[int], Iterable[int]] = ((), ())):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
 
         Parameters
@@ -128,8 +129,14 @@ class Motion:
             The expression node :meth:`describe` renders.
         length : float, optional
             Defaults to the largest track end.
+        gaps : (iterable of int, iterable of int)
+            Joints whose track begins with a time no operand of ``+`` drove
+            (its leftmost piece is a ``Const`` that ``+`` may refill), and
+            joints whose track ends with such a time (a hold).
         """
         self._tracks = dict(sorted(tracks.items()))
+        self._open = frozenset(gaps[0]) & self._tracks.keys()
+        self._tail = frozenset(gaps[1]) & self._tracks.keys()
         self._length = float(
             length if length is not None else max((t.end for t in self._tracks.values()), default=0.0)
         )
@@ -163,10 +170,11 @@ class Motion:
         return out
 
     def __getstate__(self):
-        return (self._tracks, self._length, self._expr)
+        return (self._tracks, self._length, self._expr, self._open, self._tail)
 
     def __setstate__(self, state):
-        self._tracks, self._length, self._expr = state
+        self._tracks, self._length, self._expr = state[:3]
+        self._open, self._tail = state[3:] if len(state) > 3 else (frozenset(), frozenset())
         self._derived = None
 
     # -- construction -----------------------------------------------------
@@ -237,6 +245,24 @@ class Motion:
         """
         return self._tracks[self._driven(joint, "this motion")]
 
+    def gap(self, joint: int) -> float:
+        """Frames at the start during which no operand of ``+`` drives ``joint``.
+
+        Such a joint shows the previous driven value there once this motion
+        follows another that drives it, else its first driven value.
+
+        Parameters
+        ----------
+        joint : int
+
+        Returns
+        -------
+        float
+            0 if the joint is driven from frame 0.
+        """
+        j = self._driven(joint, "this motion")
+        return tr.gap_length(self._tracks[j]) if j in self._open else 0.0
+
     def _driven(self, joint, where: str) -> int:
         j = _joint_id(joint)
         if j not in self._tracks:
@@ -262,17 +288,34 @@ class Motion:
         return self._derive(("+", id(other)), other, lambda: self._concat(other))
 
     def _concat(self, other: Motion) -> Motion:
+        # A joint an operand does not drive is left "not driven here" and filled
+        # from its neighbours: the previous driven value, else the next.  Only
+        # a leading gap depends on what comes before, so ``other``'s leading
+        # gap is refilled here; that makes + associative by construction.
         la, lb = self._length, other._length
         tracks = {}
+        opened, tail = set(self._open), set(other._tail)
         for j in self._tracks.keys() | other._tracks.keys():
             ta, tb = self._tracks.get(j), other._tracks.get(j)
-            if tb is None:
+            if tb is None and lb == 0:
+                tracks[j] = tr.pad(ta, la)  # the empty motion (or any of length 0) is an identity
+                if j in self._tail:
+                    tail.add(j)
+            elif tb is None:
                 tracks[j] = tr.pad(ta, la + lb, hold_from=la)  # a's end value is held through b
+                tail.add(j)
+            elif ta is None and la == 0:
+                tracks[j] = tb
+                if j in other._open:
+                    opened.add(j)
+            elif ta is None:
+                tracks[j] = tr.concat(tr.Const(tb.start_value), tb, la)  # already in place for b
+                opened.add(j)
             else:
-                if ta is None:
-                    ta = tr.Const(tb.start_value)  # b's start value is held through a
+                if j in other._open:
+                    tb = tr.refill(tb, ta.end_value)
                 tracks[j] = tr.concat(ta, tb, la)
-        return Motion(tracks, ("+", self._expr, other._expr))
+        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail))
 
     def repeat(self, n: int) -> Motion:
         """``n`` copies played back to back (the thesis' ``n * motion``).
@@ -304,12 +347,23 @@ class Motion:
         expr = ("*", n, self._expr)
         if n == 0:
             return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr)
+        gaps = (self._open, self._tail)
         if n == 1 or self._length == 0:
-            return Motion(self._tracks, expr, self._length * n)
+            return Motion(self._tracks, expr, self._length * n, gaps)
         L = self._length
-        # A track that lasts the whole period ends exactly where the repeat does.
-        tracks = {j: tr.Repeat(t, n, L, end=n * L if t.end == L else None) for j, t in self._tracks.items()}
-        return Motion(tracks, expr, n * L)
+        tracks = {}
+        for j, t in self._tracks.items():
+            # A track that lasts the whole period ends exactly where the repeat does.
+            end = n * L if t.end == L else None
+            if j in self._open:
+                # Copies after the first fill their leading gap with the previous copy's end
+                # value, as a + a + ... + a would.
+                later = tr.refill(t, t.end_value)
+                rest = later if n == 2 else tr.Repeat(later, n - 1, L)
+                tracks[j] = tr.concat(t, rest, L, end=end if end is not None else (n - 1) * L + t.end)
+            else:
+                tracks[j] = tr.Repeat(t, n, L, end=end)
+        return Motion(tracks, expr, n * L, gaps)
 
     def __mul__(self, n) -> Motion:
         return self.repeat(n)
@@ -337,7 +391,7 @@ class Motion:
         for joint in joints:
             j = self._driven(joint, "the motion being stripped")
             kept[j] = self._tracks[j]
-        return Motion(kept, ("strip", tuple(kept), self._expr))
+        return Motion(kept, ("strip", tuple(kept), self._expr), gaps=(self._open, self._tail))
 
     def scale_frames(self, r: float) -> Motion:
         """Stretch time by ``|r|``; a negative ``r`` also plays the motion backwards.
@@ -367,9 +421,11 @@ class Motion:
         s, L = abs(r), self._length * abs(r)
         memo: dict = {}
         tracks = {j: tr.scale_frames(t, s, memo) for j, t in self._tracks.items()}
+        gaps = (self._open, self._tail)
         if r < 0:
             tracks = {j: tr.reverse(t, L, memo) for j, t in tracks.items()}
-        return Motion(tracks, ("frames", r, self._expr), L)
+            gaps = (self._tail, self._open)  # a trailing hold played backwards is a leading gap
+        return Motion(tracks, ("frames", r, self._expr), L, gaps)
 
     def scale_extremes(self, r: float) -> Motion:
         """Multiply every angle (start and keyframe positions) by ``r``.
@@ -388,7 +444,7 @@ class Motion:
     def _scale_extremes(self, r: float) -> Motion:
         memo: dict = {}
         tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
-        return Motion(tracks, ("extremes", r, self._expr), self._length)
+        return Motion(tracks, ("extremes", r, self._expr), self._length, (self._open, self._tail))
 
     def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> Motion:
         """Take the short way round on axes that can turn freely.
@@ -412,7 +468,7 @@ class Motion:
             j = _joint_id(joint)
             if j in tracks and any(axes):
                 tracks[j] = tr.unwrap(tracks[j], tuple(bool(a) for a in axes), memo)
-        return Motion(tracks, ("unwrap", self._expr), self._length)
+        return Motion(tracks, ("unwrap", self._expr), self._length, (self._open, self._tail))
 
     # -- evaluation -------------------------------------------------------
 
@@ -664,6 +720,8 @@ def synchronize(*motions: Motion) -> Motion:
     """
     tracks: dict[int, tr.Track] = {}
     owner: dict[int, int] = {}
+    opened: set[int] = set()
+    tail: set[int] = set()
     for i, m in enumerate(motions, start=1):
         if not isinstance(m, Motion):
             raise MotionError(f"operand {i} of SYNCHRONIZE is not a motion")
@@ -675,7 +733,9 @@ def synchronize(*motions: Motion) -> Motion:
                 )
             owner[j] = i
             tracks[j] = t
-    return Motion(tracks, ("sync", tuple(m._expr for m in motions)))
+        opened |= m._open
+        tail |= m._tail
+    return Motion(tracks, ("sync", tuple(m._expr for m in motions)), gaps=(opened, tail))
 
 
 def scale_frames(a: Motion, r: float) -> Motion:

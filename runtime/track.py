@@ -806,6 +806,51 @@ def concat(first: Track, second: Track, pivot: float, right: bool = True, end: f
     return Concat((first, second), [pivot], [right], end)
 
 
+def refill(track: Track, value) -> Track:
+    """The same track with its leftmost piece, a gap ``Const``, showing ``value``.
+
+    ``a + b`` uses it when ``b`` begins with a time no operand drove the
+    joint: that time shows the previous driven value, ``a``'s end.
+
+    Parameters
+    ----------
+    track : Track
+        Its leftmost piece (through Concat and Pad nodes) is a ``Const``.
+    value : array_like, shape (3,)
+
+    Returns
+    -------
+    Track
+    """
+    if isinstance(track, Const):
+        return Const(value, track.end)
+    if isinstance(track, Concat):
+        first = refill(track.pieces[0], value)
+        return Concat((first,) + track.pieces[1:], track.pivots, track.rights, track.end)
+    if isinstance(track, Pad):
+        return Pad(refill(track.inner, value), track.end, track.hold_from)
+    raise TypeError(f"track {type(track).__name__} does not begin with a gap")  # pragma: no cover
+
+
+def gap_length(track: Track) -> float:
+    """Frames the leftmost piece (a gap ``Const``, see :func:`refill`) lasts.
+
+    Parameters
+    ----------
+    track : Track
+
+    Returns
+    -------
+    float
+    """
+    while not isinstance(track, Concat):
+        if not isinstance(track, Pad):
+            return track.end
+        track = track.inner
+    first = track.pieces[0]
+    return float(track.pivots[0]) if isinstance(first, Const) else gap_length(first)
+
+
 def _cached(memo: dict, key: tuple, node: Track, make: Callable[[], Track]) -> Track:
     k = (id(node),) + key
     hit = memo.get(k)
