@@ -71,6 +71,36 @@ def compile_file(path: str) -> Compiled:
     return compile_source(load(path), path=path)
 
 
+def compile_for_run(path: str) -> tuple:
+    """Compile a program file for running it at once: ``(module text, warnings)``.
+
+    Unlike :func:`compile_file` it keeps no syntax tree (``Compiled.checked``),
+    so the tree's memory is free again before CPython compiles the module.
+    """
+    compiled = compile_file(path)
+    return compiled.python, compiled.warnings
+
+
+def load_program(path: str) -> tuple:
+    """Compile a .lig file in memory and execute its module: ``(program, warnings)``.
+
+    The module is the text ``liganimate compile`` writes, executed piece by
+    piece (:func:`liganimate.runtime.loader.exec_module`) so that a big
+    program compiles in memory proportional to one piece.
+
+    Raises
+    ------
+    LigDiagnostics
+        The program is wrong (see :func:`compile_source`).
+    """
+    from liganimate.runtime.loader import exec_module
+
+    python, warnings = compile_for_run(path)
+    namespace = {"__name__": "liganimate_program", "__file__": path}
+    exec_module(python, f"<liganimate {path}>", namespace)
+    return namespace["program"], warnings
+
+
 def _scan_loads(source: Source, path: str, stack: tuple) -> tuple:
     """Load what the source's LOAD statements name, before parsing.
 

@@ -70,8 +70,12 @@ class Program:
     ----------
     name : str
         The source file's name, used in diagnostics.
-    positions : tuple of (line, col, end_line, end_col)
+    positions : tuple of (line, col, end_line, end_col), or str
         Source positions referred to by the ``at`` arguments of the runtime.
+        A big program gives them packed, as one string of decimal numbers
+        separated by spaces, four per position: CPython compiles a string
+        constant at once, a tuple of a million tuples in 24 s and 4 GB.
+        The string is decoded when a diagnostic first needs a position.
     main : callable
         ``main(rt) -> dict`` runs the program and returns its variables.
     source : str
@@ -80,9 +84,17 @@ class Program:
 
     def __init__(self, name: str, positions, main, source: str = ""):
         self.name = name
-        self.positions = positions
+        self._positions = positions
         self.main = main
         self.source = source
+
+    @property
+    def positions(self) -> tuple:
+        """The source positions, a tuple of (line, col, end_line, end_col), decoded on first use."""
+        if isinstance(self._positions, str):
+            numbers = iter(map(int, self._positions.split()))
+            self._positions = tuple(zip(numbers, numbers, numbers, numbers))
+        return self._positions
 
     def execute(self, mode: str = "check", renderer=None, stdout=None) -> Runtime:
         """Run the program; return the runtime, whose ``variables`` hold its final values."""
@@ -91,7 +103,8 @@ class Program:
             rt.variables = self.main(rt) or {}
         except _StopProgram:
             pass  # STOP handed over its variables
-        rt.variables = {k: rt.finished(v) for k, v in rt.variables.items() if not k.startswith("_")}
+        # LIG names are upper case; generated ones (rt, _scene_0...) are not program variables.
+        rt.variables = {k: rt.finished(v) for k, v in rt.variables.items() if k.isupper() and not k.startswith("_")}
         for scene_id, (_, _, at) in sorted(rt.scenes.items()):
             rt.warn(at, f"scene {scene_id} is defined but never shot", "add SHOOTSCENES after the scenes")
 

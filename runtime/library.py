@@ -14,6 +14,7 @@ import hashlib
 import io
 
 from .errors import LigError
+from .loader import exec_module
 
 _runs: dict = {}  # sha256 of the module text -> (namespace, variables, warnings)
 
@@ -38,7 +39,7 @@ class Library:
         entry = _runs.get(self._key)
         if entry is None:
             namespace = {"__name__": f"liganimate_library_{self._key[:12]}"}
-            exec(compile(self.python, f"<liganimate library {self.name}>", "exec"), namespace)
+            exec_module(self.python, f"<liganimate library {self.name}>", namespace)
             entry = _runs[self._key] = [namespace, None, ()]
         return entry[0]
 
