@@ -314,6 +314,7 @@ class Motion:
             else:
                 if j in other._open:
                     tb = tr.refill(tb, ta.end_value)
+                ta, tb = tr.join_smoothly(ta, tb, la)
                 tracks[j] = tr.concat(ta, tb, la)
         return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail))
 
@@ -362,7 +363,7 @@ class Motion:
                 rest = later if n == 2 else tr.Repeat(later, n - 1, L)
                 tracks[j] = tr.concat(t, rest, L, end=end if end is not None else (n - 1) * L + t.end)
             else:
-                tracks[j] = tr.Repeat(t, n, L, end=end)
+                tracks[j] = tr.repeat_smoothly(t, n, L, end)
         return Motion(tracks, expr, n * L, gaps)
 
     def __mul__(self, n) -> Motion:

@@ -149,6 +149,11 @@ of the two keyframes it joins.
 _WANTS, _FLEXIBLE, _LINEAR, _REST = 1, 2, 3, 4
 
 
+def _cap(ramp: float, T: float, linear: bool) -> float:
+    """Largest boundary velocity of a segment, in units of its slope (T/r for LINEAR)."""
+    return T / min(ramp, T / 2.0) if linear else HERMITE_CAP
+
+
 def _knot_velocity(s1, s2, kind_l, kind_r, w_l, w_r, cap_l, cap_r) -> np.ndarray:
     """Velocity shared by the two segments meeting at each interior knot.
 
@@ -184,6 +189,45 @@ def _knot_velocity(s1, s2, kind_l, kind_r, w_l, w_r, cap_l, cap_r) -> np.ndarray
     return np.where(same, np.clip(v, -limit, limit), 0.0)
 
 
+class Edge(NamedTuple):
+    """A leaf's first or last segment as its neighbour across a junction sees it.
+
+    Attributes
+    ----------
+    slope : ndarray, shape (3,)
+        Mean slope ``D/T`` of the segment.
+    kind : int
+        How that end takes part in the knot velocity (see ``_knot_velocity``).
+    w : ndarray, shape (3,)
+        Natural velocity of that end (used if ``kind`` wants speed).
+    cap : float
+        Largest velocity the segment accepts, in units of its slope.
+    """
+
+    slope: np.ndarray
+    kind: int
+    w: np.ndarray
+    cap: float
+
+    def time_scaled(self, r: float) -> Edge:
+        """The edge after SCALE FRAMES ``r > 0`` (velocities divide by ``r``)."""
+        return Edge(self.slope / r, self.kind, self.w / r, self.cap)
+
+    def angle_scaled(self, r: float) -> Edge:
+        """The edge after SCALE EXTREMES ``r`` (velocities multiply by ``r``)."""
+        return Edge(self.slope * r, self.kind, self.w * r, self.cap)
+
+    def mirrored(self) -> Edge:
+        """The edge played backwards: it moves the other way, on the other side."""
+        return Edge(-self.slope, self.kind, -self.w, self.cap)
+
+
+def _edge_velocity(left: Edge, right: Edge) -> np.ndarray:
+    """The knot velocity, shape (3,), shared across a smooth junction."""
+    return _knot_velocity(left.slope[None], right.slope[None], np.array([left.kind]), np.array([right.kind]),
+                          left.w[None], right.w[None], np.array([left.cap]), np.array([right.cap]))[0]
+
+
 class _Prepared(NamedTuple):
     F: np.ndarray  # (K+1,) knot frames, knot 0 is the start at frame 0
     V: np.ndarray  # (K+1, 3) knot values
@@ -196,6 +240,8 @@ class _Prepared(NamedTuple):
     c: np.ndarray  # (K, 3) LINEAR cruise speed
     r: np.ndarray  # (K,) LINEAR ramp length actually used
     herm: np.ndarray  # (K, 3) fixed-shape segment-axes drawn as a cubic Hermite
+    first: Edge | None  # the first segment as a neighbour before this leaf sees it
+    last: Edge | None  # the last segment as a neighbour after this leaf sees it
 
 
 class Leaf(Track):
@@ -216,11 +262,16 @@ class Leaf(Track):
     right : bool
         True if the track is right-continuous at its steps (as written by
         users); reversed leaves are left-continuous.
+    before, after : Edge, optional
+        The segment across a smooth junction before frame 0 / after the last
+        keyframe (``a + b`` and ``n * a`` where the poses meet); the leaf's
+        first / last knot then shares a velocity with it instead of stopping.
     """
 
-    __slots__ = ("_prep", "frames", "methods", "ramps", "right", "start", "values")
+    __slots__ = ("_prep", "after", "before", "frames", "methods", "ramps", "right", "start", "values")
 
-    def __init__(self, start, frames, values, methods, ramps, right: bool = True):
+    def __init__(self, start, frames, values, methods, ramps, right: bool = True,
+                 before: Edge | None = None, after: Edge | None = None):
         self.start = _frozen(start).reshape(3)
         self.frames = _frozen(frames).reshape(-1)
         k = len(self.frames)
@@ -232,7 +283,21 @@ class Leaf(Track):
         self.start_value = self.start
         self.end_value = self.values[-1] if k else self.start
         self.min_keys = k
+        self.before, self.after = before, after
         self._prep = None
+
+    def with_edges(self, before: Edge | None, after: Edge | None) -> Leaf:
+        """The same keyframes with other neighbours across junctions.
+
+        Parameters
+        ----------
+        before, after : Edge or None
+
+        Returns
+        -------
+        Leaf
+        """
+        return Leaf(self.start, self.frames, self.values, self.methods, self.ramps, self.right, before, after)
 
     def _prepare(self) -> _Prepared:
         if self._prep is not None:
@@ -281,13 +346,24 @@ class Leaf(Track):
                                   e1[:-1, None] * slope[:-1], e0[1:, None] * slope[1:], cap[:-1], cap[1:])
             Ve[:-1] = np.where(both[:, None], knot, Ve[:-1])
             Vs[1:] = np.where(both[:, None], knot, Vs[1:])
+        first = last = None
+        if K and pos[0]:
+            kind0 = int(_LINEAR if lin[0] else _REST if e0[0] + e1[0] == 0 else _WANTS if e0[0] > 0 else _FLEXIBLE)
+            first = Edge(slope[0], kind0, e0[0] * slope[0], float(_cap(self.ramps[0], T[0], lin[0])))
+            if self.before is not None:
+                Vs[0] = _edge_velocity(self.before, first)
+        if K and pos[-1]:
+            kind1 = int(_LINEAR if lin[-1] else _REST if e0[-1] + e1[-1] == 0 else _WANTS if e1[-1] > 0 else _FLEXIBLE)
+            last = Edge(slope[-1], kind1, e1[-1] * slope[-1], float(_cap(self.ramps[-1], T[-1], lin[-1])))
+            if self.after is not None:
+                Ve[-1] = _edge_velocity(last, self.after)
         r = np.minimum(self.ramps, T / 2.0)
         c = np.zeros((K, 3))
         c[pos] = (D[pos] - r[pos, None] * (Vs[pos] + Ve[pos]) / 2.0) / (T[pos] - r[pos])[:, None]
         # A fixed-shape segment keeps its exact ease curve where both boundary
         # velocities are its natural ones; elsewhere it is the cubic Hermite.
         herm = ~lin[:, None] & ((Vs != nat0) | (Ve != nat1)) & pos[:, None]
-        self._prep = _Prepared(F, V, T, D, code, tuple(kinds), Vs, Ve, c, r, herm)
+        self._prep = _Prepared(F, V, T, D, code, tuple(kinds), Vs, Ve, c, r, herm, first, last)
         return self._prep
 
     def sample(self, t: np.ndarray) -> Samples:
@@ -368,7 +444,9 @@ class Leaf(Track):
                 raise MotionError(
                     f"interpolation method {m.name} cannot be reversed: its reverse {m.reverse} is not known"
                 ) from None
-        return Leaf(V[-1], E - F[::-1][1:], V[::-1][1:], methods, self.ramps[::-1], right=not self.right)
+        before = None if self.after is None else self.after.mirrored()
+        after = None if self.before is None else self.before.mirrored()
+        return Leaf(V[-1], E - F[::-1][1:], V[::-1][1:], methods, self.ramps[::-1], not self.right, before, after)
 
     def _scaled_frames(self, r, memo):
         with np.errstate(all="ignore"):
@@ -377,7 +455,9 @@ class Leaf(Track):
         if len(ramps) and not ramps.min() > 0:
             raise MotionError(f"SCALE FRAMES {r:g} squeezes the motion's speed-up ramps to nothing",
                               hint="use a larger factor")
-        return Leaf(self.start, frames, self.values, self.methods, ramps, self.right)
+        before = None if self.before is None else self.before.time_scaled(r)
+        after = None if self.after is None else self.after.time_scaled(r)
+        return Leaf(self.start, frames, self.values, self.methods, ramps, self.right, before, after)
 
     def _mapped(self, m, memo):
         return m.leaf(self)
@@ -674,7 +754,7 @@ class Concat(Track):
     def _emit(self, out, offset):
         self.pieces[0]._emit(out, offset)
         for p, q in zip(self.pivots, self.pieces[1:]):
-            out.junction(offset + p, q.start_value)
+            out.junction(offset + p, q.start_value, _smooth_start(q))
             q._emit(out, offset + p)
 
 
@@ -748,7 +828,7 @@ class Repeat(Track):
     def _emit(self, out, offset):
         for k in range(self.n):
             if k:
-                out.junction(offset + k * self.period, self.inner.start_value)
+                out.junction(offset + k * self.period, self.inner.start_value, _smooth_start(self.inner))
             self.inner._emit(out, offset + k * self.period)
 
 
@@ -830,6 +910,154 @@ def refill(track: Track, value) -> Track:
     if isinstance(track, Pad):
         return Pad(refill(track.inner, value), track.end, track.hold_from)
     raise TypeError(f"track {type(track).__name__} does not begin with a gap")  # pragma: no cover
+
+
+def _smooth_start(track: Track) -> bool:
+    """True if ``track`` begins with a leaf joined smoothly to what precedes it."""
+    leaf = edge_leaf(track, "left")
+    return leaf is not None and leaf.before is not None
+
+
+def edge_leaf(track: Track, side: str) -> Leaf | None:
+    """The leaf that plays at the very start (``"left"``) or end (``"right"``) of a track.
+
+    Parameters
+    ----------
+    track : Track
+    side : {"left", "right"}
+
+    Returns
+    -------
+    Leaf or None
+        None where the track starts or ends with a constant or a hold (the
+        joint is at rest there, so a junction stays a velocity barrier).
+    """
+    if isinstance(track, Leaf):
+        return track
+    if isinstance(track, Pad):
+        if track.hold_from is not None and (side == "right" or track.hold_from <= 0):
+            return None
+        if side == "right" and track.inner.end != track.end:
+            return None
+        return edge_leaf(track.inner, side)
+    if isinstance(track, Concat):
+        if side == "left":
+            return edge_leaf(track.pieces[0], side)
+        if track.pivots[-1] + track.pieces[-1].end != track.end:
+            return None
+        return edge_leaf(track.pieces[-1], side)
+    if isinstance(track, Repeat):
+        if side == "right" and track.end != (track.n - 1) * track.period + track.inner.end:
+            return None
+        return edge_leaf(track.inner, side)
+    return None
+
+
+def with_edge(track: Track, side: str, edge: Edge) -> Track:
+    """``track`` with the neighbour ``edge`` given to its :func:`edge_leaf` on ``side``.
+
+    Parameters
+    ----------
+    track : Track
+        :func:`edge_leaf` of it on ``side`` is not None.
+    side : {"left", "right"}
+    edge : Edge
+
+    Returns
+    -------
+    Track
+        A repeat is split so that only its first or last copy changes.
+    """
+    if isinstance(track, Leaf):
+        if side == "left":
+            return track.with_edges(edge, track.after)
+        return track.with_edges(track.before, edge)
+    if isinstance(track, Pad):
+        return Pad(with_edge(track.inner, side, edge), track.end, track.hold_from)
+    if isinstance(track, Concat):
+        pieces = list(track.pieces)
+        i = 0 if side == "left" else -1
+        pieces[i] = with_edge(pieces[i], side, edge)
+        return Concat(pieces, track.pivots, track.rights, track.end)
+    if isinstance(track, Repeat):
+        P, n, inner = track.period, track.n, track.inner
+        rest = inner if n == 2 else Repeat(inner, n - 1, P, track.right)
+        if side == "left":
+            return concat(with_edge(inner, side, edge), rest, P, track.right, track.end)
+        return concat(rest, with_edge(inner, side, edge), (n - 1) * P, track.right, track.end)
+    raise TypeError(f"track {type(track).__name__} has no edge leaf")  # pragma: no cover
+
+
+def join_smoothly(first: Track, second: Track, pivot: float) -> tuple[Track, Track]:
+    """Share each joint's velocity across a junction where the poses meet.
+
+    Parameters
+    ----------
+    first, second : Track
+        ``second`` starts at ``pivot``.
+    pivot : float
+
+    Returns
+    -------
+    (Track, Track)
+        Unchanged unless ``first`` ends exactly at ``pivot`` in a leaf whose
+        last value is ``second``'s start value, and ``second`` starts in a
+        leaf: then those two leaves know each other's edge segments.
+    """
+    if first.end != pivot or not np.array_equal(first.end_value, second.start_value):
+        return first, second
+    a, b = edge_leaf(first, "right"), edge_leaf(second, "left")
+    if a is None or b is None:
+        return first, second
+    ea, eb = a._prepare().last, b._prepare().first
+    if ea is None or eb is None or not _changes(ea, eb):
+        return first, second
+    return with_edge(first, "right", eb), with_edge(second, "left", ea)
+
+
+def _changes(left: Edge, right: Edge) -> bool:
+    """True if a smooth junction gives either side another velocity than a barrier does."""
+    v = _edge_velocity(left, right)
+    bar_l = 0.0 if left.kind == _LINEAR else left.w
+    bar_r = 0.0 if right.kind == _LINEAR else right.w
+    return not (np.array_equal(v, np.broadcast_to(bar_l, 3)) and np.array_equal(v, np.broadcast_to(bar_r, 3)))
+
+
+def repeat_smoothly(track: Track, n: int, period: float, end: float | None) -> Track:
+    """``Repeat(track, n, period)``, sharing velocities across junctions of a cycle.
+
+    Parameters
+    ----------
+    track : Track
+    n : int
+        >= 2.
+    period : float
+    end : float or None
+        As for :class:`Repeat`.
+
+    Returns
+    -------
+    Track
+        Where ``track`` ends at ``period`` on its start value (a cycle), the
+        first copy, the middle copies and the last copy each know their
+        neighbours; still lazy (at most three leaf copies).
+    """
+    plain = Repeat(track, n, period, end=end)
+    if track.end != period or not np.array_equal(track.end_value, track.start_value):
+        return plain
+    a, b = edge_leaf(track, "right"), edge_leaf(track, "left")
+    if a is None or b is None:
+        return plain
+    last_seg, first_seg = a._prepare().last, b._prepare().first
+    if last_seg is None or first_seg is None or not _changes(last_seg, first_seg):
+        return plain
+    head = with_edge(track, "right", first_seg)
+    tail = with_edge(track, "left", last_seg)
+    if n == 2:
+        return concat(head, tail, period, end=plain.end)
+    middle = with_edge(head, "left", last_seg)
+    mids = middle if n == 3 else Repeat(middle, n - 2, period)
+    return concat(concat(head, mids, period), tail, (n - 1) * period, end=plain.end)
 
 
 def gap_length(track: Track) -> float:
@@ -952,7 +1180,9 @@ def scale_extremes(track: Track, r: float, memo: dict | None = None) -> Track:
         return out
 
     def leaf(lf: Leaf) -> Leaf:
-        return Leaf(angles(lf.start), lf.frames, angles(lf.values), lf.methods, lf.ramps, lf.right)
+        before = None if lf.before is None else lf.before.angle_scaled(r)
+        after = None if lf.after is None else lf.after.angle_scaled(r)
+        return Leaf(angles(lf.start), lf.frames, angles(lf.values), lf.methods, lf.ramps, lf.right, before, after)
 
     return map_leaves(track, LeafMap(("extremes", r), leaf, angles), memo)
 
@@ -1025,7 +1255,7 @@ def unwrap(track: Track, axes: tuple[bool, bool, bool], memo: dict | None = None
     def leaf(lf: Leaf) -> Leaf:
         values = np.array(lf.values)
         values[:, ax] = unwrap_angles(lf.start[ax], values[:, ax])
-        return Leaf(lf.start, lf.frames, values, lf.methods, lf.ramps, lf.right)
+        return Leaf(lf.start, lf.frames, values, lf.methods, lf.ramps, lf.right, lf.before, lf.after)
 
     # Start values are anchors, and a constant track is nothing but a start value.
     return map_leaves(track, LeafMap(("unwrap", tuple(ax)), leaf, lambda v: v), memo)
@@ -1069,8 +1299,15 @@ class _Emitter:
                 self.add(self.last, self.cur, "LINEAR", RAMP)
             self.add(frame, self.cur, "LINEAR", RAMP)
 
-    def junction(self, frame, start):
-        """A junction of + or *: a step, which also stops the velocity adjustment."""
+    def junction(self, frame, start, smooth: bool = False):
+        """A junction of + or *: a step, which also stops the velocity adjustment.
+
+        A smooth junction (the poses meet and the velocity is shared) is
+        written as a plain keyframe instead: the listing then computes the
+        same shared velocity there.
+        """
+        if smooth and self.last == frame:
+            return
         self.hold_until(frame)
         if not (self._at_step() and np.array_equal(self.cur, start)):
             self.add(frame, start, "LINEAR", RAMP)

@@ -4,10 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from liganimate.runtime import track as tr
 from liganimate.runtime.errors import MotionError
-from liganimate.runtime.motion import Motion, repeat, scale_extremes, scale_frames, strip, synchronize
+from liganimate.runtime.motion import (
+    Motion,
+    repeat,
+    scale_extremes,
+    scale_frames,
+    strip,
+    synchronize,
+)
 
 
 def one(method="LINEAR", start=(0, 0, 0), *keys):
@@ -173,16 +179,38 @@ def test_linear_meets_a_fixed_shape_neighbour_at_its_natural_velocity():
     assert vel(n, 10.0)[0] == pytest.approx(6.0)
 
 
-def test_linear_stops_at_steps_and_at_junctions():
+def test_linear_stops_at_steps_and_at_junctions_where_the_poses_differ():
     a = one("", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"))
-    b = one("", (30, 0, 0), (10.0, (60, 0, 0), "LINEAR"))
-    joined = one("", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"), (20.0, (60, 0, 0), "LINEAR"))
-    assert vel(joined, 10.0)[0] == pytest.approx(3.0)
-    assert vel(a + b, 10.0)[0] == 0  # the adjustment never crosses a junction of +
+    b = one("", (40, 0, 0), (10.0, (60, 0, 0), "LINEAR"))
+    assert vel(a + b, 10.0)[0] == 0  # the adjustment never crosses a junction with a jump
     assert vel(a + b, 10.0 - 1e-9)[0] == pytest.approx(0, abs=1e-6)
-    assert vel(2 * a, 10.0)[0] == 0
+    assert vel(2 * a, 10.0)[0] == 0  # a does not end where it starts
     stepped = one("", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"), (10.0, (30, 0, 0), "LINEAR"), (20.0, (60, 0, 0), "LINEAR"))
     assert vel(stepped, 10.0)[0] == 0
+
+
+def test_a_junction_where_the_poses_meet_passes_through_like_one_keyframe_list():
+    a = one("", (0, 0, 0), (8.0, (80, 0, 0), "LINEAR"))
+    b = one("", (80, 0, 0), (8.0, (160, 0, 0), "LINEAR"))
+    joined = one("", (0, 0, 0), (8.0, (80, 0, 0), "LINEAR"), (16.0, (160, 0, 0), "LINEAR"))
+    t = np.linspace(-1.0, 17.0, 73)
+    np.testing.assert_allclose((a + b).evaluate(t), joined.evaluate(t), atol=1e-12)
+    assert vel(a + b, 8.0)[0] == pytest.approx(10.0)
+    assert vel(a + b, 8.0 - 1e-9)[0] == pytest.approx(10.0, abs=1e-6)
+
+
+def test_a_cycle_repeated_keeps_its_velocity_across_every_junction():
+    cycle = one("", (0, 0, 0), (4.0, (20, 0, 0), "LINEAR"), (8.0, (-20, 0, 0), "LINEAR"), (12.0, (0, 0, 0), "LINEAR"))
+    m = 10 * cycle
+    for k in range(1, 10):
+        assert vel(m, 12.0 * k)[0] == pytest.approx(5.0)
+        assert vel(m, 12.0 * k - 1e-9)[0] == pytest.approx(5.0, abs=1e-6)
+    ref = cycle
+    for _ in range(9):
+        ref = ref + cycle
+    t = np.linspace(-1.0, 121.0, 977)
+    np.testing.assert_allclose(m.evaluate(t), ref.evaluate(t), atol=1e-9)
+    assert vel(m, 0.0)[0] == 0  # the first copy still starts, and the last ends, at rest
 
 
 def test_ramps_stretch_with_scale_frames():
@@ -433,7 +461,7 @@ def clock():
     spec = {}
     for hand in (1, 2):
         keys = []
-        for minute in range(0, 121):
+        for minute in range(121):
             angle = 6.0 * minute if hand == 1 else 30.0 * minute / 60.0
             keys.append((24.0 * minute, (0.0, 0.0, angle % 360.0), "LINEAR"))
         spec[hand] = (keys[0][1], keys[1:])

@@ -166,6 +166,8 @@ def test_concat_plays_b_after_a(a, b):
         xa = a.evaluate(t, [j])[:, 0] if j in a.joints else b.evaluate([-1.0], [j])[:, 0]  # b's start
         a_end = a.evaluate([La + 1e9], [j])[:, 0] if j in a.joints else None
         xb = b.evaluate(t - La, [j])[:, 0] if j in b.joints else a_end
+        if j in a.joints and j in b.joints and np.array_equal(a_end, b.evaluate([-1.0], [j])[:, 0]):
+            continue  # the poses meet: the velocity is shared across the junction (tested elsewhere)
         if j in a.joints and j in b.joints and b.gap(j) > 0:
             # Where b does not drive j yet, j shows the previous driven value: a's end.
             xb = np.where((t - La < b.gap(j))[:, None], a_end, xb)
