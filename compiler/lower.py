@@ -89,11 +89,13 @@ class Lowerer:
     # ------------------------------------------------------------- basics
     def at(self, node) -> int:
         pos = node if isinstance(node, A.Pos) else node.pos
-        key = (pos.line, pos.column, pos.end_line, pos.end_column)
-        if key not in self.pos_index:
-            self.pos_index[key] = len(self.positions)
-            self.positions.append(key)
-        return self.pos_index[key]
+        # A Pos is one int, equal exactly when its four numbers are: the key
+        # costs nothing more (a tuple of four ints took ~130 bytes a position).
+        index = self.pos_index.get(pos)
+        if index is None:
+            index = self.pos_index[pos] = len(self.positions)
+            self.positions.append(pos)
+        return index
 
     def emit(self, text: str) -> None:
         self.lines.append("    " * self.indent + text)
@@ -150,10 +152,11 @@ class Lowerer:
         del self.lines[body_start:]
         if len(self.positions) > CHUNK_STATEMENTS:
             # Packed (see host.Program): a tuple literal this long costs CPython seconds and gigabytes.
-            packed = " ".join(f"{a} {b} {c} {d}" for a, b, c, d in self.positions)
+            packed = " ".join(f"{p.line} {p.column} {p.end_line} {p.end_column}" for p in self.positions)
             positions = [f"_AT = {packed!r}", ""]
         else:
-            positions = ["_AT = ("] + [f"    {p!r}," for p in self.positions] + [")", ""]
+            positions = ["_AT = ("] + [f"    {(p.line, p.column, p.end_line, p.end_column)!r}," for p in self.positions]
+            positions += [")", ""]
         tail = [
             "",
             f"program = _host.Program(_SOURCE_NAME, _AT, _main, {self.source_literal()})",

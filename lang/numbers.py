@@ -107,7 +107,7 @@ def literal(text: str) -> int | float:
         The value, or a :class:`BadInteger` / :class:`BadReal` standing for
         a literal outside the language's numbers (the checker reports it).
     """
-    if any(ch in text for ch in ".eE"):
+    if "." in text or "e" in text or "E" in text:
         value = float(text)  # Python parses any length; overflow gives inf
         if math.isinf(value):
             bad = BadReal(0.0)

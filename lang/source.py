@@ -209,24 +209,36 @@ def decode(data: bytes, filename: str) -> str:
     return text
 
 
+# Lines are what text.split("\n") gives (a "\r" stays in its line); with
+# re.M, ^ and $ are exactly their ends.
+_STAR_FLAG = re.compile(r"^\*", re.MULTILINE)
+_COMMENT_LINE = re.compile(r"^[Cc](?:[ \t\r][^\n]*)?$", re.MULTILINE)
+
+
 def prepare(text: str, filename: str) -> Source:
-    """Blank column-1 ``*`` flags and ``C`` comment lines, keeping positions."""
-    out = []
+    """Blank column-1 ``*`` flags and ``C`` comment lines, keeping positions.
+
+    The whole text is substituted at once: a list of a million lines cost
+    more memory than the program's syntax tree.
+    """
     warnings = []
-    for number, line in enumerate(text.split("\n"), start=1):
-        if line[:1] == "*":
-            line = " " + line[1:]
-        elif line[:1] in ("C", "c") and (len(line) == 1 or line[1] in " \t\r"):
-            if _LOOKS_LIKE_CODE.match(line):
-                warnings.append(Diagnostic(
-                    filename, Pos(number, 1, number, 2),
-                    "this line is a comment: a C in column 1 followed by a blank starts a comment line",
-                    "indent the line if it is a statement about a variable called C",
-                    severity="warning",
-                ))
-            line = ""
-        out.append(line)
-    return Source(filename, text, "\n".join(out), warnings)
+    counted = [1, 0]  # line number at offset: lines are counted only up to a comment that warns
+
+    def blank(match) -> str:
+        if _LOOKS_LIKE_CODE.match(match.group()):
+            counted[0] += text.count("\n", counted[1], match.start())
+            counted[1] = match.start()
+            number = counted[0]
+            warnings.append(Diagnostic(
+                filename, Pos(number, 1, number, 2),
+                "this line is a comment: a C in column 1 followed by a blank starts a comment line",
+                "indent the line if it is a statement about a variable called C",
+                severity="warning",
+            ))
+        return ""
+
+    prepared = _STAR_FLAG.sub(" ", _COMMENT_LINE.sub(blank, text))
+    return Source(filename, text, prepared, warnings)
 
 
 def load(path: str, display_name: str | None = None) -> Source:

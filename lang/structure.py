@@ -17,16 +17,24 @@ from .diagnostics import Diagnostic, LigDiagnostics
 #: Deeper syntax trees are refused with a diagnostic (no RecursionError may escape).
 MAX_DEPTH = 100
 
-_FIELDS: dict = {}
+_FIELDS: dict = {}  # node type -> names of the fields that may hold nodes
+# Field annotations (strings: lang/ast.py postpones them) that never hold a node.
+_SCALAR = {"str", "int", "float", "bool", "Pos", "int | float", "str | None", "int | None", "float | None"}
+
+
+def _node_fields(cls) -> tuple:
+    """Names of the fields of node type ``cls`` that may hold nodes (not ``pos``, not names or numbers)."""
+    names = _FIELDS.get(cls)
+    if names is None:
+        names = _FIELDS[cls] = tuple(f.name for f in dataclasses.fields(cls)
+                                     if f.name != "pos" and getattr(f.type, "__name__", f.type) not in _SCALAR)
+    return names
 
 
 def children(node):
     """Child nodes of ``node`` (through lists and tuples), in source order."""
-    names = _FIELDS.get(type(node))
-    if names is None:
-        names = _FIELDS[type(node)] = [f.name for f in dataclasses.fields(node) if f.name != "pos"]
     out = []
-    for name in names:
+    for name in _node_fields(type(node)):
         _collect(getattr(node, name), out)
     return out
 
@@ -42,6 +50,7 @@ def _collect(value, out):
 def check_depth(roots: list, source) -> None:
     """Refuse trees deeper than MAX_DEPTH, iteratively, pointing at the deepest place."""
     stack = [(node, 1) for node in roots]
+    fields = _FIELDS
     while stack:
         node, depth = stack.pop()
         if depth > MAX_DEPTH:
@@ -51,8 +60,15 @@ def check_depth(roots: list, source) -> None:
                 "split it into several statements with variables in between",
                 source=source.text,
             )])
-        for child in children(node):
-            stack.append((child, depth + 1))
+        names = fields.get(type(node))
+        if names is None:
+            names = _node_fields(type(node))
+        # Most nodes are leaves (names, numbers): they are not walked at all.
+        if names:
+            depth += 1
+            for child in children(node):
+                if depth > MAX_DEPTH or fields.get(type(child)) != ():
+                    stack.append((child, depth))
 
 
 #: Blocks (DO, IF, scenes) nested deeper than this are refused: Python, which
@@ -69,7 +85,7 @@ def group_blocks(body: list, source) -> list:
 
 
 def _check_blocks(body: list, source) -> None:
-    stack = [(s, 1) for s in body]
+    stack = [(s, 1) for s in body if isinstance(s, _BLOCKS)]
     while stack:
         node, depth = stack.pop()
         inner = []
@@ -90,7 +106,11 @@ def _check_blocks(body: list, source) -> None:
                 "move the inner part into a loop of its own or a PRIMITIVE",
                 source=source.text,
             )])
-        stack.extend((s, depth + 1) for s in inner)
+        stack.extend((s, depth + 1) for s in inner if isinstance(s, _BLOCKS))
+
+
+_BLOCKS = (A.Do, A.If, A.Scene, A.PrimitiveDef)  # statements that hold statements
+_INNER = (A.If, A.Scene, A.PrimitiveDef)  # ... before DO loops are grouped
 
 
 def _group_list(stmts: list, source) -> list:
@@ -98,7 +118,8 @@ def _group_list(stmts: list, source) -> list:
     open_dos: list = []  # (header, index in out where its body starts)
     closed: dict = {}  # label -> (DO line, CONTINUE line) of the last loop it closed, for hints
     for stmt in stmts:
-        _group_inner(stmt, source)
+        if isinstance(stmt, _INNER):
+            _group_inner(stmt, source)
         if isinstance(stmt, A.DoHeader):
             open_dos.append((stmt, len(out)))
             continue
