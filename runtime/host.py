@@ -562,7 +562,14 @@ class Runtime(Arithmetic):
         frame = float(t - start)
         if repeat:
             length = motion.length
-            frame = math.fmod(frame, length) if length > 0 else 0.0
+            if length > 0:
+                # Played as n * motion (n copies cover the whole range), not as
+                # frame MOD length: the poses are the same, but a cycle then keeps
+                # its velocity across each junction instead of restarting from rest.
+                copies = int((end - start) // length) + 1
+                motion = self._guard(at, M.repeat, copies, motion)
+            else:
+                frame = 0.0
         if self.mode == "check":
             self._bind(fig, motion, at)
         return Posed(fig, motion, frame, at)
