@@ -220,3 +220,60 @@ def test_positions_are_immutable_values():
     assert copy.deepcopy(p) == p and type(copy.deepcopy(p)) is Pos
     assert pickle.loads(pickle.dumps(p)) == p
     assert {p: 1}[Pos(7, 3, 9, 12)] == 1
+
+
+# ------------------------------------------------------------ whole check
+
+def test_checking_a_big_program_stays_under_a_memory_limit(tmp_path):
+    # `liganimate check` of 200,000 short lines (issue 14: memory a small
+    # multiple of the source) in a fresh process whose address space may
+    # grow by at most 250 MB once everything is imported. Measured: about
+    # 130 MB; compiling the main program as one function, with the syntax
+    # tree still alive and the positions as a tuple literal, took about 400.
+    src = tmp_path / "big.lig"
+    src.write_text("X = 1\n" * 200_000)
+    code = textwrap.dedent(f"""
+        import io, resource
+        from liganimate.compiler import load_program
+        program, _ = load_program({str(tmp_path / "small.lig")!r})
+        program.check()
+        with open("/proc/self/statm") as fh:
+            size = int(fh.read().split()[0]) * resource.getpagesize()
+        resource.setrlimit(resource.RLIMIT_AS, (size + (250 << 20), resource.RLIM_INFINITY))
+        program, warnings = load_program({str(src)!r})
+        rt = program.execute("check", stdout=io.StringIO())
+        print(rt.variables["X"], sorted(rt.variables))
+    """)
+    (tmp_path / "small.lig").write_text("X = 1\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.strip() == "1 ['X']"
+
+
+def test_prepare_blanks_comments_and_flags_as_line_by_line(tmp_path):
+    # prepare() substitutes the whole text at once; it must give what the
+    # line-by-line rule gives (column-1 * becomes a blank; a C or c line
+    # followed by a blank, a tab, a carriage return or nothing is emptied,
+    # with a warning when it looks like code) for any text.
+    import random
+
+    from liganimate.lang.source import _LOOKS_LIKE_CODE, prepare
+
+    def by_lines(text):
+        out, warned = [], []
+        for number, line in enumerate(text.split("\n"), start=1):
+            if line[:1] == "*":
+                line = " " + line[1:]
+            elif line[:1] in ("C", "c") and (len(line) == 1 or line[1] in " \t\r"):
+                if _LOOKS_LIKE_CODE.match(line):
+                    warned.append(number)
+                line = ""
+            out.append(line)
+        return "\n".join(out), warned
+
+    rng = random.Random(14)
+    pieces = ["C", "c", "*", " ", "\t", "\r", "\n", "=", ":-", "X", "[", "1", "é", "\n\n", "C =", "c\r\n"]
+    for _ in range(5000):
+        text = "".join(rng.choice(pieces) for _ in range(rng.randint(0, 25)))
+        source = prepare(text, "t.lig")
+        assert (source.lexed, [w.pos.line for w in source.warnings]) == by_lines(text), repr(text)
