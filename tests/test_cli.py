@@ -130,3 +130,20 @@ def test_print_labels_whole_calls_and_nint_rounds_like_fortran(tmp_path):
     assert r.returncode == 0, r.stderr
     assert r.stdout.splitlines() == ["MOD(-7, 3) = 2", "NINT(-2.5) = -3", "NINT(2.5) = 3", "NINT(-2.4) = -2",
                                      "MAX(ABS(-2), 1) = 2"]
+
+
+def test_command_line_errors_escape_control_characters_in_paths(tmp_path):
+    # An OSError path and a LigError message can quote a file name the user
+    # (or an attacker) chose; a raw ESC would drive the terminal.
+    r = run("check", "missing\x1b[31mred.lig", cwd=tmp_path)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert "\x1b" not in r.stderr and "missing\\x1b[31mred.lig" in r.stderr
+    r = run("run", str(EXAMPLES / "appendix_a.lig"), "--gif", "no\x1bdir/x.gif", cwd=tmp_path)
+    assert r.returncode == 1 and "\x1b" not in r.stderr and "no\\x1bdir" in r.stderr
+
+
+@pytest.mark.parametrize("command", ["export", "import", "view", "studio"])
+def test_every_tool_is_a_subcommand_of_liganimate(command):
+    r = run(command, "--help")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith(f"usage: liganimate {command}")

@@ -103,6 +103,7 @@ def _guarded(fn):
     goes through, to :func:`_stopping`.
     """
     from liganimate.lang.diagnostics import LigDiagnostics
+    from liganimate.lang.display import escape_text
     from liganimate.runtime.errors import LigError
     from liganimate.runtime.imagefiles import os_error_words
 
@@ -112,9 +113,11 @@ def _guarded(fn):
         _print_diagnostics(exc.diagnostics)
         return EXIT_USER_ERROR
     except LigError as exc:
-        sys.stderr.write(f"liganimate: error: {exc.message}\n")
+        # Messages can quote program-derived text (names, paths): escaped like
+        # every diagnostic, so no control sequence reaches the terminal.
+        sys.stderr.write(f"liganimate: error: {escape_text(exc.message)}\n")
         if exc.hint:
-            sys.stderr.write(f"  hint: {exc.hint}\n")
+            sys.stderr.write(f"  hint: {escape_text(exc.hint)}\n")
         return EXIT_USER_ERROR
     except BrokenPipeError:
         # The reader went away (liganimate lib | head): not an error of ours.
@@ -123,8 +126,8 @@ def _guarded(fn):
         os.dup2(devnull, sys.stdout.fileno())
         return 0
     except OSError as exc:
-        where = f": {exc.filename}" if exc.filename else ""
-        sys.stderr.write(f"liganimate: error: {os_error_words(exc)}{where}\n")
+        where = f": {escape_text(str(exc.filename))}" if exc.filename else ""
+        sys.stderr.write(f"liganimate: error: {escape_text(os_error_words(exc))}{where}\n")
         return EXIT_USER_ERROR
     except RecursionError:
         sys.stderr.write("liganimate: error: the program is nested too deeply to compile\n")
@@ -291,6 +294,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("motion")
     p.add_argument("-o", "--output", metavar="FILE.png")
     p.set_defaults(func=cmd_plot)
+    # Export/import and the browser tools register their own subcommands.
+    from liganimate import exchange_cli, view_cli
+
+    exchange_cli.add_commands(sub)
+    view_cli.add_commands(sub)
     return parser
 
 
