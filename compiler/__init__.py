@@ -36,12 +36,14 @@ class NotParsed(LigDiagnostics):
 
 
 def compile_source(source: Source, module_name: str | None = None, *, path: str | None = None,
-                   stack: tuple = ()) -> Compiled:
+                   stack: tuple = (), consume: bool = False) -> Compiled:
     """Parse, check and lower a prepared source.
 
     ``path`` is the file the source came from: relative LOADs start there
     (default: the current folder). ``stack`` is the chain of libraries being
-    loaded around this one (see :mod:`.library`).
+    loaded around this one (see :mod:`.library`). ``consume=True`` takes the
+    syntax tree apart while lowering (see :func:`.lower.lower`): only for a
+    caller that drops ``Compiled.checked``.
 
     Raises
     ------
@@ -57,7 +59,7 @@ def compile_source(source: Source, module_name: str | None = None, *, path: str 
     except LigDiagnostics as exc:
         raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
     checked = check(program, path=path, stack=stack)
-    python = lower(checked, module_name or source.filename)
+    python = lower(checked, module_name or source.filename, consume)
     return Compiled(python, list(source.warnings) + checked.warnings, checked)
 
 
@@ -77,7 +79,7 @@ def compile_for_run(path: str) -> tuple:
     Unlike :func:`compile_file` it keeps no syntax tree (``Compiled.checked``),
     so the tree's memory is free again before CPython compiles the module.
     """
-    compiled = compile_file(path)
+    compiled = compile_source(load(path), path=path, consume=True)
     return compiled.python, compiled.warnings
 
 

@@ -74,6 +74,7 @@ class Lowerer:
         self.pos_index: dict = {}
         self.indent = 0
         self.doc_name = module_doc_name
+        self.consume = False  # see lower()
         self.canvas = None
         self.tmp = 0
         # > 0 inside code that runs many times (DO bodies, scene bodies,
@@ -180,26 +181,32 @@ class Lowerer:
         chunks, start = [], len(self.lines)
         self.indent += 1
         inits = [f"{name} = {_ZERO[t]}" for name, t in sorted(self.c.main.types.items())]
-        for item in inits + list(body):
-            if isinstance(item, str):
-                self.emit(item)
-            else:
-                getattr(self, "s_" + type(item).__name__)(item, "main")
-            if len(self.lines) - start >= CHUNK_LINES:
-                chunks.append(self.lines[start:])
+
+        def cut(least: int) -> None:
+            if len(self.lines) - start >= least:
+                # Kept as one string: a million lines cost ~60 bytes each as separate strings.
+                chunks.append("\n".join(self.lines[start:]))
                 del self.lines[start:]
-        if len(self.lines) > start:
-            chunks.append(self.lines[start:])
-            del self.lines[start:]
+
+        for item in inits:
+            self.emit(item)
+            cut(CHUNK_LINES)
+        for i, stmt in enumerate(body):
+            getattr(self, "s_" + type(stmt).__name__)(stmt, "main")
+            if self.consume:
+                body[i] = stmt = None  # lowered: its part of the tree can go now
+            cut(CHUNK_LINES)
+        cut(1)
         self.indent -= 1
-        for k, lines in enumerate(chunks):
+        for k, text in enumerate(chunks):
             self.emit(f"def _main_{k}(rt):")
             # Every upper-case word of the chunk that is a variable: a chunk
             # that assigns one without `global` would make it its own local.
-            names = set(_WORD.findall("\n".join(lines))) & self.main_names
+            names = set(_WORD.findall(text)) & self.main_names
             if names:
                 self.emit(f"    global {', '.join(sorted(names))}")
-            self.lines.extend(lines)
+            self.lines.append(text)
+            chunks[k] = None
             self.emit("")
         self.emit("def _main(rt):")
         self.emit("    " + repr(f"The main program of {self.doc_name}."))
@@ -268,6 +275,8 @@ class Lowerer:
         scope_t = self.var_type(target)
         if scope_t == T.REAL and self.type_of(s.value) == T.INTEGER:
             value = _as_real(s.value, value)
+        if scope_t == T.GRAPHICAL and self.type_of(s.value) == T.MODEL:
+            value = f"rt.as_graphical({value}, {self.at(s.value)})"
         self.emit(f"{target} = {value}")
 
     def var_type(self, name: str):
@@ -513,6 +522,9 @@ class Lowerer:
         if e.op == "+" and self.type_of(e.left) == T.MOTION:
             return self._motion_sum(e)
         left, right = self.expr(e.left), self.expr(e.right)
+        if e.op == "+" and t == T.GRAPHICAL:
+            # Superposition checks the triangle limit; an animated model is drawn in its pose.
+            return f"rt.superpose({left}, {right}, {self.at(e)})"
         if e.op == "/":
             return f"rt.div({left}, {right}, {self.at(e.op_pos)})"
         if e.op == "MOD":
@@ -673,6 +685,13 @@ def _source_text(source: str, pos: A.Pos) -> str:
     return "value"
 
 
-def lower(checked: Checked, name: str) -> str:
-    """Return the Python source of the module for a checked program."""
-    return Lowerer(checked, name).module()
+def lower(checked: Checked, name: str, consume: bool = False) -> str:
+    """Return the Python source of the module for a checked program.
+
+    ``consume=True`` (for a caller that drops ``checked`` at once) lets a
+    big main program's statements go as they are lowered, so that the
+    syntax tree and the module text are not both whole at the same time.
+    """
+    lowerer = Lowerer(checked, name)
+    lowerer.consume = consume
+    return lowerer.module()
