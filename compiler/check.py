@@ -353,9 +353,22 @@ class Checker:
         if name in self.scope.implicit and current == T.INTEGER and value_type == T.REAL:
             self.scope.types[name] = T.REAL
             return
+        if current == T.GRAPHICAL and value_type == T.MODEL and self._animated_here(value_node):
+            return  # §5.1: after ANIMATE, the model is also a graphical object (its pose this tick)
         if not T.fits(current, value_type):
             hint = "use INT(...) or NINT(...) to make an INTEGER" if current == T.INTEGER and value_type == T.REAL else None
             self.err(value_node, f"{name} is {T.NOUN[current]}, so it cannot hold {T.NOUN[value_type]}", hint)
+
+    def _animated_here(self, node) -> bool:
+        """True if ``node`` names (possibly modified) a model already ANIMATEd in this scene body.
+
+        The thesis, §5.1: after ANIMATE "a graphical object of the name
+        'model_name' is available"; it is the model in the current tick's pose.
+        """
+        while isinstance(node, A.Modified):
+            node = node.target
+        return (self.scene is not None and isinstance(node, A.Var)
+                and node.name in self.scene.animated)
 
     def _s_Assign(self, s, context):
         if s.target.name in self.signatures:
@@ -753,6 +766,9 @@ class Checker:
                 return T.VECTOR
             if op == "+" and lt == rt == T.GRAPHICAL:
                 return T.GRAPHICAL
+            if op == "+" and {lt, rt} <= {T.GRAPHICAL, T.MODEL} and all(
+                    t == T.GRAPHICAL or self._animated_here(side) for t, side in ((lt, e.left), (rt, e.right))):
+                return T.GRAPHICAL  # an animated model drawn in this tick's pose
             if op == "+" and lt == rt == T.MOTION:
                 return T.MOTION
             if op == "+" and lt == rt == T.MODEL:

@@ -23,6 +23,7 @@ from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 from . import figure as F
 from . import limits
 from . import motion as M
+from . import pose as P
 from .arithmetic import Arithmetic
 from .errors import LigError
 from .library import Library  # noqa: F401  (generated modules name it _host.Library)
@@ -96,9 +97,13 @@ class Program:
             self._positions = tuple(zip(numbers, numbers, numbers, numbers))
         return self._positions
 
-    def execute(self, mode: str = "check", renderer=None, stdout=None) -> Runtime:
-        """Run the program; return the runtime, whose ``variables`` hold its final values."""
+    def execute(self, mode: str = "check", renderer=None, stdout=None, echo_print: bool = False) -> Runtime:
+        """Run the program; return the runtime, whose ``variables`` hold its final values.
+
+        In ``"check"`` mode PRINT only checks its items unless ``echo_print``.
+        """
         rt = Runtime(self, mode, renderer, stdout)
+        rt.echo_print = echo_print
         try:
             rt.variables = self.main(rt) or {}
         except _StopProgram:
@@ -110,9 +115,24 @@ class Program:
 
         return rt
 
-    def check(self) -> list:
-        """Run every statement and every scene tick without drawing; return the warnings."""
-        return self.execute("check", stdout=io.StringIO()).warnings
+    def check(self, stdout=None) -> list:
+        """Run every statement and every scene tick without drawing; return the warnings.
+
+        Parameters
+        ----------
+        stdout : text stream, optional
+            Where PRINT writes, as the thesis' preprocessor printed its
+            tables when it read the program (``liganimate check`` passes
+            ``sys.stdout``). By default PRINT output is dropped, so a caller
+            that checks and then renders (``run``) prints it only once.
+
+        Returns
+        -------
+        list of Diagnostic
+        """
+        if stdout is None:
+            return self.execute("check", stdout=io.StringIO()).warnings
+        return self.execute("check", stdout=stdout, echo_print=True).warnings
 
     def render(self, out_dir: str, checked: bool = False, **options) -> Runtime:
         """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`).
@@ -169,6 +189,7 @@ class Runtime(Arithmetic):
         self.view_width = 10.0
         self.variables: dict = {}
         self._bind_cache: dict = {}
+        self.echo_print = False
 
     # ---------------------------------------------------------- diagnostics
     def pos(self, at: int) -> Pos:
@@ -216,9 +237,23 @@ class Runtime(Arithmetic):
         """DRAW POLY inside a PRIMITIVE."""
         self._guard(at, canvas.poly, points)
 
-    @staticmethod
-    def superpose(a: Graphical, b: Graphical) -> Graphical:
-        return a + b
+    def superpose(self, a, b, at=None) -> Graphical:
+        """``a + b`` of graphical objects (either may be an ANIMATEd model, drawn in its pose)."""
+        return self._guard(at, Graphical.__add__, self.as_graphical(a, at), self.as_graphical(b, at))
+
+    def as_graphical(self, value, at) -> Graphical:
+        """A graphical object, or a model as a graphical object (thesis §5.1).
+
+        An ANIMATEd model is drawn in its pose of the current tick, at its
+        placement; any other model in its neutral pose.
+        """
+        if value is None:
+            self.fail(at, "a graphical object is used before it has a value")
+        if isinstance(value, Posed):
+            return self._guard(at, P.posed_graphical, value.figure, value.motion, value.frame)
+        if isinstance(value, F.Figure):
+            return self._guard(at, P.posed_graphical, value, None, 0.0)
+        return value
 
     def modify_graphical(self, g: Graphical, mods, at) -> Graphical:
         for kind, arg, axis in mods:
@@ -590,7 +625,7 @@ class Runtime(Arithmetic):
         for item in items:
             if item is None:
                 self.fail(at, "a background object is used before it has a value")
-            out.append(item.figure if isinstance(item, Posed) else item)
+            out.append(self.as_graphical(item, at) if isinstance(item, Posed) else item)
         if self.scene is not None:
             self.scene.background = out
 
@@ -610,7 +645,7 @@ class Runtime(Arithmetic):
 
     # --------------------------------------------------------------- PRINT
     def print_items(self, items, at):
-        if self.mode == "check":
+        if self.mode == "check" and not self.echo_print:
             # Nothing is written, but whatever could fail when it is (a model
             # without a value, a motion whose keyframes do not fit) fails now.
             for kind, value, label in items:

@@ -114,16 +114,18 @@ class MeshTable:
         if tris:
             self.triangles = np.concatenate(tris)
             self.link = np.concatenate(link)
-            self.grey = grey_levels(np.concatenate(light))
+            self.lightness = np.concatenate(light)
+            self.grey = grey_levels(self.lightness)
             self.closed = np.concatenate(closed)
         else:
             self.triangles = np.zeros((0, 3, 3))
             self.link = np.zeros(0, dtype=int)
+            self.lightness = np.zeros(0)
             self.grey = np.zeros(0, dtype=np.uint8)
             self.closed = np.zeros(0, dtype=bool)
 
 
-_meshes: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_meshes: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def mesh_table(fig: F.Figure) -> MeshTable:
@@ -181,3 +183,31 @@ def static_triangles(fig: F.Figure):
     X = world_transforms(fig, angles, np.asarray(fig.placement)[None])
     table = mesh_table(fig)
     return world_triangles(table, X)[0], table.grey, table.closed & (np.linalg.det(np.asarray(fig.placement)[:3, :3]) > 0)
+
+
+def posed_graphical(fig: F.Figure, motion: Motion | None, frame: float) -> Graphical:
+    """A model as a graphical object: its triangles in one pose, at its placement.
+
+    Parameters
+    ----------
+    fig : Figure
+    motion : Motion or None
+        None for the neutral pose.
+    frame : float
+        Frame of ``motion`` (clamped angles, as the renderer draws them).
+
+    Returns
+    -------
+    Graphical
+        World-space triangles (M, 3, 3); closed only where the placement does
+        not mirror (the winding is then still outward).
+    """
+    placement = np.asarray(fig.placement, dtype=np.float64)
+    if motion is None:
+        angles = K.clamp(fig, np.zeros((1, fig.n_joints, 3)))
+    else:
+        angles = joint_angles(fig, motion, np.array([float(frame)]))
+    X = world_transforms(fig, angles, placement[None])
+    table = mesh_table(fig)
+    closed = table.closed & (np.linalg.det(placement[:3, :3]) > 0)
+    return Graphical(world_triangles(table, X)[0], table.lightness, closed)

@@ -84,6 +84,15 @@ class Graphical:
         return len(self.triangles)
 
     def __add__(self, other: Graphical) -> Graphical:
+        """Superposition: both objects' triangles.
+
+        Raises
+        ------
+        LigError
+            If the result would exceed :data:`MAX_TRIANGLES` (checked before
+            anything is allocated, so ``G = G + G`` in a loop fails cleanly).
+        """
+        check_triangles(len(self) + len(other), "the superposed object")
         return Graphical(
             np.concatenate([self.triangles, other.triangles]),
             np.concatenate([self.lightness, other.lightness]),
@@ -112,12 +121,33 @@ def grey_levels(lightness) -> np.ndarray:
     return np.floor(l * 2.55 + 0.5).astype(np.uint8)
 
 
+MAX_TRIANGLES = 10_000_000
+"""Most triangles one graphical object may hold (about 720 MB of vertices)."""
+
+_MANY_HINT = "build the object from fewer or simpler pieces (each doubling G = G + G doubles its triangles)"
+
+
+def check_triangles(n: int, what: str) -> None:
+    """LigError if ``n`` triangles exceed :data:`MAX_TRIANGLES`.
+
+    Parameters
+    ----------
+    n : int
+    what : str
+        Names the object in the message.
+    """
+    if n > MAX_TRIANGLES:
+        raise LigError(f"{what} would have {n:,} triangles, beyond the limit of {MAX_TRIANGLES:,} "
+                       f"for one graphical object", _MANY_HINT)
+
+
 class Canvas:
     """What a PRIMITIVE draws into: DRAW WITH <LIGHTNESS l> and DRAW POLY."""
 
     def __init__(self):
         self.polys: list = []
         self.light = 40.0
+        self.triangles = 0
 
     def lightness(self, value) -> None:
         """Set the lightness of the polygons drawn next (clipped to 0..100 when drawn)."""
@@ -141,6 +171,8 @@ class Canvas:
         if not far <= GEOMETRY_MAX:
             raise LigError(f"this polygon has a corner {magnitude(far)} units along an axis, beyond the limit of "
                            f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
+        self.triangles += len(pts) - 2
+        check_triangles(self.triangles, "the primitive's drawing")
         self.polys.append((np.asarray(pts, dtype=np.float64), self.light))
 
     def result(self) -> Graphical:
