@@ -1,0 +1,152 @@
+"""Foot-skate benchmark: how far a planted foot slides, per library locomotion motion.
+
+For each locomotion motion of the standard library (humanoid WALK and RUN),
+the HUMANOID is posed at every frame of two cycles, exactly as
+``liganimate run --poses`` poses it (clamped angles, world link
+transforms), and moved along +X at the body speed of the scene-level
+translation the examples use (``<TRANS (v * T, 0, 0)>``). For each foot:
+
+* *planted* frames are those whose sole (the foot mesh's lowest vertex) is
+  within 1 cm of that foot's lowest height over the cycles;
+* the *slide* is the horizontal distance the foot's contact point (the
+  lowest vertex) and its ankle (the foot link's origin) travel between two
+  consecutive planted frames, in millimetres per frame.
+
+Reported per motion: the documented body speed, the worst contact and
+ankle slide at that speed, the body speed that would minimise the slide
+(the median backward speed of the planted foot), the worst slide there,
+and how many frames in a row a foot rests. The issue's target is at most
+1 mm a frame. The last line printed is one JSON object with the figures.
+
+Usage: ``python benchmarks/foot_skate.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+
+import numpy as np
+from liganimate.runtime.host import Posed
+from liganimate.runtime.pose import (
+    joint_angles,
+    mesh_table,
+    world_transforms,
+    world_triangles,
+)
+
+from liganimate.cli import load_program
+
+# Body speed (metres a frame) of the scene-level translation for each motion:
+# WALK, 1.2 m per 24-frame cycle (examples/walk_and_wave.lig moves 0.05 a tick);
+# RUN, "about 2.2 m" per 16-frame cycle (stdlib/humanoid.lig).
+SPEEDS = {"WALK": 1.2 / 24.0, "RUN": 2.2 / 16.0}
+PLANTED = 0.01  # metres above the foot's lowest height
+
+
+def load():
+    """The HUMANOID figure and its locomotion motions, as a program loading them sees them."""
+    folder = tempfile.mkdtemp(prefix="foot-skate-")
+    path = os.path.join(folder, "load.lig")
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write("      LOAD HUMANOID, WALK, RUN FROM 'humanoid'\n      END\n")
+    program, _ = load_program(path)
+    rt = program.execute("check")
+    fig = rt.variables["HUMANOID"]
+    fig = fig.figure if isinstance(fig, Posed) else fig
+    return fig, {name: rt._motion(rt.variables[name], 0) for name in SPEEDS}
+
+
+def feet(fig, motion, speed):
+    """Per foot over two cycles, moved at ``speed``: (contact, next, ankle), each (T, 3).
+
+    ``contact[t]`` is the foot's lowest vertex at frame t and ``next[t]`` the
+    same vertex one frame later (the last row repeats), so a slide is
+    measured on one material point, not on whichever vertex is lowest.
+    """
+    frames = np.arange(0.0, 2.0 * motion.length + 1.0)
+    angles = joint_angles(fig, motion, frames)
+    placement = np.repeat(np.asarray(fig.placement, dtype=np.float64)[None], len(frames), axis=0)
+    placement[:, 0, 3] += speed * frames
+    X = world_transforms(fig, angles, placement)
+    table = mesh_table(fig)
+    tris = world_triangles(table, X)  # (T, M, 3, 3)
+    out = {}
+    for name in ("R_FOOT", "L_FOOT"):
+        link = fig.links_named(name)[0]
+        verts = tris[:, table.link == link].reshape(len(frames), -1, 3)
+        low = np.argmin(verts[:, :, 1], axis=1)
+        rows = np.arange(len(frames))
+        later = np.minimum(rows + 1, len(frames) - 1)
+        out[name] = (verts[rows, low], verts[later, low], X[:, link, :3, 3])
+    return out
+
+
+def slide(points, later, planted) -> float:
+    """Largest horizontal step (mm/frame) from a planted frame to the next planted one (0 if none).
+
+    ``later[t]`` is where the point of ``points[t]`` is at frame t + 1.
+    """
+    both = planted[1:] & planted[:-1]
+    if not both.any():
+        return 0.0
+    step = np.linalg.norm((later[:-1] - points[:-1])[:, [0, 2]], axis=1)
+    return float(step[both].max() * 1000.0)
+
+
+def longest_rest(planted) -> int:
+    """Most consecutive planted frames."""
+    best = run = 0
+    for p in planted:
+        run = run + 1 if p else 0
+        best = max(best, run)
+    return best
+
+
+def measure(fig, motion, speed) -> dict:
+    contact = ankle = 0.0
+    rests = []
+    for pts, nxt, ank in feet(fig, motion, speed).values():
+        planted = pts[:, 1] <= pts[:, 1].min() + PLANTED
+        contact = max(contact, slide(pts, nxt, planted))
+        ank_next = np.concatenate([ank[1:], ank[-1:]])
+        ankle = max(ankle, slide(ank, ank_next, planted))
+        rests.append(longest_rest(planted))
+    return {"contact_mm": round(contact, 2), "ankle_mm": round(ankle, 2), "rest_frames": min(rests)}
+
+
+def best_speed(fig, motion) -> float:
+    """The body speed under which the planted feet move least: their median backward speed."""
+    v = []
+    for pts, nxt, _ in feet(fig, motion, 0.0).values():
+        planted = pts[:, 1] <= pts[:, 1].min() + PLANTED
+        both = planted[1:] & planted[:-1]
+        v.extend((-(nxt[:-1, 0] - pts[:-1, 0]))[both])
+    return float(np.median(v)) if v else 0.0
+
+
+def main() -> None:
+    fig, motions = load()
+    report = {}
+    for name, motion in motions.items():
+        at = measure(fig, motion, SPEEDS[name])
+        v = best_speed(fig, motion)
+        best = measure(fig, motion, v)
+        report[name] = {"speed": round(SPEEDS[name], 4), **at, "best_speed": round(v, 4),
+                        "best_contact_mm": best["contact_mm"], "best_ankle_mm": best["ankle_mm"]}
+        print(f"{name:5s} at {SPEEDS[name] * 1000:6.1f} mm/frame: planted foot slides up to "
+              f"{at['contact_mm']:6.2f} mm/frame at the sole, {at['ankle_mm']:6.2f} at the ankle; "
+              f"rests {at['rest_frames']} frames in a row; best body speed {v * 1000:6.1f} mm/frame "
+              f"-> {best['contact_mm']:6.2f} / {best['ankle_mm']:6.2f} mm/frame")
+    worst = max(max(r["contact_mm"], r["ankle_mm"]) for r in report.values())
+    never = [n for n, r in report.items() if r["rest_frames"] < 2]
+    met = worst <= 1.0 and not never
+    print(f"target: at most 1 mm/frame; worst now {worst:.2f}"
+          + (f"; no foot rests two frames in {', '.join(never)}" if never else "")
+          + f" ({'met' if met else 'not met'})")
+    print(json.dumps({"motions": report, "worst_mm": worst, "met": met}))
+
+
+if __name__ == "__main__":
+    main()
