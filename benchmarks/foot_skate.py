@@ -6,8 +6,8 @@ the HUMANOID is posed at every frame of two cycles, exactly as
 transforms), and moved along +X at the body speed of the scene-level
 translation the examples use (``<TRANS (v * T, 0, 0)>``). For each foot:
 
-* *planted* frames are those whose sole (the foot mesh's lowest vertex) is
-  within 1 cm of that foot's lowest height over the cycles;
+* *planted* frames are those whose ankle (the foot link's origin) is
+  within 1 cm of its lowest height over the cycles, as issue 9 measured;
 * the *slide* is the horizontal distance the foot's contact point (the
   lowest vertex) and its ankle (the foot link's origin) travel between two
   consecutive planted frames, in millimetres per frame.
@@ -42,7 +42,7 @@ from liganimate.cli import load_program
 # WALK, 1.2 m per 24-frame cycle (examples/walk_and_wave.lig moves 0.05 a tick);
 # RUN, "about 2.2 m" per 16-frame cycle (stdlib/humanoid.lig).
 SPEEDS = {"WALK": 1.2 / 24.0, "RUN": 2.2 / 16.0}
-PLANTED = 0.01  # metres above the foot's lowest height
+PLANTED = 0.01  # metres above the ankle's lowest height
 
 
 def load():
@@ -108,7 +108,7 @@ def measure(fig, motion, speed) -> dict:
     contact = ankle = 0.0
     rests = []
     for pts, nxt, ank in feet(fig, motion, speed).values():
-        planted = pts[:, 1] <= pts[:, 1].min() + PLANTED
+        planted = ank[:, 1] <= ank[:, 1].min() + PLANTED
         contact = max(contact, slide(pts, nxt, planted))
         ank_next = np.concatenate([ank[1:], ank[-1:]])
         ankle = max(ankle, slide(ank, ank_next, planted))
@@ -119,8 +119,8 @@ def measure(fig, motion, speed) -> dict:
 def best_speed(fig, motion) -> float:
     """The body speed under which the planted feet move least: their median backward speed."""
     v = []
-    for pts, nxt, _ in feet(fig, motion, 0.0).values():
-        planted = pts[:, 1] <= pts[:, 1].min() + PLANTED
+    for pts, nxt, ank in feet(fig, motion, 0.0).values():
+        planted = ank[:, 1] <= ank[:, 1].min() + PLANTED
         both = planted[1:] & planted[:-1]
         v.extend((-(nxt[:-1, 0] - pts[:-1, 0]))[both])
     return float(np.median(v)) if v else 0.0
