@@ -147,3 +147,18 @@ def test_every_tool_is_a_subcommand_of_liganimate(command):
     r = run(command, "--help")
     assert r.returncode == 0, r.stderr
     assert r.stdout.startswith(f"usage: liganimate {command}")
+
+
+def test_names_a_library_may_define_exclude_every_grammar_keyword():
+    # Library writers (import, the studio's Save) ask compiler.names; its
+    # keywords come from the grammar's own terminals, so a keyword added to
+    # lig.lark can never become a generated MODEL or MOTION name.
+    from liganimate.compiler.names import definable, reserved
+
+    for word in ("STARTMOTION", "ENDMOTION", "SYNCHRONISE", "FRAMES", "SIN", "BOX", "HEIGHT"):
+        assert word in reserved() and not definable(word.lower())
+    # REACH's words are keywords only where no assignment follows: definable.
+    assert "MOVE" in reserved() and definable("Move") and definable("endreach")
+    assert definable("walk_2") and not definable("2walk") and not definable("a-b")
+    r = run("import", "nothing.bvh", "--model", "animate")
+    assert r.returncode == 2 and "not a LIG name" in r.stderr

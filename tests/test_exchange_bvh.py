@@ -47,7 +47,7 @@ REROOTED = """\
 
 
 def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "liganimate.exchange_cli", *args], check=False,
+    return subprocess.run([sys.executable, "-m", "liganimate", *args], check=False,
                           capture_output=True, text=True)
 
 

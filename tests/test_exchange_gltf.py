@@ -219,7 +219,7 @@ def test_a_sheared_placement_is_refused_and_nothing_written(tmp_path):
     src = tmp_path / "shear.lig"
     src.write_text(text)
     out = tmp_path / "shear.glb"
-    r = subprocess.run([sys.executable, "-m", "liganimate.exchange_cli", "export", str(src), "-o", str(out)],
+    r = subprocess.run([sys.executable, "-m", "liganimate", "export", str(src), "-o", str(out)],
                        check=False, capture_output=True, text=True)
     assert r.returncode == 1
     assert "shear" in r.stderr and "Traceback" not in r.stderr
@@ -231,7 +231,7 @@ def test_cli_export_writes_a_valid_glb(tmp_path):
     src = tmp_path / "walk.lig"
     src.write_text(WALKING_HUMANOID)
     out = tmp_path / "film.glb"
-    r = subprocess.run([sys.executable, "-m", "liganimate.exchange_cli", "export", str(src), "-o", str(out),
+    r = subprocess.run([sys.executable, "-m", "liganimate", "export", str(src), "-o", str(out),
                         "--fps", "30"], check=False, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     doc, blob = load_gltf(str(out))

@@ -116,7 +116,7 @@ def test_write_files_is_all_or_nothing(tmp_path):
 
 
 def _cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "liganimate.exchange_cli", *args], check=False,
+    return subprocess.run([sys.executable, "-m", "liganimate", *args], check=False,
                           capture_output=True, text=True, cwd=cwd)
 
 

@@ -196,7 +196,7 @@ def test_other_methods_hosts_and_origins(server):
 def test_the_command_prints_its_port_and_serves(tmp_path):
     env = dict(os.environ)
     save = tmp_path / "mine.lig"
-    cmd = [sys.executable, "-m", "liganimate.view_cli", "studio", "--no-browser", "--seed", "77", "--save", str(save)]
+    cmd = [sys.executable, "-m", "liganimate", "studio", "--no-browser", "--seed", "77", "--save", str(save)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         lines = []
@@ -231,7 +231,7 @@ def test_the_command_prints_its_port_and_serves(tmp_path):
     (["--save", "/no/such/folder/x.lig"], "there is no folder"),
 ])
 def test_the_command_refuses_bad_choices(tmp_path, args, message):
-    cmd = [sys.executable, "-m", "liganimate.view_cli", "studio", "--no-browser", *args]
+    cmd = [sys.executable, "-m", "liganimate", "studio", "--no-browser", *args]
     r = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert r.returncode == 1 and message in r.stderr and "Traceback" not in r.stderr
 
@@ -253,6 +253,6 @@ def test_a_program_file_and_its_models(tmp_path):
     assert info.value.hint == "did you mean ONE?"
     bad = tmp_path / "bad.lig"
     bad.write_text("X = (1,\n", encoding="utf-8")
-    r = subprocess.run([sys.executable, "-m", "liganimate.view_cli", "studio", "--no-browser", str(bad)],
+    r = subprocess.run([sys.executable, "-m", "liganimate", "studio", "--no-browser", str(bad)],
                        check=False, capture_output=True, text=True, timeout=120)
     assert r.returncode == 1 and "bad.lig:1:" in r.stderr and "Traceback" not in r.stderr

@@ -61,7 +61,7 @@ def pages(tmp_path_factory):
     out = {}
     for name, src in sources.items():
         page = tmp / f"{name}.html"
-        for cmd in ([sys.executable, "-m", "liganimate.view_cli", "view", str(src), "-o", str(page), "--quiet"],
+        for cmd in ([sys.executable, "-m", "liganimate", "view", str(src), "-o", str(page), "--quiet"],
                     [sys.executable, "-m", "liganimate", "run", str(src), "-o", str(tmp / name), "--quiet"]):
             r = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=600)
             assert r.returncode == 0, r.stderr
@@ -204,7 +204,7 @@ def test_a_thousand_frame_five_figure_scene_opens_quickly(tmp_path):
     """Under 10 MB and drawn within 2 s of navigation in headless Chromium."""
     require_chromium()
     page = tmp_path / "five.html"
-    r = subprocess.run([sys.executable, "-m", "liganimate.view_cli", "view", FIVE, "-o", str(page), "--quiet"],
+    r = subprocess.run([sys.executable, "-m", "liganimate", "view", FIVE, "-o", str(page), "--quiet"],
                        check=False, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
     assert page.stat().st_size < 10_000_000

@@ -27,7 +27,7 @@ TYPES = {"f32": "<f4", "u8": "u1", "u16": "<u2", "i32": "<i4", "u32": "<u4"}
 
 
 def _view(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "liganimate.view_cli", "view", *args], check=False,
+    return subprocess.run([sys.executable, "-m", "liganimate", "view", *args], check=False,
                           capture_output=True, text=True, cwd=cwd, timeout=300)
 
 

@@ -27,7 +27,7 @@ import os
 import re
 
 import numpy as np
-from liganimate.compiler.types import BUILTINS
+from liganimate.compiler.names import reserved
 
 from ..motion import Motion
 from ._numbers import format_rows
@@ -37,16 +37,9 @@ __all__ = ["ROOT_PATH_MARK", "clip_angles", "lig_library", "read_root_path", "re
 
 ROOT_PATH_MARK = "ROOT PATH"
 DECIMALS = 7
-_RESERVED = set(BUILTINS) | {
-    "AND", "ANIMATE", "AXIS", "BACKGROUND", "BEGIN", "BY", "CONTINUE", "DO", "DRAW", "ELSE", "END", "ENDJOINT",
-    "ENDMODEL", "ENDMOTION", "ENDSCENE", "ENDREACH", "FIGURE", "FRAME", "FRAMES", "FROM", "IF", "INITIALIZE",
-    "INTERPOLATE", "INTERPOLATION", "JOINT", "JOINTS", "LENGTH", "LIGHTNESS", "LINK", "MAIN", "MODEL", "NOT", "OR",
-    "POINT", "POLY", "POSITION", "PRIMITIVE", "REPEAT", "RETURN", "ROT", "SAMEFRAME", "SCALE", "SCENE", "STARTMODEL",
-    "STARTMOTION", "STARTSCENE", "STARTREACH", "STOP", "STRIP", "THEN", "TO", "TRANS", "USING", "VIEW", "WIDTH",
-    "WITH", "REAL", "INTEGER", "VECTOR", "GRAPHICAL", "MOTION", "SHOOTSCENE", "SHOOTSCENES", "SYNCHRONIZE",
-    "SYNCHRONISE", "LOAD", "PRINT", "EXTREME", "EXTREMES", "GOAL", "WEIGHT", "NORMAL", "MOVE", "CHAIN", "TRANSLATE",
-    "INTO", "SOLVER", "TOLERANCE", "ITERATIONS", "ON", "PLANE", "ALONG", "AT", "HEIGHT", "DEPTH", "BOX", "ORIGIN",
-}
+# Keywords and built-ins (compiler/names.py, read from the grammar), and the
+# segment name the writers give a figure's empty root.
+_RESERVED = reserved() | {"ORIGIN"}
 
 
 def _identifier(name: str, taken: set) -> str:

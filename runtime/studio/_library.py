@@ -22,23 +22,14 @@ from __future__ import annotations
 import re
 
 import numpy as np
-from liganimate.compiler.types import BUILTINS
+from liganimate.compiler.names import reserved
 
 __all__ = ["library_text", "lig_name"]
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
-# Words a segment may not be called: statement keywords and built-in names.
-_RESERVED = set(BUILTINS) | {
-    "ALONG", "AND", "ANIMATE", "AT", "AXIS", "BACKGROUND", "BEGIN", "BOX", "BY", "CHAIN", "CONTINUE", "DEPTH",
-    "DO", "DRAW", "ELSE", "END", "ENDJOINT", "ENDMODEL", "ENDMOTION", "ENDREACH", "ENDSCENE", "EXTREME",
-    "EXTREMES", "FIGURE", "FRAME", "FRAMES", "FROM", "GOAL", "GRAPHICAL", "HEIGHT", "IF", "INITIALIZE",
-    "INTEGER", "INTERPOLATE", "INTERPOLATION", "INTO", "ITERATIONS", "JOINT", "JOINTS", "LENGTH", "LIGHTNESS",
-    "LINK", "LOAD", "MAIN", "MODEL", "MOTION", "MOVE", "NORMAL", "NOT", "ON", "OR", "ORIGIN", "PLANE", "POINT",
-    "POLY", "POSITION", "PRIMITIVE", "PRINT", "REAL", "REPEAT", "RETURN", "ROT", "SAMEFRAME", "SCALE", "SCENE",
-    "SHOOTSCENE", "SHOOTSCENES", "SOLVER", "STARTMODEL", "STARTMOTION", "STARTREACH", "STARTSCENE", "STOP",
-    "STRIP", "SYNCHRONISE", "SYNCHRONIZE", "THEN", "TO", "TOLERANCE", "TRANS", "TRANSLATE", "USING", "VECTOR",
-    "VIEW", "WEIGHT", "WIDTH", "WITH",
-}
+# Keywords and built-ins (compiler/names.py, read from the grammar), and the
+# segment name the writers give a figure's empty root.
+_RESERVED = reserved() | {"ORIGIN"}
 
 
 def lig_name(text: str) -> bool:

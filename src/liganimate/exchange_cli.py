@@ -13,7 +13,6 @@ import re
 import sys
 
 _EXPORT_KINDS = {".glb": "glb", ".gltf": "gltf", ".bvh": "bvh"}
-_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
 
 def _fps(text: str) -> float:
@@ -37,8 +36,11 @@ def _degrees(text: str) -> float:
 
 
 def _lig_name(text: str) -> str:
-    if not _NAME.match(text):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a LIG name (a letter, then letters, digits and _)")
+    from liganimate.compiler.names import definable
+
+    if not definable(text):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a LIG name a library can define "
+                                         "(a letter, then letters, digits and _; not a keyword)")
     return text.upper()
 
 
@@ -136,14 +138,3 @@ def cmd_import(args) -> int:
 
     return _guarded(go)
 
-
-def main(argv=None) -> int:
-    """``python -m liganimate.exchange_cli export|import ...`` (the same commands on their own)."""
-    parser = argparse.ArgumentParser(prog="liganimate")
-    add_commands(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    return args.func(args)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -148,14 +148,3 @@ def cmd_studio(args) -> int:
 
     return _guarded(go)
 
-
-def main(argv=None) -> int:
-    """``python -m liganimate.view_cli view|studio ...`` (the same commands on their own)."""
-    parser = argparse.ArgumentParser(prog="liganimate")
-    add_commands(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    return args.func(args)
-
-
-if __name__ == "__main__":
-    sys.exit(main())
