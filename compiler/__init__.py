@@ -83,8 +83,11 @@ def compile_for_run(path: str) -> tuple:
     return compiled.python, compiled.warnings
 
 
-def load_program(path: str) -> tuple:
-    """Compile a .lig file in memory and execute its module: ``(program, warnings)``.
+def load_program(path: str | None = None, *, text: str | None = None, name: str = "<text>") -> tuple:
+    """Compile a .lig file (or program ``text``) in memory and execute its module: ``(program, warnings)``.
+
+    This is the one place a program is compiled and executed; the command
+    line, :func:`liganimate.load` and the studio all come here.
 
     The module is the text ``liganimate compile`` writes, executed piece by
     piece (:func:`liganimate.runtime.loader.exec_module`) so that a big
@@ -97,9 +100,14 @@ def load_program(path: str) -> tuple:
     """
     from liganimate.runtime.loader import exec_module
 
-    python, warnings = compile_for_run(path)
-    namespace = {"__name__": "liganimate_program", "__file__": path}
-    exec_module(python, f"<liganimate {path}>", namespace)
+    if path is not None:
+        python, warnings = compile_for_run(path)
+        name = path
+    else:
+        compiled = compile_source(prepare(text or "", name), consume=True)
+        python, warnings = compiled.python, compiled.warnings
+    namespace = {"__name__": "liganimate_program", "__file__": name}
+    exec_module(python, f"<liganimate {name}>", namespace)
     return namespace["program"], warnings
 
 

@@ -23,13 +23,9 @@ def _run(program) -> dict:
 
 
 def _compiled_text(text: str, name: str):
-    from liganimate.compiler import compile_text
+    from liganimate.compiler import load_program
 
-    compiled = compile_text(text, name)
-    namespace = {"__name__": "liganimate_studio"}
-    # The compiler's own output; program text reaches it only through repr().
-    exec(compile(compiled.python, f"<liganimate {name}>", "exec"), namespace)  # noqa: S102
-    return namespace["program"]
+    return load_program(text=text, name=name)[0]
 
 
 def _stdlib_offering(name: str):

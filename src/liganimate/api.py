@@ -142,7 +142,7 @@ def load(path_or_text) -> LoadedProgram:
     OSError
         When the file cannot be read.
     """
-    from liganimate.compiler import compile_file, compile_text
+    from liganimate.compiler import load_program
 
     if isinstance(path_or_text, os.PathLike):
         path, text = os.fspath(path_or_text), None
@@ -153,11 +153,7 @@ def load(path_or_text) -> LoadedProgram:
     else:
         path, text = None, path_or_text
     try:
-        compiled = compile_file(path) if text is None else compile_text(text, "<text>")
+        program, warnings = load_program(path, text=text)
     except LigDiagnostics as exc:
         _reraise(exc)
-    name = path if path is not None else "<text>"
-    namespace = {"__name__": "liganimate_program", "__file__": name}
-    # The compiler's own output; program text reaches it only through repr().
-    exec(compile(compiled.python, f"<liganimate {name}>", "exec"), namespace)  # noqa: S102
-    return LoadedProgram(name, namespace["program"], compiled.warnings)
+    return LoadedProgram(path if path is not None else "<text>", program, warnings)

@@ -43,13 +43,9 @@ def _size(text: str):
 
 def load_program(path: str):
     """Compile a .lig file in memory (the same lowering ``compile`` writes) and return (program, warnings)."""
-    from liganimate.compiler import compile_file
+    from liganimate.compiler import load_program as _load
 
-    compiled = compile_file(path)
-    namespace = {"__name__": "liganimate_program", "__file__": path}
-    code = compile(compiled.python, f"<liganimate {path}>", "exec")
-    exec(code, namespace)
-    return namespace["program"], compiled.warnings
+    return _load(path)
 
 
 def _add_render_options(p: argparse.ArgumentParser) -> None:
