@@ -162,3 +162,15 @@ def test_names_a_library_may_define_exclude_every_grammar_keyword():
     assert definable("walk_2") and not definable("2walk") and not definable("a-b")
     r = run("import", "nothing.bvh", "--model", "animate")
     assert r.returncode == 2 and "not a LIG name" in r.stderr
+
+
+def test_check_prints_what_print_asks_for_and_run_prints_it_once(tmp_path):
+    # The thesis' preprocessor printed its tables when it read the program.
+    prog = tmp_path / "p.lig"
+    prog.write_text("X = 2 + 3\nPRINT 'hello', X\n")
+    r = run("check", str(prog), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == ["hello", "X = 5"]
+    r = run("run", str(prog), "--quiet", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == ["hello", "X = 5"]

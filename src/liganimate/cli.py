@@ -180,7 +180,7 @@ def cmd_check(args) -> int:
     def go():
         program, warnings = load_program(args.file)
         _print_diagnostics(warnings)
-        _print_diagnostics(program.check())
+        _print_diagnostics(program.check(stdout=sys.stdout))
         return 0
 
     return _guarded(go)
