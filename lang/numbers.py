@@ -177,7 +177,12 @@ def magnitude(x: float) -> str:
         return "an undefined amount"
     if math.isinf(x):
         return f"more than {_REAL_MAX_TEXT}"
-    return f"{x:g}"
+    # Spelled as LIG writes numbers (1E12, 2.5E-7), not as Python prints them.
+    text = f"{x:g}"
+    if "e" in text:
+        mantissa, exponent = text.split("e")
+        text = f"{mantissa}E{int(exponent)}"
+    return text
 
 
 def overflow(value, what: str = "the result") -> NumberError:

@@ -37,7 +37,7 @@ from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
-from liganimate.lang.numbers import INT_MAX, MAX_ANGLE
+from liganimate.lang.numbers import INT_MAX, MAX_ANGLE, magnitude
 
 from .errors import FigureError
 
@@ -155,7 +155,7 @@ def normalize_extremes(extremes) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise FigureError("joint extremes must be finite numbers of degrees.")
     if not np.all(np.abs(arr) <= MAX_ANGLE):
-        raise FigureError(f"joint extremes must lie within ±{MAX_ANGLE:g} degrees.",
+        raise FigureError(f"joint extremes must lie within ±{magnitude(MAX_ANGLE)} degrees.",
                           hint="a range of 360 degrees or more already lets the joint turn freely")
     out = np.zeros((3, 2))
     out[: arr.shape[0]] = arr

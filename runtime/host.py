@@ -507,13 +507,13 @@ class Runtime(Arithmetic):
         if frame < 0:
             self.fail(at, f"frame {frame:g} is before the motion starts")
         if frame > N.MAX_FRAME:
-            self.fail(at, f"frame {frame:g} is beyond the last frame a keyframe may have, {N.MAX_FRAME:g}")
+            self.fail(at, f"frame {N.magnitude(frame)} is beyond the last frame a keyframe may have, {N.magnitude(N.MAX_FRAME)}")
         self._angles(position, at)
 
     def _angles(self, position, at) -> None:
         if not max(abs(a) for a in position) <= N.MAX_ANGLE:
             far = max(abs(a) for a in position)
-            self.fail(at, f"an angle of {far:g} degrees is beyond the largest a keyframe may hold, {N.MAX_ANGLE:g}",
+            self.fail(at, f"an angle of {N.magnitude(far)} degrees is beyond the largest a keyframe may hold, {N.magnitude(N.MAX_ANGLE)}",
                       "angles are in degrees; a joint's extremes clip them anyway")
 
     def concat(self, a, b, at):

@@ -43,7 +43,7 @@ def check_graphical(g: Graphical, what: str = "this object") -> Graphical:
     e = g.extent()
     if not e <= GEOMETRY_MAX:
         raise LigError(f"{what} reaches {_fmt(e)} units from the origin along an axis, beyond the limit of "
-                       f"{GEOMETRY_MAX:g} for anything drawn", _HINT)
+                       f"{_fmt(GEOMETRY_MAX)} for anything drawn", _HINT)
     return g
 
 
@@ -90,7 +90,7 @@ def check_figure(fig, what: str = "the model"):
         far = float(np.linalg.norm(p[:3, :3]) * reach + np.max(np.abs(p[:3, 3])))
     if not far <= GEOMETRY_MAX:
         raise LigError(f"{what} can reach {_fmt(far)} units from the origin, beyond the limit of "
-                       f"{GEOMETRY_MAX:g} for anything drawn",
+                       f"{_fmt(GEOMETRY_MAX)} for anything drawn",
                        "a model is measured by its segments and joint locations, so that it stays within the "
                        "limit in every pose; " + _HINT)
     return fig
@@ -102,11 +102,11 @@ def check_view_point(point) -> tuple:
     far = max(abs(x), abs(y), abs(z))
     if not far <= GEOMETRY_MAX:
         raise LigError(f"the VIEW POINT is {_fmt(far)} units from the origin along an axis, beyond the limit of "
-                       f"{GEOMETRY_MAX:g}", _HINT)
+                       f"{_fmt(GEOMETRY_MAX)}", _HINT)
     if math.hypot(x, y, z) < GEOMETRY_MIN:
         if x == y == z == 0:
             raise LigError("the VIEW POINT cannot be the origin: the camera looks at the origin")
-        raise LigError(f"the VIEW POINT is closer to the origin than {GEOMETRY_MIN:g}, so the camera has no "
+        raise LigError(f"the VIEW POINT is closer to the origin than {_fmt(GEOMETRY_MIN)}, so the camera has no "
                        "usable direction", "the camera looks at the origin from the VIEW POINT")
     return (x, y, z)
 
@@ -117,6 +117,6 @@ def check_view_width(width) -> float:
     if not w > 0:
         raise LigError(f"the VIEW WIDTH must be positive, not {w:g}")
     if w < GEOMETRY_MIN:
-        raise LigError(f"the VIEW WIDTH {w:g} is below the smallest width, {GEOMETRY_MIN:g}",
+        raise LigError(f"the VIEW WIDTH {w:g} is below the smallest width, {_fmt(GEOMETRY_MIN)}",
                        "VIEW WIDTH is the width of the view around the origin, in world units")
     return w

@@ -1200,7 +1200,7 @@ def check_frames(frames: np.ndarray, cause: str) -> None:
         return
     last = frames[-1]
     if not last <= MAX_FRAME:
-        raise MotionError(f"{cause} puts a keyframe at frame {magnitude(last)}, beyond the last frame allowed, {MAX_FRAME:g}",
+        raise MotionError(f"{cause} puts a keyframe at frame {magnitude(last)}, beyond the last frame allowed, {magnitude(MAX_FRAME)}",
                           hint="a keyframe's frame is at most 1E9")
     gaps = np.diff(frames, prepend=0.0)
     close = (gaps > 0) & (gaps < MIN_FRAME_GAP)
@@ -1214,7 +1214,7 @@ def check_angles(values: np.ndarray, cause: str) -> None:
     """Angles within ``±MAX_ANGLE`` degrees, else MotionError naming ``cause``."""
     far = float(np.max(np.abs(values))) if np.size(values) else 0.0
     if not far <= MAX_ANGLE:
-        raise MotionError(f"{cause} makes an angle of {magnitude(far)} degrees, beyond the largest allowed, {MAX_ANGLE:g}",
+        raise MotionError(f"{cause} makes an angle of {magnitude(far)} degrees, beyond the largest allowed, {magnitude(MAX_ANGLE)}",
                           hint="angles are in degrees; a joint's extremes clip them anyway")
 
 

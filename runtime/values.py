@@ -170,7 +170,7 @@ class Canvas:
         far = max(abs(c) for p in pts for c in p)
         if not far <= GEOMETRY_MAX:
             raise LigError(f"this polygon has a corner {magnitude(far)} units along an axis, beyond the limit of "
-                           f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
+                           f"{magnitude(GEOMETRY_MAX)} for anything drawn", _FAR_HINT)
         self.triangles += len(pts) - 2
         check_triangles(self.triangles, "the primitive's drawing")
         self.polys.append((np.asarray(pts, dtype=np.float64), self.light))
@@ -296,7 +296,7 @@ def box(centre, width, height, depth, light) -> Graphical:
     far = float(np.max(np.abs(c))) + max(abs(w), abs(h), abs(d)) / 2  # its corners are c +- size / 2
     if not far <= GEOMETRY_MAX:
         raise LigError(f"this BOX reaches {magnitude(far)} units from the origin along an axis, beyond the limit of "
-                       f"{GEOMETRY_MAX:g} for anything drawn", _FAR_HINT)
+                       f"{magnitude(GEOMETRY_MAX)} for anything drawn", _FAR_HINT)
     light = _clip_lightness(light)
     l1, l2 = light, light * 1.5
     ftr = c + (w / 2, h / 2, d / 2)

@@ -245,3 +245,12 @@ def test_an_absurd_keyframe_number_is_refused_in_bounded_memory(tmp_path):
 def test_a_missing_keyframe_is_found_without_walking_every_number(tmp_path):
     r = capped_check(tmp_path, "W[1, 1000000] = FRAME 2 POSITION 0, 0, 0\nX = LEN(W)")
     assert_diagnostic(r, "1:1", "keyframe 1000000 of joint 1 is set, but keyframe 1 never is")
+
+
+def test_limits_are_spelled_as_lig_writes_numbers(tmp_path):
+    # A message quotes the limit the user must stay within; Python's '1e+12'
+    # is not a number the user could type back into a program as shown.
+    r = check(tmp_path, "G :- BOX WIDTH 3E12, HEIGHT 1, DEPTH 1\n")
+    assert r.returncode == 1 and "1E12" in r.stderr
+    assert "e+" not in r.stderr and "inf" not in r.stderr
+    assert N.magnitude(2.5e-7) == "2.5E-7" and N.magnitude(float("inf")) == "more than 1.8E308"
