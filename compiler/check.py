@@ -48,6 +48,16 @@ class SceneInfo:
     assigned: set = field(default_factory=set)
 
 
+def expr_type(types: dict, e) -> str | None:
+    """The type the checker settled for expression ``e`` (``types`` is :attr:`Checked.types`).
+
+    Literals are not in the table: a literal's type follows from its value.
+    """
+    if type(e) is A.Num:
+        return T.INTEGER if isinstance(e.value, int) else T.REAL
+    return types.get(id(e))
+
+
 @dataclass
 class Checked:
     """A program that passed the static checks, with what lowering needs."""
@@ -55,7 +65,7 @@ class Checked:
     program: A.Program
     main: Scope
     primitives: dict  # NAME -> (PrimitiveDef | None, Signature, Scope | None)
-    types: dict  # id(expr node) -> type
+    types: dict  # id(expr node) -> type, literals aside (see expr_type)
     scenes: dict  # id(Scene node) -> SceneInfo
     warnings: list
     libraries: list = field(default_factory=list)  # Library objects, in order of first LOAD
@@ -714,7 +724,10 @@ class Checker:
 
     def expr(self, e):
         t = getattr(self, "_e_" + type(e).__name__)(e)
-        self.types[id(e)] = t
+        # A literal's type is its value's (expr_type): most nodes of a big
+        # program are literals, and an entry each cost ~80 bytes a line.
+        if type(e) is not A.Num:
+            self.types[id(e)] = t
         return t
 
     def _e_Num(self, e):
@@ -881,7 +894,7 @@ class Checker:
             self.err(node, message, hint)
         for c in e.clauses:
             ptype = sig.param_types.get(c.keyword)
-            t = self.types.get(id(c.value))
+            t = expr_type(self.types, c.value)
             if t is None or ptype is None:
                 continue
             if not T.fits(ptype, t):

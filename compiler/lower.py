@@ -20,7 +20,7 @@ from liganimate.lang import numbers as N
 from liganimate import __version__
 
 from . import types as T
-from .check import _SOLVERS, Checked
+from .check import _SOLVERS, Checked, expr_type
 
 _ZERO = {
     T.INTEGER: "0",
@@ -102,7 +102,7 @@ class Lowerer:
         self.lines.append("    " * self.indent + text)
 
     def type_of(self, e) -> str:
-        return self.c.types.get(id(e))
+        return expr_type(self.c.types, e)
 
     # ------------------------------------------------------------- module
     def module(self) -> str:
