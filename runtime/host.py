@@ -29,6 +29,9 @@ from .errors import LigError
 from .library import Library  # noqa: F401  (generated modules name it _host.Library)
 from .values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
+#: How often a long scene reports its progress while it is checked, in ticks.
+PROGRESS_TICKS = 4096
+
 _StopProgram = type("_StopProgram", (Exception,), {})
 
 
@@ -97,13 +100,17 @@ class Program:
             self._positions = tuple(zip(numbers, numbers, numbers, numbers))
         return self._positions
 
-    def execute(self, mode: str = "check", renderer=None, stdout=None, echo_print: bool = False) -> Runtime:
+    def execute(self, mode: str = "check", renderer=None, stdout=None, echo_print: bool = False,
+                progress=None) -> Runtime:
         """Run the program; return the runtime, whose ``variables`` hold its final values.
 
         In ``"check"`` mode PRINT only checks its items unless ``echo_print``.
+        ``progress(scene_id, tick, length)``, if given, is called every
+        :data:`PROGRESS_TICKS` ticks of a scene, so a long check is not silent.
         """
         rt = Runtime(self, mode, renderer, stdout)
         rt.echo_print = echo_print
+        rt.progress = progress
         try:
             rt.variables = self.main(rt) or {}
         except _StopProgram:
@@ -115,7 +122,7 @@ class Program:
 
         return rt
 
-    def check(self, stdout=None) -> list:
+    def check(self, stdout=None, progress=None) -> list:
         """Run every statement and every scene tick without drawing; return the warnings.
 
         Parameters
@@ -126,13 +133,17 @@ class Program:
             ``sys.stdout``). By default PRINT output is dropped, so a caller
             that checks and then renders (``run``) prints it only once.
 
+        progress : callable, optional
+            ``progress(scene_id, tick, length)``, called every
+            :data:`PROGRESS_TICKS` ticks (the command line draws a line from it).
+
         Returns
         -------
         list of Diagnostic
         """
         if stdout is None:
-            return self.execute("check", stdout=io.StringIO()).warnings
-        return self.execute("check", stdout=stdout, echo_print=True).warnings
+            return self.execute("check", stdout=io.StringIO(), progress=progress).warnings
+        return self.execute("check", stdout=stdout, echo_print=True, progress=progress).warnings
 
     def render(self, out_dir: str, checked: bool = False, **options) -> Runtime:
         """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`).
@@ -181,6 +192,7 @@ class Runtime(Arithmetic):
         self.mode = mode
         self.renderer = renderer
         self.out = stdout if stdout is not None else sys.stdout
+        self.progress = None  # see Program.execute
         self.warnings: list = []
         self._warned: set = set()
         self.scenes: dict = {}
@@ -584,9 +596,14 @@ class Runtime(Arithmetic):
             self.fail(at if sameframe_at is None else sameframe_at, f"SAMEFRAME must be at least 1, not {sameframe}")
         state = self.scene
         state.length, state.sameframe = length, sameframe
+        progress = self.progress
         for t in range(length):
             state.tick = t
+            if progress is not None and not t % PROGRESS_TICKS:
+                progress(state.id, t, length)
             yield t
+        if progress is not None and length >= PROGRESS_TICKS:
+            progress(state.id, length, length)
 
     def animate(self, m, name, start, end, motion, repeat, at):
         fig = self._model(m, at, name)

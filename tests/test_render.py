@@ -456,3 +456,27 @@ def test_png_with_blank_runs_is_a_valid_zlib_stream(width):
     with Image.open(__import__("io").BytesIO(data)) as im:
         np.testing.assert_array_equal(np.asarray(im), img)
     assert imagefiles.encode_png(img.copy()) == data
+
+
+def test_a_long_check_reports_its_progress():
+    # A scene of millions of ticks is checked tick by tick; the caller hears
+    # of it every PROGRESS_TICKS ticks and once at the end.
+    from liganimate.compiler import load_program
+    from liganimate.runtime.host import PROGRESS_TICKS
+
+    program, _ = load_program(text="INITIALIZE SCENE 3\nSTARTSCENE LENGTH 10000\nENDSCENE\nSHOOTSCENES\n")
+    calls = []
+    program.check(progress=lambda *a: calls.append(a))
+    assert calls == [(3, t, 10000) for t in range(0, 10000, PROGRESS_TICKS)] + [(3, 10000, 10000)]
+
+
+def test_check_shows_progress_on_a_terminal_and_clears_it(tmp_path):
+    prog = tmp_path / "long.lig"
+    # The longest scene allowed, with a statement a tick: a few seconds' check,
+    # past the one second after which the line appears.
+    prog.write_text("X = 0\nINITIALIZE SCENE 1\nSTARTSCENE LENGTH 10000000\nX = X + 1\nENDSCENE\nSHOOTSCENES\n")
+    status, shown = run_on_terminal(["check", str(prog)], tmp_path)
+    assert status == 0, shown
+    assert "checking scene 1: " in shown and "10,000,000/10,000,000 ticks" in shown
+    # The last thing written blanks the line out, leaving the cursor at its start.
+    assert shown.endswith("\r") and shown.rsplit("\r", 2)[-2].strip() == ""

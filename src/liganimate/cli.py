@@ -14,6 +14,7 @@ import argparse
 import os
 import signal
 import sys
+import time
 
 from liganimate import __version__
 from liganimate.runtime import interrupts
@@ -81,9 +82,45 @@ def _check_render_options(args, stem: str) -> str:
     return out
 
 
+class _CheckProgress:
+    """``checking scene 1: 40,960/10,000,000 ticks`` on a terminal, once a check has run for a second.
+
+    A check runs every tick of every scene; a scene of millions of ticks
+    would otherwise keep the terminal silent for minutes.
+    """
+
+    def __init__(self):
+        self.start = time.monotonic()
+        self.width = 0
+
+    def __call__(self, scene_id, tick, length) -> None:
+        if not self.width and time.monotonic() - self.start < 1.0:
+            return
+        line = f"checking scene {scene_id}: {tick:,}/{length:,} ticks"
+        self.width = max(self.width, len(line))
+        sys.stderr.write("\r" + line.ljust(self.width))
+        sys.stderr.flush()
+
+    def done(self) -> None:
+        """Clear the line, if one was shown."""
+        if self.width:
+            sys.stderr.write("\r" + " " * self.width + "\r")
+            sys.stderr.flush()
+
+
+def _checked(program, quiet: bool, stdout=None) -> list:
+    """``program.check(...)`` with a progress line on a terminal; returns the warnings."""
+    progress = _CheckProgress() if not quiet and sys.stderr.isatty() else None
+    try:
+        return program.check(stdout=stdout, progress=progress)
+    finally:
+        if progress is not None:
+            progress.done()
+
+
 def _render(program, warnings, args, out: str) -> int:
     _print_diagnostics(warnings)
-    warnings_run = program.check()
+    warnings_run = _checked(program, args.quiet)
     _print_diagnostics(warnings_run)
     program.render(out, checked=True, size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps,
                    quiet=args.quiet)
@@ -180,7 +217,7 @@ def cmd_check(args) -> int:
     def go():
         program, warnings = load_program(args.file)
         _print_diagnostics(warnings)
-        _print_diagnostics(program.check(stdout=sys.stdout))
+        _print_diagnostics(_checked(program, False, stdout=sys.stdout))
         return 0
 
     return _guarded(go)
