@@ -182,24 +182,10 @@ class Checker:
             try:
                 path = L.resolve(stmt.library, self.path)
                 lib = L.load(stmt.library, path, self.stack + _here(self.path))
-            except L.LibraryNotFound as exc:
-                hint = None
-                if not L.is_path(stmt.library):
-                    hint = did_you_mean(stmt.library.lower(), L.stdlib_names()) or (
-                        "the standard libraries are " + ", ".join(L.stdlib_names()))
-                    hint += "; a file of your own is named by a path such as 'lib/mine.lig'"
-                self.err(stmt.library_pos, f"there is no library '{stmt.library}' (looked for {exc.tried[0]})", hint)
-                continue
-            except L.LibraryCycle as exc:
-                self.err(stmt.library_pos, "libraries load each other in a circle: " + " -> ".join(exc.chain),
-                         "move what both need into a third library")
-                continue
-            except LigDiagnostics as exc:
-                self.errors.extend(exc.diagnostics)
-                self.err(stmt.library_pos, f"the library '{stmt.library}' has errors (shown above)")
-                continue
-            except OSError as exc:
-                self.err(stmt.library_pos, f"the library '{stmt.library}' cannot be read: {exc.strerror or exc}")
+            except L.FAILURES as exc:
+                message, hint, inner = L.failure(exc, stmt.library)
+                self.errors.extend(inner)
+                self.err(stmt.library_pos, message, hint)
                 continue
             if lib.scenes:
                 self.err(stmt.library_pos, f"{lib.display} defines scenes, so it is a program, not a library",

@@ -352,11 +352,12 @@ def failure(exc: Exception, name: str) -> tuple:
     OSError, the failures a LOAD reports at its own line.
     """
     if isinstance(exc, LibraryNotFound):
-        hint = None
         if not is_path(name):
             hint = did_you_mean(name.lower(), stdlib_names()) or ("the standard libraries are " + ", ".join(stdlib_names()))
             hint += "; a file of your own is named by a path such as 'lib/mine.lig'"
-        return f"there is no library '{name}' (looked for {exc.tried[0]})", hint, []
+            # Where the package is installed says nothing to the user.
+            return f"there is no library '{name}' in the standard library", hint, []
+        return f"there is no library '{name}' (looked for {exc.tried[0]})", None, []
     if isinstance(exc, LibraryCycle):
         return ("libraries load each other in a circle: " + " -> ".join(exc.chain),
                 "move what both need into a third library", [])

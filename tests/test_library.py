@@ -280,3 +280,13 @@ def test_lib_lists_the_standard_library(libs):
         assert f"{name}  (stdlib/{name}.lig)" in r.stdout
     r = cli("lib", "nope", cwd=libs)
     assert r.returncode == 1 and "there is no library 'nope'" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_a_missing_standard_library_does_not_quote_where_the_package_lives(tmp_path):
+    # The install folder (site-packages/...) means nothing to the user; the
+    # hint lists the standard libraries instead. A path LOAD still says where it looked.
+    r = cli("check", str(write(tmp_path, "LOAD 'nowhere'\n", "p.lig")), cwd=tmp_path)
+    assert r.returncode == 1 and "there is no library 'nowhere' in the standard library" in r.stderr
+    assert "stdlib" not in r.stderr.split("hint:")[0] and "humanoid" in r.stderr
+    r = cli("check", str(write(tmp_path, "LOAD 'lib/nowhere.lig'\n", "q.lig")), cwd=tmp_path)
+    assert r.returncode == 1 and "looked for " in r.stderr and "nowhere.lig" in r.stderr

@@ -267,8 +267,7 @@ def cmd_lib(args) -> int:
             try:
                 path = L.resolve(name, os.path.join(os.getcwd(), "-"))
             except L.LibraryNotFound as exc:
-                raise LigError(f"there is no library '{name}' (looked for {exc.tried[0]})",
-                               "the standard libraries are " + ", ".join(L.stdlib_names())) from None
+                raise LigError(*L.failure(exc, name)[:2]) from None
             lib = L.load(name, path)
             if i:
                 print()
