@@ -188,6 +188,7 @@ def main(argv=None) -> int:
     cold_rounds = 3 if args.quick else 10
 
     from lark import Lark
+
     from liganimate.compiler import compile_text
     from liganimate.lang import parser as P
     from liganimate.lang.source import prepare

@@ -28,9 +28,8 @@ import sys
 import tempfile
 import time
 
-from liganimate.runtime import exchange as X
-
 from liganimate.cli import load_program
+from liganimate.runtime import exchange as X
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, "five_humans.lig")

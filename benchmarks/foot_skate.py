@@ -28,6 +28,8 @@ import os
 import tempfile
 
 import numpy as np
+
+from liganimate.cli import load_program
 from liganimate.runtime.host import Posed
 from liganimate.runtime.pose import (
     joint_angles,
@@ -35,8 +37,6 @@ from liganimate.runtime.pose import (
     world_transforms,
     world_triangles,
 )
-
-from liganimate.cli import load_program
 
 # Body speed (metres a frame) of the scene-level translation for each motion:
 # WALK, 1.2 m per 24-frame cycle (examples/walk_and_wave.lig moves 0.05 a tick);

@@ -53,8 +53,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "tests"))
 
-import fuzzgen
-import fuzzrun
+import fuzzgen  # noqa: E402 - found through the sys.path line above
+import fuzzrun  # noqa: E402
 
 WORKER_FAILURES = ("hang", "died")
 ALL_OUTCOMES = fuzzrun.OUTCOMES + WORKER_FAILURES

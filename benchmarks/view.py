@@ -37,10 +37,9 @@ FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-
 
 def build_page(folder: str):
     """Run the scene and write its page; return (path, seconds)."""
+    from liganimate.cli import load_program
     from liganimate.runtime import exchange as X
     from liganimate.runtime.view import viewer_html
-
-    from liganimate.cli import load_program
 
     program, _ = load_program(SCENE)
     t0 = time.perf_counter()

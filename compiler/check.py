@@ -134,7 +134,7 @@ class Checker:
         try:
             self._loads(main, sigs)
         except _Stop:
-            raise LigDiagnostics(self.errors)
+            raise LigDiagnostics(self.errors) from None
         self.signatures = sigs
         try:
             # First passes settle implicit types; the final pass reports.

@@ -29,11 +29,10 @@ import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from liganimate import __version__
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
 from liganimate.lang.source import SourceFileError, lig_text, read_source_bytes
-
-from liganimate import __version__
 
 from . import library_cache
 from . import types as T

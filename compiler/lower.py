@@ -14,10 +14,9 @@ from __future__ import annotations
 
 import re
 
+from liganimate import __version__
 from liganimate.lang import ast as A
 from liganimate.lang import numbers as N
-
-from liganimate import __version__
 
 from . import types as T
 from .check import _SOLVERS, Checked, expr_type
@@ -133,7 +132,7 @@ class Lowerer:
             self.emit(f"_prim_{name} = _LIB{i}.primitive({name!r})")
         if self.c.libraries:
             self.emit("")
-        for name, (pdef, sig, scope) in sorted(self.c.primitives.items()):
+        for _name, (pdef, sig, scope) in sorted(self.c.primitives.items()):
             if pdef is not None:
                 self.primitive(pdef, sig, scope)
                 self.emit("")

@@ -44,7 +44,7 @@ class Signature:
 
     def usage(self) -> str:
         """A one-line reminder of the call syntax."""
-        out, group = [self.name], None
+        out = [self.name]
         for s in self.slots:
             piece = f"{s.keyword} {s.param.lower()}"
             if s.group is not None:

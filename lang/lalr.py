@@ -85,7 +85,7 @@ class Driver:
         self.actions: list = []  # state -> {symbol: next state, or ~rule to reduce}
         if sorted(table.states) != list(range(len(table.states))):
             raise ValueError("the parse table's states are not numbered 0..n-1")
-        for state, row in sorted(table.states.items()):
+        for _state, row in sorted(table.states.items()):
             acts = {}
             for symbol, (action, arg) in row.items():
                 if action is Shift:

@@ -37,6 +37,7 @@ from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
+
 from liganimate.lang.numbers import INT_MAX, MAX_ANGLE, magnitude
 
 from .errors import FigureError

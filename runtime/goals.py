@@ -21,8 +21,8 @@ once.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -377,7 +377,7 @@ class GoalStack:
 
     # ------------------------------------------------------------ batches
 
-    def take(self, idx: np.ndarray) -> "GoalStack":
+    def take(self, idx: np.ndarray) -> GoalStack:
         """The same goals for the batch elements ``idx`` only.
 
         Parameters

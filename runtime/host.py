@@ -16,6 +16,7 @@ import re
 import sys
 
 import numpy as np
+
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
@@ -501,7 +502,7 @@ class Runtime(Arithmetic):
             if joint in spec:
                 self.fail(jat, f"joint {joint} appears twice in this motion")
             last = 0
-            for frame, pos, method, kat in kfs:
+            for frame, pos, _method, kat in kfs:
                 self._keyframe_values(frame, pos, kat)
                 if frame < last:
                     self.fail(kat, f"keyframes must be in ascending frame order: frame {frame:g} comes after frame {last:g}")

@@ -22,7 +22,6 @@ from collections import OrderedDict
 
 import numpy as np
 
-from . import kinematics as K
 from .figure import Figure
 
 __all__ = ["IKModel", "link_lengths", "figure_length", "matvec3", "cross3"]
@@ -93,11 +92,11 @@ for _col, _terms in enumerate([
         _TERM_SUMS[_k, _col] = _sign
 del _col, _terms, _k, _sign
 
-_lengths_cache: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_lengths_cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 # (id(figure), movable mask, translate) -> (figure, model).  The model holds
 # its figure, so a weak-keyed cache would never let go; this one is bounded
 # (least recently used out), and the stored figure keeps the id valid.
-_model_cache: "OrderedDict" = OrderedDict()
+_model_cache: OrderedDict = OrderedDict()
 _MODEL_CACHE_MAX = 32
 
 
@@ -310,7 +309,7 @@ class IKModel:
         self.into_joint = into  # per link, the joint joining it to parent_link (-1 for the main link)
 
     @classmethod
-    def cached(cls, figure: Figure, movable, translate: bool = False) -> "IKModel":
+    def cached(cls, figure: Figure, movable, translate: bool = False) -> IKModel:
         """An :class:`IKModel`, reused while the same figure is solved with the same options.
 
         Figures are immutable values, so a model built for one stays right;

@@ -224,7 +224,7 @@ def _load_plugins() -> None:
                 continue  # an explicit register() wins over an installed plugin
             register(method)
         except Exception as exc:  # noqa: BLE001 - one bad plugin must not break the others
-            warnings.warn(f"interpolation plugin {ep.name!r} could not be loaded: {exc}", RuntimeWarning)
+            warnings.warn(f"interpolation plugin {ep.name!r} could not be loaded: {exc}", RuntimeWarning, stacklevel=2)
 
 
 def get(name: str) -> InterpolationMethod:

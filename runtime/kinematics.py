@@ -367,14 +367,15 @@ def pose_transforms_reference(figure: Figure, angles) -> np.ndarray:
         frame = a[idx]
         placed = {}
 
-        def visit(link, X):
-            placed[link] = X
+        # visit runs within this iteration, so the loop's frame and placed are the ones meant.
+        def visit(link, X):  # noqa: B023
+            placed[link] = X  # noqa: B023
             for k, joint in enumerate(figure.joints):
-                ax, ay, az = frame[k]
+                ax, ay, az = frame[k]  # noqa: B023
                 A = _translation(joint.loc1) @ _rz(az) @ _ry(ay) @ _rx(ax) @ _translation(-joint.loc2)
-                if joint.primary == link and joint.secondary not in placed:
+                if joint.primary == link and joint.secondary not in placed:  # noqa: B023
                     visit(joint.secondary, X @ A)
-                elif joint.secondary == link and joint.primary not in placed:
+                elif joint.secondary == link and joint.primary not in placed:  # noqa: B023
                     visit(joint.primary, X @ np.linalg.inv(A))
 
         visit(figure.main, np.eye(4))

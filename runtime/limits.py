@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from liganimate.lang.numbers import GEOMETRY_MAX, GEOMETRY_MIN, magnitude
 
 from .errors import LigError

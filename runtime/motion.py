@@ -14,6 +14,7 @@ import operator
 from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
+
 from liganimate.runtime import interpolation
 from liganimate.runtime import track as tr
 from liganimate.runtime.errors import MotionError

@@ -23,8 +23,8 @@ Example (``arm`` a model with a link named HAND)::
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Iterable, Sequence
 
 import numpy as np
 

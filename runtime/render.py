@@ -172,7 +172,7 @@ class Renderer:
             return
         requests = []  # (image slot, tick slot, order, name, posed, tick)
         for i, img in enumerate(self.pending):
-            for j, (tick, camera, drawn) in enumerate(img["ticks"]):
+            for j, (tick, _camera, drawn) in enumerate(img["ticks"]):
                 for order, (name, posed) in enumerate(drawn):
                     requests.append((i, j, order, name, posed, tick))
         groups: dict = {}
@@ -181,7 +181,7 @@ class Renderer:
             key = (id(fig.links), id(fig.joints), fig.main, id(motion))
             groups.setdefault(key, []).append(r)
         results = {}
-        for key, reqs in groups.items():
+        for reqs in groups.values():
             fig, motion = reqs[0][4].figure, reqs[0][4].motion
             frames = np.array([r[4].frame for r in reqs])
             placements = np.stack([np.asarray(r[4].figure.placement, dtype=np.float64) for r in reqs])
@@ -201,7 +201,7 @@ class Renderer:
                 parts = [results[(i, j, o)] for o in range(len(drawn))]
                 draws.append((camera, parts))
                 if self._poses_fh is not None:
-                    for o, (name, posed) in enumerate(drawn):
+                    for o, (name, _posed) in enumerate(drawn):
                         angles, X, fig = results[(i, j, o, "pose")]
                         self._write_pose(img["scene"], tick, img["image"], name, fig, angles, X)
             path = os.path.join(self.out_dir, f"scene{img['scene']}", f"{img['image']:05d}.png")

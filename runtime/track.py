@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
+
 from liganimate.lang.numbers import MAX_ANGLE, MAX_FRAME, MIN_FRAME_GAP, magnitude
 from liganimate.runtime import interpolation
 from liganimate.runtime.errors import MotionError
@@ -313,7 +314,7 @@ class Leaf(Track):
         kinds: list = []
         code = np.empty(K, dtype=np.intp)
         for i, m in enumerate(self.methods):
-            for j, known in enumerate(kinds):
+            for j, known in enumerate(kinds):  # noqa: B007 - j is kept by the break
                 if known is m:
                     break
             else:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
 
 from .errors import LigError

@@ -198,10 +198,9 @@ def run_case(text: str, limit: float = 2.0, render: bool = True, memory: int = M
     case may add (0: no limit); ``workdir`` is a folder for the scratch
     files (default: a fresh temporary folder, removed afterwards).
     """
+    from liganimate.cli import load_program
     from liganimate.lang.diagnostics import LigDiagnostics
     from liganimate.runtime.errors import LigError
-
-    from liganimate.cli import load_program
 
     own = workdir is None
     tmp = tempfile.mkdtemp(prefix="ligfuzz-") if own else workdir

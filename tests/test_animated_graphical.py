@@ -7,12 +7,12 @@ import pathlib
 
 import numpy as np
 import pytest
-from liganimate.compiler import NotParsed
-from liganimate.lang.diagnostics import LigDiagnostics
-from liganimate.runtime import values
 from PIL import Image
 
 from liganimate.cli import load_program
+from liganimate.compiler import NotParsed
+from liganimate.lang.diagnostics import LigDiagnostics
+from liganimate.runtime import values
 
 HEAD = """\
       GRAPHICAL ARM, BODY, G, FLOOR

@@ -15,6 +15,7 @@ import pathlib
 
 import numpy as np
 import pytest
+
 from liganimate.compiler import compile_file, load_program
 from liganimate.lang.diagnostics import format_diagnostic
 from liganimate.runtime.loader import exec_module

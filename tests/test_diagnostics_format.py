@@ -14,6 +14,8 @@ import unicodedata
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from mutations import SOURCES, example, mutated, mutations
+
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, format_diagnostic
 from liganimate.lang.display import MAX_COLUMNS
@@ -24,7 +26,6 @@ from liganimate.lang.parser import (
     build_parser,
     parse,
 )
-from mutations import SOURCES, example, mutated, mutations
 
 
 def syntax_error(text: str, name: str = "t.lig") -> Diagnostic:

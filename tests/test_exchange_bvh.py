@@ -11,14 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 from exchange_support import pose_records
-from liganimate.runtime import exchange as X
-
-# bvhio imports PyGLM under its old name; not ours to fix.
-pytestmark = pytest.mark.filterwarnings("ignore:Importing PyGLM:PendingDeprecationWarning")
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.transform import Rotation
 
 from liganimate.cli import load_program
+from liganimate.runtime import exchange as X
+
+# bvhio imports PyGLM under its old name; not ours to fix.
+pytestmark = pytest.mark.filterwarnings("ignore:Importing PyGLM:PendingDeprecationWarning")
 
 WALK = """\
       LOAD HUMANOID, WALK FROM 'humanoid'

@@ -16,9 +16,9 @@ from exchange_support import (
     validate,
     world_transforms,
 )
-from liganimate.runtime import exchange as X
 
 from liganimate.cli import load_program
+from liganimate.runtime import exchange as X
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FPS = 24.0

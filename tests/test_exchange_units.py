@@ -8,6 +8,8 @@ import sys
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
+
 from liganimate.runtime.exchange import write_files
 from liganimate.runtime.exchange._numbers import format_rows
 from liganimate.runtime.exchange._rotations import (
@@ -18,7 +20,6 @@ from liganimate.runtime.exchange._rotations import (
     matrix_from_euler_zyx,
     quaternion_from_matrix,
 )
-from scipy.spatial.transform import Rotation
 
 
 def _parse(data: bytes, columns: int) -> np.ndarray:

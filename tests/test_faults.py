@@ -14,11 +14,11 @@ import sys
 import time
 
 import pytest
+from test_render import children, leftovers, pngs, program, run, wait_gone
 
 from liganimate.runtime import outputs, render
 from liganimate.runtime.errors import RenderError
 from liganimate.runtime.imagefiles import read_png
-from test_render import children, leftovers, pngs, program, run, wait_gone
 
 # --------------------------------------------------------------------------
 # Output options are refused before the program is compiled

@@ -16,8 +16,9 @@ The run is derandomized (the same cases every time) and takes about 15 s.
 from __future__ import annotations
 
 from hypothesis import HealthCheck, event, given, settings
-from liganimate.lang.diagnostics import LigDiagnostics
 from mutations import SOURCES, example, fuzz, mutated, mutations
+
+from liganimate.lang.diagnostics import LigDiagnostics
 
 EXAMPLES = 600
 

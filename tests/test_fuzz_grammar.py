@@ -19,6 +19,7 @@ import fuzzgrammar
 import fuzzrun
 from hypothesis import HealthCheck, Phase, event, given, settings
 from hypothesis import strategies as st
+
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.lang.parser import parse
 

@@ -10,6 +10,7 @@ import warnings
 
 import fuzzrun
 import pytest
+
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 

@@ -10,7 +10,6 @@ tests/golden/_failures/. Regenerate only on purpose:
 
 from __future__ import annotations
 
-import os
 import pathlib
 
 import numpy as np

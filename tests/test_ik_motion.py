@@ -145,7 +145,7 @@ def test_reach_rejects_batched_goals_and_bad_motion_options():
 
 
 def test_unmet_goals_become_one_sentence_each():
-    from liganimate.runtime.reach import PlaneGoal, AxisGoal, residual_warnings
+    from liganimate.runtime.reach import AxisGoal, PlaneGoal, residual_warnings
 
     fig = body()
     goals = [

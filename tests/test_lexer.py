@@ -17,10 +17,11 @@ from importlib import resources
 from hypothesis import HealthCheck, given, settings
 from lark import Lark
 from lark.exceptions import UnexpectedInput
+from mutations import ROOT, SOURCES, example, mutated, mutations
+
 from liganimate.lang import parser as P
 from liganimate.lang.source import prepare
 from liganimate.lang.transform import ToAst
-from mutations import ROOT, SOURCES, example, mutated, mutations
 
 
 @functools.lru_cache(maxsize=1)

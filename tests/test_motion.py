@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from liganimate.runtime import track as tr
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import (

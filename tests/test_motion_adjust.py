@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
 from liganimate.runtime.motion import Motion
 
 METHODS = ["LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"]

@@ -12,6 +12,7 @@ import os
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+
 from liganimate.runtime import track as tr
 from liganimate.runtime.motion import (
     Motion,

@@ -9,8 +9,9 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import assume, given
 from hypothesis import strategies as st
-from liganimate.runtime.motion import Motion, strip, synchronize
 from test_motion_laws import FEW, PROFILE, assert_close, motions, probe_times
+
+from liganimate.runtime.motion import Motion, strip, synchronize
 
 
 def same(m: Motion, n: Motion, extra=()) -> None:

@@ -14,6 +14,7 @@ import sys
 import textwrap
 
 import pytest
+
 from liganimate.lang import numbers as N
 
 BIG = "1" + "0" * 400  # a 401-digit integer

@@ -15,6 +15,7 @@ import textwrap
 import tracemalloc
 
 import pytest
+
 from liganimate.lang import parser as P
 from liganimate.lang import tables
 

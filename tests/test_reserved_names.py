@@ -5,7 +5,6 @@ generated module's own machinery compile, run, render, and survive
 from __future__ import annotations
 
 import importlib.util
-import os
 import subprocess
 import sys
 

@@ -14,6 +14,7 @@ import subprocess
 import sys
 
 import pytest
+
 from liganimate.compiler import compile_file, library, library_cache
 from liganimate.lang.diagnostics import LigDiagnostics
 

@@ -100,7 +100,7 @@ for _right, _left in ((10, 20), (11, 21), (12, 22), (13, 23), (30, 40), (31, 41)
     HUMANOID_EXTREMES[_left] = _mirror(HUMANOID_EXTREMES[_right])
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def values(program_text: str) -> dict:
     """The variables of a small program (compiled in a folder of its own)."""
     import tempfile

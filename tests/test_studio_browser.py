@@ -9,6 +9,7 @@ import time
 import numpy as np
 import pytest
 from browser import Browser, require_chromium
+
 from liganimate.runtime.studio import (
     Session,
     StudioServer,

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
+from liganimate.cli import load_program
 from liganimate.runtime.studio import (
     POPULATION,
     Generator,
@@ -13,8 +15,6 @@ from liganimate.runtime.studio import (
     studio_model,
 )
 from liganimate.runtime.studio._genes import directions, solutions, wrap
-
-from liganimate.cli import load_program
 
 
 @pytest.fixture(scope="module")

@@ -8,6 +8,8 @@ import sys
 
 import numpy as np
 import pytest
+
+from liganimate.cli import load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.runtime import exchange as X
 from liganimate.runtime.pose import mesh_table, world_transforms, world_triangles
@@ -18,8 +20,6 @@ from liganimate.runtime.studio import (
     widened_extremes,
     write_library,
 )
-
-from liganimate.cli import load_program
 
 
 @pytest.fixture(scope="module")

@@ -13,6 +13,7 @@ import sys
 import time
 
 import pytest
+
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.studio import (
     MAX_BODY,

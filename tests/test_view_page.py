@@ -13,12 +13,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from liganimate.runtime import exchange as X
-from liganimate.runtime.pose import mesh_table, world_transforms
-from liganimate.runtime.view import json_for_script, viewer_html
 
 import liganimate
 from liganimate.api import LigProgramError, LoadedProgram
+from liganimate.runtime import exchange as X
+from liganimate.runtime.pose import mesh_table, world_transforms
+from liganimate.runtime.view import json_for_script, viewer_html
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 APPENDIX = os.path.join(ROOT, "examples", "appendix_a.lig")

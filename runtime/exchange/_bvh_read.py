@@ -15,6 +15,7 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
+
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 

@@ -27,6 +27,7 @@ import os
 import re
 
 import numpy as np
+
 from liganimate.compiler.names import reserved
 
 from ..motion import Motion

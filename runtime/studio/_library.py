@@ -22,6 +22,7 @@ from __future__ import annotations
 import re
 
 import numpy as np
+
 from liganimate.compiler.names import reserved
 
 __all__ = ["library_text", "lig_name"]
