@@ -31,11 +31,9 @@ import argparse
 import json
 import os
 import random
-import signal
 import sys
 import time
 import traceback
-from contextlib import contextmanager
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXAMPLES = os.path.join(ROOT, "examples")
@@ -112,37 +110,16 @@ def mutate(text: str, kind: str, u: float, v: float, pick: int) -> str:
     raise ValueError(kind)
 
 
-class Slow(Exception):
-    """The case ran past its time limit."""
-
-
-@contextmanager
-def time_limit(seconds: float):
-    """Raise :class:`Slow` in the main thread after ``seconds`` (SIGALRM; no-op elsewhere)."""
-    if seconds <= 0 or not hasattr(signal, "setitimer"):
-        yield
-        return
-
-    def on_alarm(signum, frame):
-        raise Slow()
-
-    old = signal.signal(signal.SIGALRM, on_alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
+# The time limit is the fuzz harness's own (tests/fuzzrun.py), not a second copy.
+sys.path.insert(0, os.path.join(ROOT, "tests"))
+from fuzzrun import Slow, time_limit  # noqa: E402
 
 
 def compile_and_check(text: str, filename: str = "fuzz.lig") -> None:
     """What ``liganimate check`` does, in process. Raises LigDiagnostics for user errors."""
-    from liganimate.compiler import compile_text
+    from liganimate.compiler import load_program
 
-    compiled = compile_text(text, filename)
-    namespace = {"__name__": "liganimate_fuzz"}
-    exec(compile(compiled.python, f"<liganimate {filename}>", "exec"), namespace)
-    namespace["program"].check()
+    load_program(text=text, name=filename)[0].check()
 
 
 def classify(text: str, limit: float = 2.0):
