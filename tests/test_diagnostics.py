@@ -15,7 +15,7 @@ import sys
 
 import pytest
 
-from liganimate.compiler import compile_text
+from liganimate.compiler import load_program
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, format_diagnostic
 
 # Three unit boxes and a one-joint motion that most tests build on (lines 1-9).
@@ -36,10 +36,7 @@ A_MODEL = "      A :- JOINT 1, S1, (0.0, 0.0, 0.0), S2, (0.0, 0.0, 0.0), (0.0, 0
 
 
 def program_of(text: str, name: str = "t.lig"):
-    compiled = compile_text(text, name)
-    namespace = {"__name__": "liganimate_program"}
-    exec(compile(compiled.python, name, "exec"), namespace)
-    return namespace["program"], compiled.warnings
+    return load_program(text=text, name=name)
 
 
 def diagnose(text: str, name: str = "t.lig") -> Diagnostic:

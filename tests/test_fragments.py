@@ -9,8 +9,7 @@ import os
 import numpy as np
 import pytest
 
-from liganimate.cli import load_program
-from liganimate.compiler import compile_text
+from liganimate.compiler import load_program
 from liganimate.runtime import kinematics as K
 from liganimate.runtime.pose import joint_angles
 
@@ -21,10 +20,7 @@ SQUAT = os.path.join(ROOT, "examples", "reversed_squat.lig")
 
 def program_from_text(text: str, name: str):
     """What load_program does, from text."""
-    compiled = compile_text(text, name)
-    namespace = {"__name__": "liganimate_program"}
-    exec(compile(compiled.python, name, "exec"), namespace)
-    return namespace["program"], compiled.warnings
+    return load_program(text=text, name=name)
 
 
 @pytest.fixture(scope="module")

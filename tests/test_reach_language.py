@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from liganimate.compiler import compile_text
+from liganimate.compiler import load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.runtime.kinematics import pose_transforms
 from liganimate.runtime.pose import joint_angles
@@ -24,11 +24,9 @@ ENDMODEL
 
 def run(text: str):
     """Compile and execute in check mode; return (variables, warnings)."""
-    compiled = compile_text(text, "reach.lig")
-    namespace: dict = {}
-    exec(compile(compiled.python, "reach.py", "exec"), namespace)
-    rt = namespace["program"].execute("check")
-    return rt.variables, compiled.warnings + rt.warnings
+    program, warnings = load_program(text=text, name="reach.lig")
+    rt = program.execute("check")
+    return rt.variables, warnings + rt.warnings
 
 
 def tip(variables, motion_name: str, frame: float) -> np.ndarray:

@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from liganimate.compiler import compile_text
+from liganimate.compiler import compile_text, load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 
 # class, None, self ... as GRAPHICAL objects, MODELs, MOTIONs, INTEGERs,
@@ -71,10 +71,7 @@ C the names the generated module uses itself.
 
 
 def program_of(text: str, name: str = "names.lig"):
-    compiled = compile_text(text, name)
-    namespace = {"__name__": "liganimate_program"}
-    exec(compile(compiled.python, name, "exec"), namespace)
-    return namespace["program"], compiled.warnings
+    return load_program(text=text, name=name)
 
 
 def check_values(variables):
