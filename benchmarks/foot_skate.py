@@ -30,13 +30,13 @@ import tempfile
 import numpy as np
 
 from liganimate.cli import load_program
-from liganimate.runtime.host import Posed
-from liganimate.runtime.pose import (
+from liganimate.runtime.figure.pose import (
     joint_angles,
     mesh_table,
     world_transforms,
     world_triangles,
 )
+from liganimate.runtime.host import Posed
 
 # Body speed (metres a frame) of the scene-level translation for each motion:
 # WALK, 1.2 m per 24-frame cycle (examples/walk_and_wave.lig moves 0.05 a tick);

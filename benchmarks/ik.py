@@ -47,9 +47,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from liganimate.runtime import kinematics as K  # noqa: E402
-from liganimate.runtime.figure import Figure, Joint, Link  # noqa: E402
-from liganimate.runtime.reach import PointGoal, solve_pose  # noqa: E402
+from liganimate.runtime.figure import kinematics as K  # noqa: E402
+from liganimate.runtime.figure.tree import Figure, Joint, Link  # noqa: E402
+from liganimate.runtime.ik.reach import PointGoal, solve_pose  # noqa: E402
 
 CHAINS = (6, 10, 30)
 TARGETS = 1000

@@ -34,8 +34,8 @@ import time
 import numpy as np
 
 from liganimate.cli import load_program
+from liganimate.runtime.figure.pose import joint_angles, world_transforms
 from liganimate.runtime.host import Posed
-from liganimate.runtime.pose import joint_angles, world_transforms
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROGRAM = os.path.join(HERE, "..", "examples", "appendix_a.lig")

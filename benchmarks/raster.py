@@ -37,9 +37,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from liganimate.runtime.camera import Camera  # noqa: E402
-from liganimate.runtime.imagefiles import write_png  # noqa: E402
-from liganimate.runtime.raster import rasterize  # noqa: E402
+from liganimate.runtime.render.camera import Camera  # noqa: E402
+from liganimate.runtime.render.imagefiles import write_png  # noqa: E402
+from liganimate.runtime.render.raster import rasterize  # noqa: E402
 
 SIZE = (640, 480)
 VIEW_POINT = (3.0, 4.0, 14.0)

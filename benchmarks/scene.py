@@ -37,8 +37,8 @@ import time
 import numpy as np
 
 from liganimate.cli import load_program
-from liganimate.runtime import render as R
-from liganimate.runtime.camera import Camera
+from liganimate.runtime.render import frames as R
+from liganimate.runtime.render.camera import Camera
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, "five_humans.lig")
@@ -175,7 +175,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as out:
         _, loop_img = run_loop(captured[-1:], size, out, save=False)
     cam = Camera(captured[-1][0][0], captured[-1][0][1], size)
-    from liganimate.runtime.raster import rasterize
+    from liganimate.runtime.render.raster import rasterize
 
     ours = rasterize(captured[-1][1], captured[-1][2], cam, cull=captured[-1][3])
     differ = int((ours != loop_img).sum())

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from liganimate.lang import ast as A
 from liganimate.lang import numbers
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
-from liganimate.runtime import interpolation
+from liganimate.runtime.motion import interpolation
 
 from . import types as T
 from .primitives import builtin_signatures, signature_from_pattern

@@ -17,8 +17,7 @@ from __future__ import annotations
 import math
 
 from liganimate.lang import numbers as N
-
-from .values import Vec
+from liganimate.runtime.values import Vec
 
 _R = N.REAL_MAX
 _RESULT = {"+": "the sum", "-": "the difference", "*": "the product"}

@@ -20,15 +20,14 @@ import numpy as np
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
-
-from . import figure as F
-from . import limits
-from . import motion as M
-from . import pose as P
-from .arithmetic import Arithmetic
-from .errors import LigError
-from .library import Library  # noqa: F401  (generated modules name it _host.Library)
-from .values import EMPTY, ZERO, Canvas, Graphical, Vec, box
+from liganimate.runtime import limits
+from liganimate.runtime.arithmetic import Arithmetic
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure import pose as P
+from liganimate.runtime.figure import tree as F
+from liganimate.runtime.library import Library  # noqa: F401  (generated modules name it _host.Library)
+from liganimate.runtime.motion import algebra as M
+from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
 #: How often a long scene reports its progress while it is checked, in ticks.
 PROGRESS_TICKS = 4096
@@ -152,7 +151,7 @@ class Program:
         ``checked=True`` says the caller has just run :meth:`check` itself
         (the command line does, to show its warnings first), so it is not run twice.
         """
-        from .render import Renderer
+        from liganimate.runtime.render.frames import Renderer
 
         if not checked:
             self.check()
@@ -167,7 +166,7 @@ class Program:
 
 def overflow(program: Program, value, kind, at):
     """Report a + - * value out of range from a compiled module's own check (``_ck``), at ``at``."""
-    from .arithmetic import overflow_error
+    from liganimate.runtime.arithmetic import overflow_error
 
     exc = overflow_error(value, kind)
     raise LigDiagnostics([Diagnostic(program.name, Pos(*program.positions[at]), exc.message, exc.hint,
@@ -450,7 +449,7 @@ class Runtime(Arithmetic):
     # ------------------------------------------------------------- REACH
     def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
         """A STARTREACH block: (the motion to the solved pose, the solved translation)."""
-        from . import reach as R
+        from liganimate.runtime.ik import reach as R
 
         fig = self._model(model, at, "the model of a REACH")
         start_motion = self._motion(start, at) if start is not None else None
@@ -683,7 +682,7 @@ class Runtime(Arithmetic):
         if kind == "table":
             fig = self._model(value, at, label)
             if isinstance(value, Posed):
-                from .pose import joint_angles
+                from liganimate.runtime.figure.pose import joint_angles
 
                 angles, vel, acc = joint_angles(fig, value.motion, np.array([value.frame]), full=True)
                 return f"MODEL {label} at frame {value.frame:g}\n" + fig.describe_table(angles[0], vel[0], acc[0])

@@ -13,8 +13,8 @@ from __future__ import annotations
 import hashlib
 import io
 
-from .errors import LigError
-from .loader import exec_module
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.loader import exec_module
 
 _runs: dict = {}  # sha256 of the module text -> (namespace, variables, warnings)
 

@@ -23,9 +23,8 @@ import math
 import numpy as np
 
 from liganimate.lang.numbers import GEOMETRY_MAX, GEOMETRY_MIN, magnitude
-
-from .errors import LigError
-from .values import Graphical
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.values import Graphical
 
 _HINT = "everything drawn must stay within 1E12 units of the origin along each axis"
 

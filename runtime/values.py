@@ -13,8 +13,7 @@ import math
 import numpy as np
 
 from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
-
-from .errors import LigError
+from liganimate.runtime.errors import LigError
 
 
 class Vec(tuple):

@@ -16,9 +16,10 @@ import time
 import pytest
 from test_render import children, leftovers, pngs, program, run, wait_gone
 
-from liganimate.runtime import outputs, render
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.imagefiles import read_png
+from liganimate.runtime.render import frames as render
+from liganimate.runtime.render import outputs
+from liganimate.runtime.render.imagefiles import read_png
 
 # --------------------------------------------------------------------------
 # Output options are refused before the program is compiled
@@ -113,7 +114,7 @@ def test_the_library_refuses_the_same_options_by_their_keyword_names(tmp_path):
 # in the command's own process, then runs the command.
 _ENOSPC_POSES = """
 import errno, os, sys
-from liganimate.runtime import imagefiles
+from liganimate.runtime.render import imagefiles
 real = os.write
 def write(fd, data):
     if ".poses.jsonl." in os.readlink(f"/proc/self/fd/{fd}"):
@@ -247,7 +248,7 @@ def test_locks_exclude_within_one_process_and_are_released(tmp_path):
 
 
 def test_errno_words_keep_unknown_errors_readable():
-    from liganimate.runtime.imagefiles import os_error_words
+    from liganimate.runtime.render.imagefiles import os_error_words
 
     assert os_error_words(OSError(errno.ENOSPC, "No space left on device")) == "no space left on device"
     assert os_error_words(OSError(errno.ENXIO, "No such device or address")) == "no such device or address"

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from liganimate.runtime.errors import FigureError
-from liganimate.runtime.figure import Figure, Joint, JointSpec, Link, assemble, join, normalize_extremes
-from liganimate.runtime.kinematics import invert_transform, pose_transforms, shape_transforms, transform_from
+from liganimate.runtime.figure.kinematics import invert_transform, pose_transforms, shape_transforms, transform_from
+from liganimate.runtime.figure.tree import Figure, Joint, JointSpec, Link, assemble, join, normalize_extremes
 
 FREE = [(-180, 180)] * 3
 

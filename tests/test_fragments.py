@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from liganimate.compiler import load_program
-from liganimate.runtime import kinematics as K
-from liganimate.runtime.pose import joint_angles
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure.pose import joint_angles
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FRAGMENTS = os.path.join(ROOT, "examples", "thesis_fragments.lig")

@@ -17,7 +17,7 @@ import pytest
 from PIL import Image
 
 from liganimate.cli import load_program
-from liganimate.runtime.imagefiles import read_png
+from liganimate.runtime.render.imagefiles import read_png
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"

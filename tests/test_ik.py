@@ -10,12 +10,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from liganimate.runtime import kinematics as K
 from liganimate.runtime.errors import LigError
-from liganimate.runtime.figure import Figure, Joint, Link
-from liganimate.runtime.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal
-from liganimate.runtime.ikmodel import IKModel
-from liganimate.runtime.reach import solve_pose
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure.tree import Figure, Joint, Link
+from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal
+from liganimate.runtime.ik.model import IKModel
+from liganimate.runtime.ik.reach import solve_pose
 
 SOLVERS = ["dls", "transpose", "ccd"]
 FREE = [(-180, 180)] * 3
@@ -483,7 +483,7 @@ def test_restarts_find_poses_the_start_cannot_and_leave_unreachable_goals_alone(
 def test_one_pose_evaluation_equals_the_batched_one(seed):
     """The single solve's kinematics and goals (IKModel.forward_one, GoalStack.evaluate_one) against
     the batched ones: trees with random main links, chains, placements, translation, every goal kind."""
-    from liganimate.runtime import solvers as S
+    from liganimate.runtime.ik import solvers as S
 
     rng = np.random.default_rng(seed)
     fig = random_tree(rng, int(rng.integers(2, 9))) if seed % 3 else chain(int(rng.integers(1, 8)))
@@ -516,7 +516,7 @@ def test_one_pose_evaluation_equals_the_batched_one(seed):
 def test_single_dls_solves_take_the_batched_loops_steps(monkeypatch):
     """A batch of one runs its own loop (solvers._dls_one); with restarts, given-up attempts,
     iteration limits and unreachable goals it ends where the batched loop ends a batch of one."""
-    from liganimate.runtime import solvers as S
+    from liganimate.runtime.ik import solvers as S
 
     def batched_loop(prob, x, tol, max_iter, restarts, seed, trace):
         st = S._State(prob, x[None].copy(), tol, trace, jac=True, max_iter=max_iter, restarts=restarts, seed=seed)

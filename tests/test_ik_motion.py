@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from liganimate.runtime import kinematics as K
-from liganimate.runtime import motion as M
-from liganimate.runtime import pose as P
-from liganimate.runtime.figure import Figure, Joint, Link
-from liganimate.runtime.reach import GoalError, PointGoal, reach, reach_keyframes, solve_pose
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import pose as P
+from liganimate.runtime.figure.tree import Figure, Joint, Link
+from liganimate.runtime.ik.reach import GoalError, PointGoal, reach, reach_keyframes, solve_pose
+from liganimate.runtime.motion import algebra as M
 
 EXT = [(-120, 120)] * 3
 
@@ -145,7 +145,7 @@ def test_reach_rejects_batched_goals_and_bad_motion_options():
 
 
 def test_unmet_goals_become_one_sentence_each():
-    from liganimate.runtime.reach import AxisGoal, PlaneGoal, residual_warnings
+    from liganimate.runtime.ik.reach import AxisGoal, PlaneGoal, residual_warnings
 
     fig = body()
     goals = [

@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 
 from liganimate.cli import load_program
-from liganimate.runtime import kinematics as K
-from liganimate.runtime.reach import PointGoal, solve_pose
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.ik.reach import PointGoal, solve_pose
 
 MM = 1e-3
 

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from liganimate.runtime import imagefiles
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.imagefiles import encode_png, read_png, write_gif, write_mp4, write_png
+from liganimate.runtime.render import imagefiles
+from liganimate.runtime.render.imagefiles import encode_png, read_png, write_gif, write_mp4, write_png
 
 
 def frames(n, shape=(48, 64), seed=0):
@@ -326,7 +326,7 @@ import numpy as np
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
 resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.imagefiles import write_gif
+from liganimate.runtime.render.imagefiles import write_gif
 rng = np.random.default_rng(0)
 try:
     write_gif({str(tmp_path / "big.gif")!r}, (rng.integers(0, 256, (64, 64), dtype=np.uint8) for _ in range(40)), 10)

@@ -7,9 +7,9 @@ import importlib.metadata
 import numpy as np
 import pytest
 
-from liganimate.runtime import interpolation as I
 from liganimate.runtime.errors import MotionError
-from liganimate.runtime.motion import Motion
+from liganimate.runtime.motion import interpolation as I
+from liganimate.runtime.motion.algebra import Motion
 
 BUILTINS = ["LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"]
 U = np.linspace(0.0, 1.0, 101)

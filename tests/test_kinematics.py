@@ -7,8 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from liganimate.runtime.figure import Figure, Joint, Link, join
-from liganimate.runtime.kinematics import (
+from liganimate.runtime.figure.kinematics import (
     clamp,
     free_axes,
     invert_transform,
@@ -19,6 +18,7 @@ from liganimate.runtime.kinematics import (
     shape_transforms,
     transform_from,
 )
+from liganimate.runtime.figure.tree import Figure, Joint, Link, join
 
 
 def rot(axis: str, deg: float) -> np.ndarray:

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from liganimate.runtime import track as tr
 from liganimate.runtime.errors import MotionError
-from liganimate.runtime.motion import (
+from liganimate.runtime.motion import track as tr
+from liganimate.runtime.motion.algebra import (
     Motion,
     repeat,
     scale_extremes,

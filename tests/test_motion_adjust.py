@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from liganimate.runtime.motion import Motion
+from liganimate.runtime.motion.algebra import Motion
 
 METHODS = ["LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"]
 

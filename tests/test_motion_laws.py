@@ -13,8 +13,8 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from liganimate.runtime import track as tr
-from liganimate.runtime.motion import (
+from liganimate.runtime.motion import track as tr
+from liganimate.runtime.motion.algebra import (
     Motion,
     repeat,
     scale_extremes,

@@ -11,7 +11,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 from test_motion_laws import FEW, PROFILE, assert_close, motions, probe_times
 
-from liganimate.runtime.motion import Motion, strip, synchronize
+from liganimate.runtime.motion.algebra import Motion, strip, synchronize
 
 
 def same(m: Motion, n: Motion, extra=()) -> None:

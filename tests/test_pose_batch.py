@@ -12,11 +12,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from liganimate.runtime import kinematics as K
-from liganimate.runtime import motion as M
-from liganimate.runtime import pose
-from liganimate.runtime.figure import Link, join
-from liganimate.runtime.render import Renderer
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import pose
+from liganimate.runtime.figure.tree import Link, join
+from liganimate.runtime.motion import algebra as M
+from liganimate.runtime.render.frames import Renderer
 from liganimate.runtime.values import box
 
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from liganimate.runtime.camera import Camera
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.raster import Framebuffer, _expand, _spans, rasterize
+from liganimate.runtime.render.camera import Camera
+from liganimate.runtime.render.raster import Framebuffer, _expand, _spans, rasterize
 
 # Camera used for exact tests: the plane through the origin is 8 px per unit,
 # and every number involved is exact in binary floating point.
@@ -235,7 +235,7 @@ def test_equal_depth_later_triangle_wins():
 
 
 def test_large_draws_in_chunks_give_the_same_image(monkeypatch):
-    from liganimate.runtime import raster
+    from liganimate.runtime.render import raster
 
     rng = np.random.default_rng(5)
     tris = rng.uniform(-3, 3, (80, 3, 3))

@@ -7,8 +7,8 @@ import pytest
 
 from liganimate.compiler import load_program
 from liganimate.lang.diagnostics import LigDiagnostics
-from liganimate.runtime.kinematics import pose_transforms
-from liganimate.runtime.pose import joint_angles
+from liganimate.runtime.figure.kinematics import pose_transforms
+from liganimate.runtime.figure.pose import joint_angles
 
 # A planar two-segment arm of unit segments, hanging from the origin along -Y.
 ARM = """\

@@ -21,9 +21,9 @@ import pytest
 from PIL import Image
 
 from liganimate.cli import load_program
-from liganimate.runtime import imagefiles
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.imagefiles import read_png
+from liganimate.runtime.render import imagefiles
+from liganimate.runtime.render.imagefiles import read_png
 from liganimate.runtime.values import _solid_orientation, polygons_to_graphical
 
 # A body with a swinging arm: small and quick to draw, and each tick differs.
@@ -411,9 +411,9 @@ def test_open_or_inconsistent_surfaces_are_not_culled():
 
 
 def test_culling_leaves_the_appendix_a_picture_unchanged(tmp_path):
-    from liganimate.runtime import pose
-    from liganimate.runtime.camera import Camera
-    from liganimate.runtime.raster import rasterize
+    from liganimate.runtime.figure import pose
+    from liganimate.runtime.render.camera import Camera
+    from liganimate.runtime.render.raster import rasterize
 
     prog, _ = load_program(str(pathlib.Path(__file__).parent.parent / "examples" / "appendix_a.lig"))
     rt = prog.execute("check")

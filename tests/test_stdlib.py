@@ -22,8 +22,8 @@ import pytest
 
 from liganimate.cli import load_program
 from liganimate.compiler import library
-from liganimate.runtime import kinematics as K
-from liganimate.runtime import pose as P
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import pose as P
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 STDLIB = ROOT / "stdlib"

@@ -314,7 +314,7 @@ def test_bad_arguments_change_nothing(humanoid, call):
 
 
 def test_a_model_without_joints_is_refused():
-    from liganimate.runtime.figure import Figure, Link
+    from liganimate.runtime.figure.tree import Figure, Link
     from liganimate.runtime.values import EMPTY
 
     with pytest.raises(ValueError, match="no joints"):

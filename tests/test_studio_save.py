@@ -12,7 +12,7 @@ import pytest
 from liganimate.cli import load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.runtime import exchange as X
-from liganimate.runtime.pose import mesh_table, world_transforms, world_triangles
+from liganimate.runtime.figure.pose import mesh_table, world_transforms, world_triangles
 from liganimate.runtime.studio import (
     Generator,
     library_text,

@@ -17,7 +17,7 @@ import pytest
 import liganimate
 from liganimate.api import LigProgramError, LoadedProgram
 from liganimate.runtime import exchange as X
-from liganimate.runtime.pose import mesh_table, world_transforms
+from liganimate.runtime.figure.pose import mesh_table, world_transforms
 from liganimate.runtime.view import json_for_script, viewer_html
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

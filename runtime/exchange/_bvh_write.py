@@ -21,8 +21,9 @@ import re
 
 import numpy as np
 
-from ..errors import LigError
-from ..values import Graphical
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.values import Graphical
+
 from ._numbers import format_rows
 from ._rotations import decompose_trs, euler_zyx_from_matrix
 

@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import figure as F
-from ..pose import joint_angles
-from ..values import Graphical
+from liganimate.runtime.figure import tree as F
+from liganimate.runtime.figure.pose import joint_angles
+from liganimate.runtime.values import Graphical
 
 __all__ = ["ModelTake", "SceneCollector", "SceneTake", "collect"]
 

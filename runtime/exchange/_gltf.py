@@ -18,10 +18,11 @@ import base64
 import numpy as np
 import pygltflib as G
 
-from ..camera import Camera
-from ..errors import LigError
-from ..pose import static_triangles
-from ..values import Graphical, grey_levels
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure.pose import static_triangles
+from liganimate.runtime.render.camera import Camera
+from liganimate.runtime.values import Graphical, grey_levels
+
 from ._rotations import (
     continuous_quaternions,
     decompose_trs,

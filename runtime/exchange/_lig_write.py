@@ -29,8 +29,8 @@ import re
 import numpy as np
 
 from liganimate.compiler.names import reserved
+from liganimate.runtime.motion.algebra import Motion
 
-from ..motion import Motion
 from ._numbers import format_rows
 from ._rotations import euler_zyx_from_matrix, matrix_from_axes
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import matrix_from_euler_zyx
+from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
 
 __all__ = [
     "continuous_quaternions",

@@ -31,8 +31,9 @@ import copy
 
 import numpy as np
 
-from .. import kinematics as K
-from ..pose import world_transforms
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure.pose import world_transforms
+
 from ._genes import alternatives, joint_axes
 
 __all__ = ["POPULATION", "Generator"]

@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kinematics import matrix_from_euler_zyx
+from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
+
 from . import _spheres
 
 __all__ = ["Alternatives", "JointAxes", "alternatives", "joint_axes", "wrap"]

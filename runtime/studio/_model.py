@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import io
 
-from ..errors import LigError
-from ..figure import Figure
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure.tree import Figure
 
 __all__ = ["studio_model"]
 

@@ -16,9 +16,9 @@ from importlib import resources
 import numpy as np
 
 from liganimate import __version__
+from liganimate.runtime.figure.pose import mesh_table
+from liganimate.runtime.view import Blob, asset, fill, inline_code, json_for_script
 
-from ..pose import mesh_table
-from ..view import Blob, asset, fill, inline_code, json_for_script
 from ._generator import POPULATION
 
 __all__ = ["studio_page"]

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..pose import mesh_table, static_triangles, world_transforms
-from ..values import Graphical, grey_levels
+from liganimate.runtime.figure.pose import mesh_table, static_triangles, world_transforms
+from liganimate.runtime.values import Graphical, grey_levels
 
 __all__ = ["Blob", "scene_manifest"]
 

@@ -65,8 +65,8 @@ def _check_render_options(args, stem: str) -> str:
     Nothing is written here: the folder and lock files are made when
     rendering starts.  An output another run is writing is refused now too.
     """
-    from liganimate.runtime.imagefiles import find_ffmpeg
-    from liganimate.runtime.outputs import (
+    from liganimate.runtime.render.imagefiles import find_ffmpeg
+    from liganimate.runtime.render.outputs import (
         CLI_NAMES,
         check_fps,
         check_outputs,
@@ -138,7 +138,7 @@ def _guarded(fn):
     from liganimate.lang.diagnostics import LigDiagnostics
     from liganimate.lang.display import escape_text
     from liganimate.runtime.errors import LigError
-    from liganimate.runtime.imagefiles import os_error_words
+    from liganimate.runtime.render.imagefiles import os_error_words
 
     try:
         return fn()
@@ -226,7 +226,7 @@ def cmd_check(args) -> int:
 def cmd_compile(args) -> int:
     def go():
         from liganimate.compiler import compile_file
-        from liganimate.runtime.imagefiles import AtomicWriter
+        from liganimate.runtime.render.imagefiles import AtomicWriter
 
         compiled = compile_file(args.file)
         _print_diagnostics(compiled.warnings)
@@ -243,7 +243,7 @@ def cmd_archive(args) -> int:
         from liganimate.compiler import compile_source
         from liganimate.compiler.archive import archive_text
         from liganimate.lang.source import prepare
-        from liganimate.runtime.imagefiles import AtomicWriter
+        from liganimate.runtime.render.imagefiles import AtomicWriter
 
         out = args.output or os.path.splitext(os.path.basename(args.file))[0] + "_lib.lig"
         text = archive_text(args.file, out)
@@ -285,7 +285,7 @@ def cmd_lib(args) -> int:
 
 def cmd_plot(args) -> int:
     def go():
-        from liganimate.runtime.plot import plot_motion
+        from liganimate.runtime.render.plot import plot_motion
 
         program, warnings = load_program(args.file)
         _print_diagnostics(warnings)

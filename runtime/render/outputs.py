@@ -27,7 +27,7 @@ import re
 import struct
 import sys
 
-from .errors import RenderError
+from liganimate.runtime.errors import RenderError
 
 LOCK_NAME = ".liganimate.lock"
 # The names AtomicWriter's temporary files take (mkstemp: 8 characters of [a-z0-9_]).

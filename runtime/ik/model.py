@@ -22,7 +22,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from .figure import Figure
+from liganimate.runtime.figure.tree import Figure
 
 __all__ = ["IKModel", "link_lengths", "figure_length", "matvec3", "cross3"]
 

@@ -12,7 +12,7 @@ replaces it with a trapezoidal velocity profile.  Every other method is used
 with its exact ease curve ("fixed shape") where its neighbours meet it at
 its natural velocities ``(D/T) e'(0)`` and ``(D/T) e'(1)``, and as a
 monotone cubic Hermite where the velocity adjustment gives it others (see
-``docs/semantics-motion.md`` and ``liganimate.runtime.track``).
+``docs/semantics-motion.md`` and ``liganimate.runtime.motion.track``).
 """
 
 from __future__ import annotations

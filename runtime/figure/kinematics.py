@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .figure import Figure
+from liganimate.runtime.figure.tree import Figure
 
 __all__ = [
     "matrix_from_euler_zyx",

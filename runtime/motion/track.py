@@ -20,8 +20,8 @@ from typing import NamedTuple
 import numpy as np
 
 from liganimate.lang.numbers import MAX_ANGLE, MAX_FRAME, MIN_FRAME_GAP, magnitude
-from liganimate.runtime import interpolation
 from liganimate.runtime.errors import MotionError
+from liganimate.runtime.motion import interpolation
 
 RAMP = 3.0
 """Frames a LINEAR segment spends reaching its cruise speed (before SCALE FRAMES)."""

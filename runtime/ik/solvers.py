@@ -37,8 +37,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .goals import GoalStack
-from .ikmodel import IKModel, cross3
+from liganimate.runtime.ik.goals import GoalStack
+from liganimate.runtime.ik.model import IKModel, cross3
 
 __all__ = ["SOLVERS", "SolveResult", "solve", "CONVERGED", "STALLED", "LIMIT"]
 

@@ -26,9 +26,16 @@ from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
-from .camera import Camera
-from .errors import RenderError
-from .imagefiles import (
+from liganimate.runtime.errors import RenderError
+from liganimate.runtime.figure.pose import (
+    joint_angles,
+    mesh_table,
+    static_triangles,
+    world_transforms,
+    world_triangles,
+)
+from liganimate.runtime.render.camera import Camera
+from liganimate.runtime.render.imagefiles import (
     AtomicWriter,
     find_ffmpeg,
     fsync_folder,
@@ -38,16 +45,9 @@ from .imagefiles import (
     write_mp4,
     write_png,
 )
-from .outputs import KEYWORD_NAMES, OutputLock, check_outputs
-from .pose import (
-    joint_angles,
-    mesh_table,
-    static_triangles,
-    world_transforms,
-    world_triangles,
-)
-from .raster import Framebuffer, rasterize
-from .values import Graphical, grey_levels
+from liganimate.runtime.render.outputs import KEYWORD_NAMES, OutputLock, check_outputs
+from liganimate.runtime.render.raster import Framebuffer, rasterize
+from liganimate.runtime.values import Graphical, grey_levels
 
 # Images whose poses are evaluated together.
 BATCH = 32

@@ -26,9 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import LigError
-from .figure import Figure
-from .ikmodel import IKModel, cross3, matvec3
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure.tree import Figure
+from liganimate.runtime.ik.model import IKModel, cross3, matvec3
 
 __all__ = [
     "GoalError",

@@ -1,6 +1,6 @@
 """Motion values: per-joint tracks with the thesis' motion algebra.
 
-A :class:`Motion` maps joint ids to tracks (see :mod:`liganimate.runtime.track`).
+A :class:`Motion` maps joint ids to tracks (see :mod:`liganimate.runtime.motion.track`).
 It is immutable, and every operation is lazy: ``a + b``, ``n * a``, STRIP,
 SYNCHRONIZE and the SCALE transforms build new node graphs of a size that
 does not depend on repetition counts, so ``10**9 * walk`` costs what ``walk``
@@ -15,9 +15,9 @@ from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
-from liganimate.runtime import interpolation
-from liganimate.runtime import track as tr
 from liganimate.runtime.errors import MotionError
+from liganimate.runtime.motion import interpolation
+from liganimate.runtime.motion import track as tr
 
 __all__ = [
     "DEFAULT_KEYFRAME_LIMIT",

@@ -24,7 +24,7 @@ from typing import Self
 
 import numpy as np
 
-from .errors import RenderError
+from liganimate.runtime.errors import RenderError
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 # Chosen by measurement on flat-shaded 640x480 frames of five figures
@@ -380,7 +380,7 @@ def find_ffmpeg() -> str:
 
 
 def _check_fps(fps) -> float:
-    from .outputs import MAX_FPS, MIN_FPS
+    from liganimate.runtime.render.outputs import MAX_FPS, MIN_FPS
 
     try:
         f = float(fps)

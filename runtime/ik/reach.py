@@ -28,13 +28,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kinematics as K
-from . import pose as PO
-from .figure import Figure
-from .goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
-from .ikmodel import IKModel
-from .motion import Motion
-from .solvers import CONVERGED, LIMIT, SOLVERS, STALLED, solve
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import pose as PO
+from liganimate.runtime.figure.tree import Figure
+from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
+from liganimate.runtime.ik.model import IKModel
+from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVERS, STALLED, solve
+from liganimate.runtime.motion.algebra import Motion
 
 __all__ = [
     "PointGoal",
@@ -236,7 +236,7 @@ def _movable_mask(figure: Figure, goals: Sequence, movable) -> np.ndarray:
 def _options(figure: Figure, solver: str, tolerance, max_iterations) -> tuple[float, int]:
     if solver not in SOLVERS:
         raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVERS)}")
-    from .ikmodel import figure_length
+    from liganimate.runtime.ik.model import figure_length
 
     if tolerance is None:
         tol = DEFAULT_TOLERANCE * figure_length(figure)

@@ -35,8 +35,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .camera import Camera
-from .errors import RenderError
+from liganimate.runtime.errors import RenderError
+from liganimate.runtime.render.camera import Camera
 
 # The depth buffer's "nothing drawn here".  Every fragment's key is
 # positive (it starts with the bits of a positive float64).

@@ -11,10 +11,10 @@ import weakref
 
 import numpy as np
 
-from . import figure as F
-from . import kinematics as K
-from .motion import Motion
-from .values import Graphical, grey_levels
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import tree as F
+from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.values import Graphical, grey_levels
 
 # (id(motion), id(joints)) -> (motion, joints, bound); the stored objects keep
 # the ids valid. Bounded so a long program cannot grow it without limit.

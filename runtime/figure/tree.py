@@ -39,8 +39,7 @@ from typing import NamedTuple
 import numpy as np
 
 from liganimate.lang.numbers import INT_MAX, MAX_ANGLE, magnitude
-
-from .errors import FigureError
+from liganimate.runtime.errors import FigureError
 
 __all__ = [
     "AXES",

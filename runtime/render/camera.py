@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .errors import RenderError
+from liganimate.runtime.errors import RenderError
 
 DEFAULT_SIZE = (640, 480)
 

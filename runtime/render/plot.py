@@ -12,8 +12,8 @@ import io
 
 import numpy as np
 
-from .errors import LigError
-from .imagefiles import AtomicWriter
+from liganimate.runtime.errors import LigError
+from liganimate.runtime.render.imagefiles import AtomicWriter
 
 # Samples across the whole motion: enough for smooth curves over a few
 # hundred frames, bounded so that ``1000000000 * WALK`` still plots at once.
@@ -77,8 +77,7 @@ def plot_motion(rt, name: str, out_path: str) -> None:
         When the program has no such motion. Nothing is written then.
     """
     from liganimate.lang.diagnostics import did_you_mean
-
-    from .motion import Motion
+    from liganimate.runtime.motion.algebra import Motion
 
     variables = rt.variables
     value = variables.get(name)

@@ -1,0 +1,10 @@
+"""Goal-directed posing: weighted goals, the solvers, and REACH.
+
+Owns :mod:`.model` (a figure as the solvers see it), :mod:`.goals` (goal
+kinds, residuals, Jacobians), :mod:`.solvers` (damped least squares, Jacobian
+transpose, cyclic coordinate descent) and :mod:`.reach` (poses and motions
+that meet goals).
+
+May import: :mod:`liganimate.runtime.errors`, :mod:`liganimate.runtime.figure`,
+:mod:`liganimate.runtime.motion` and its own modules.
+"""
