@@ -58,9 +58,28 @@ def thesis_style_program(lines: int = 10_000) -> str:
     with open(APPENDIX_A, encoding="utf-8") as fh:
         text = fh.read()
     head_end = text.index("      END\n") + len("      END\n")  # the PRIMITIVE BOX
-    body = text[head_end:text.index("*     SHOOTSCENE")]
-    names = ["HEAD", "BODY", "TORSO", "FARM", "BARM", "FLEG", "BLEG", "FOOT", "LOCATN", "DISTAN",
-             "VUWID", "TORWID", "FRMNUM", "HUMAN", "LARM", "RARM", "LLEG", "RLEG", "SQUAT"]
+    body = text[head_end : text.index("*     SHOOTSCENE")]
+    names = [
+        "HEAD",
+        "BODY",
+        "TORSO",
+        "FARM",
+        "BARM",
+        "FLEG",
+        "BLEG",
+        "FOOT",
+        "LOCATN",
+        "DISTAN",
+        "VUWID",
+        "TORWID",
+        "FRMNUM",
+        "HUMAN",
+        "LARM",
+        "RARM",
+        "LLEG",
+        "RLEG",
+        "SQUAT",
+    ]
     word = re.compile(r"\b(" + "|".join(names) + r")\b")
     out = [text[:head_end]]
     total = text[:head_end].count("\n") + 3
@@ -76,8 +95,7 @@ def thesis_style_program(lines: int = 10_000) -> str:
 
 def big_program(lines: int = 10_000) -> str:
     """A dense program of ``lines`` lines, every line a statement, using most statement kinds."""
-    out = ["REAL X, Y", "VECTOR V", "MOTION M", "GRAPHICAL G", "MODEL A",
-           "G :- BOX WIDTH 1, HEIGHT 2, DEPTH 0.5"]
+    out = ["REAL X, Y", "VECTOR V", "MOTION M", "GRAPHICAL G", "MODEL A", "G :- BOX WIDTH 1, HEIGHT 2, DEPTH 0.5"]
     i = 0
     while len(out) < lines:
         i += 1
@@ -121,8 +139,11 @@ def scale_times(rounds: int) -> dict:
             rounds_n = rounds if n < 50_000 else max(1, rounds // 2)
             t_parse = best(lambda: P.parse(text, f"{style}.lig"), rounds_n, clock=time.process_time)  # noqa: B023
             t_compile = best(lambda: compile_text(text, f"{style}.lig"), rounds_n, clock=time.process_time)  # noqa: B023
-            out[f"{style}_{n}"] = {"lines": lines, "parse_us_per_line": round(t_parse / lines * 1e6, 2),
-                                   "compile_us_per_line": round(t_compile / lines * 1e6, 2)}
+            out[f"{style}_{n}"] = {
+                "lines": lines,
+                "parse_us_per_line": round(t_parse / lines * 1e6, 2),
+                "compile_us_per_line": round(t_compile / lines * 1e6, 2),
+            }
     return out
 
 
@@ -172,10 +193,12 @@ def best(fn, rounds: int, clock=time.perf_counter) -> float:
 
 def cold(cmd: list, rounds: int) -> float:
     """The shortest wall time of running ``cmd`` in a new process."""
+
     def once():
         r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, check=False)
         if r.returncode != 0:
             raise SystemExit(f"{' '.join(cmd)} failed:\n{r.stderr}")
+
     return best(once, rounds)
 
 
@@ -199,8 +222,14 @@ def main(argv=None) -> int:
     P.build_parser()
     compiled = compile_text(text, APPENDIX_A)
     grammar = resources.files("liganimate.lang").joinpath("lig.lark").read_text(encoding="utf-8")
-    stock = Lark(grammar, parser="lalr", lexer="contextual", postlex=P._PrimitiveNames(),
-                 transformer=ToAst(), maybe_placeholders=False)
+    stock = Lark(
+        grammar,
+        parser="lalr",
+        lexer="contextual",
+        postlex=P._PrimitiveNames(),
+        transformer=ToAst(),
+        maybe_placeholders=False,
+    )
     lexed = prepare(text, APPENDIX_A).lexed
 
     def stock_parse():
@@ -217,9 +246,11 @@ def main(argv=None) -> int:
         t_parse = min(t_parse, best(lambda: P.parse(text, APPENDIX_A), 1))
         t_stock = min(t_stock, best(stock_parse, 1))
         t_python = min(t_python, best(lambda: compile(compiled.python, "appendix_a.py", "exec"), 1))
-    print(f"Appendix A, parser built: compile {t_ours * 1e3:.1f} ms (parse {t_parse * 1e3:.1f} ms); "
-          f"stock Lark contextual parse {t_stock * 1e3:.1f} ms; CPython compiling the generated module "
-          f"{t_python * 1e3:.1f} ms; the thesis' preprocessor {THESIS_SECONDS:.3f} s")
+    print(
+        f"Appendix A, parser built: compile {t_ours * 1e3:.1f} ms (parse {t_parse * 1e3:.1f} ms); "
+        f"stock Lark contextual parse {t_stock * 1e3:.1f} ms; CPython compiling the generated module "
+        f"{t_python * 1e3:.1f} ms; the thesis' preprocessor {THESIS_SECONDS:.3f} s"
+    )
 
     thesis = thesis_style_program()
     big = big_program()
@@ -227,8 +258,10 @@ def main(argv=None) -> int:
     for _ in range(big_rounds):
         t_thesis = min(t_thesis, best(lambda: compile_text(thesis, "thesis_style.lig"), 1))
         t_big = min(t_big, best(lambda: compile_text(big, "dense.lig"), 1))
-    print(f"10,000-line program in the thesis' style ({thesis.count(chr(10))} lines): compile {t_thesis:.3f} s; "
-          f"dense 10,000 statements: compile {t_big:.3f} s")
+    print(
+        f"10,000-line program in the thesis' style ({thesis.count(chr(10))} lines): compile {t_thesis:.3f} s; "
+        f"dense 10,000 statements: compile {t_big:.3f} s"
+    )
 
     exe = sys.executable
     t_check = t_floor = t_python0 = float("inf")
@@ -236,20 +269,28 @@ def main(argv=None) -> int:
         t_check = min(t_check, cold([exe, "-m", "liganimate", "check", APPENDIX_A], 1))
         t_floor = min(t_floor, cold([exe, "-c", "import numpy, lark"], 1))
         t_python0 = min(t_python0, cold([exe, "-c", "pass"], 1))
-    print(f"cold liganimate check appendix_a.lig: {t_check:.3f} s; python -c 'import numpy, lark' {t_floor:.3f} s; "
-          f"python -c pass {t_python0:.3f} s")
+    print(
+        f"cold liganimate check appendix_a.lig: {t_check:.3f} s; python -c 'import numpy, lark' {t_floor:.3f} s; "
+        f"python -c pass {t_python0:.3f} s"
+    )
 
     scale = scale_times(big_rounds)
     for style in STYLES:
         row = [scale[f"{style}_{n}"] for n in SIZES]
-        print(f"{style} lines, parse / compile per line: " + "; ".join(
-            f"{r['lines']:,}: {r['parse_us_per_line']:.1f} / {r['compile_us_per_line']:.1f} us" for r in row))
+        print(
+            f"{style} lines, parse / compile per line: "
+            + "; ".join(
+                f"{r['lines']:,}: {r['parse_us_per_line']:.1f} / {r['compile_us_per_line']:.1f} us" for r in row
+            )
+        )
     peaks = {}
     for style in STYLES:
         per_line, source = peak_bytes_per_line(style, SIZES[-1])
         peaks[style] = {"peak_bytes_per_line": round(per_line), "source_bytes_per_line": round(source, 1)}
-        print(f"{style} {SIZES[-1]:,} lines in a fresh process: peak memory grows {per_line:.0f} bytes a line "
-              f"({per_line / source:.0f}x the source)")
+        print(
+            f"{style} {SIZES[-1]:,} lines in a fresh process: peak memory grows {per_line:.0f} bytes a line "
+            f"({per_line / source:.0f}x the source)"
+        )
 
     figures = {
         "appendix_a_compile_ms": round(t_ours * 1e3, 2),
@@ -266,8 +307,9 @@ def main(argv=None) -> int:
         "cold_import_numpy_lark_s": round(t_floor, 3),
         "cold_python_s": round(t_python0, 3),
         "scale": scale,
-        "scale_growth_short_50k_over_1k": round(scale["short_50000"]["compile_us_per_line"]
-                                               / scale["short_1000"]["compile_us_per_line"], 2),
+        "scale_growth_short_50k_over_1k": round(
+            scale["short_50000"]["compile_us_per_line"] / scale["short_1000"]["compile_us_per_line"], 2
+        ),
         "scale_peak": peaks,
         "targets_met": {
             "appendix_a_under_20ms": t_ours < 0.020,

@@ -88,9 +88,11 @@ def main(argv=None) -> int:
             X.write_files([(os.path.join(out, "capture.lig"), X.lig_library(clip, "H", "M"))])
 
         t_import = best(import_, rounds)
-        sizes = {"glb_bytes": os.path.getsize(os.path.join(out, "film.glb")),
-                 "bvh_bytes": os.path.getsize(capture),
-                 "lig_bytes": os.path.getsize(os.path.join(out, "capture.lig"))}
+        sizes = {
+            "glb_bytes": os.path.getsize(os.path.join(out, "film.glb")),
+            "bvh_bytes": os.path.getsize(capture),
+            "lig_bytes": os.path.getsize(os.path.join(out, "capture.lig")),
+        }
     result = {
         "ticks": ticks,
         "figures": 5,
@@ -104,9 +106,11 @@ def main(argv=None) -> int:
         "goal_met": max(t_gltf, t_bvh, t_import) < t_render / 10,
         **sizes,
     }
-    print(f"{ticks} ticks, five figures: render {t_render:.2f} s; glTF {t_gltf:.3f} s "
-          f"({100 * t_gltf / t_render:.1f}%), BVH {t_bvh:.3f} s ({100 * t_bvh / t_render:.1f}%), "
-          f"import of a {ticks}-frame capture {t_import:.3f} s ({100 * t_import / t_render:.1f}%)")
+    print(
+        f"{ticks} ticks, five figures: render {t_render:.2f} s; glTF {t_gltf:.3f} s "
+        f"({100 * t_gltf / t_render:.1f}%), BVH {t_bvh:.3f} s ({100 * t_bvh / t_render:.1f}%), "
+        f"import of a {ticks}-frame capture {t_import:.3f} s ({100 * t_import / t_render:.1f}%)"
+    )
     sys.stdout.write(json.dumps(result) + "\n")
     return 0
 

@@ -133,18 +133,27 @@ def main() -> None:
         at = measure(fig, motion, SPEEDS[name])
         v = best_speed(fig, motion)
         best = measure(fig, motion, v)
-        report[name] = {"speed": round(SPEEDS[name], 4), **at, "best_speed": round(v, 4),
-                        "best_contact_mm": best["contact_mm"], "best_ankle_mm": best["ankle_mm"]}
-        print(f"{name:5s} at {SPEEDS[name] * 1000:6.1f} mm/frame: planted foot slides up to "
-              f"{at['contact_mm']:6.2f} mm/frame at the sole, {at['ankle_mm']:6.2f} at the ankle; "
-              f"rests {at['rest_frames']} frames in a row; best body speed {v * 1000:6.1f} mm/frame "
-              f"-> {best['contact_mm']:6.2f} / {best['ankle_mm']:6.2f} mm/frame")
+        report[name] = {
+            "speed": round(SPEEDS[name], 4),
+            **at,
+            "best_speed": round(v, 4),
+            "best_contact_mm": best["contact_mm"],
+            "best_ankle_mm": best["ankle_mm"],
+        }
+        print(
+            f"{name:5s} at {SPEEDS[name] * 1000:6.1f} mm/frame: planted foot slides up to "
+            f"{at['contact_mm']:6.2f} mm/frame at the sole, {at['ankle_mm']:6.2f} at the ankle; "
+            f"rests {at['rest_frames']} frames in a row; best body speed {v * 1000:6.1f} mm/frame "
+            f"-> {best['contact_mm']:6.2f} / {best['ankle_mm']:6.2f} mm/frame"
+        )
     worst = max(max(r["contact_mm"], r["ankle_mm"]) for r in report.values())
     never = [n for n, r in report.items() if r["rest_frames"] < 2]
     met = worst <= 1.0 and not never
-    print(f"target: at most 1 mm/frame; worst now {worst:.2f}"
-          + (f"; no foot rests two frames in {', '.join(never)}" if never else "")
-          + f" ({'met' if met else 'not met'})")
+    print(
+        f"target: at most 1 mm/frame; worst now {worst:.2f}"
+        + (f"; no foot rests two frames in {', '.join(never)}" if never else "")
+        + f" ({'met' if met else 'not met'})"
+    )
     print(json.dumps({"motions": report, "worst_mm": worst, "met": met}))
 
 

@@ -98,8 +98,9 @@ def worker(conn, limit: float, memory: int) -> None:
                 text = generate(generator, seed)
                 out = fuzzrun.timed(text, limit=limit, memory=memory, workdir=workdir)
                 keep = out.failed
-                conn.send((tid, out.kind, out.site, out.detail, round(out.seconds, 4), _rss_mb(),
-                           text if keep else None))
+                conn.send(
+                    (tid, out.kind, out.site, out.detail, round(out.seconds, 4), _rss_mb(), text if keep else None)
+                )
             else:  # ("minimise", tid, text, kind, site, budget)
                 _, tid, text, kind, site, budget = task
                 small = fuzzrun.minimise(text, fuzzrun.Outcome(kind, site=site), budget=budget, limit=limit)
@@ -216,8 +217,9 @@ def run(args) -> dict:
                     _, kind, site, detail, seconds, _, text = result
                 counts[g][kind] += 1
                 if kind in fuzzrun.FAILURES or kind in WORKER_FAILURES:
-                    grp = groups.setdefault((kind, site), {"count": 0, "text": None, "detail": detail,
-                                                           "generator": g, "seed": seed})
+                    grp = groups.setdefault(
+                        (kind, site), {"count": 0, "text": None, "detail": detail, "generator": g, "seed": seed}
+                    )
                     grp["count"] += 1
                     if grp["text"] is None or len(text) < len(grp["text"]):
                         grp.update(text=text, detail=detail, generator=g, seed=seed)
@@ -225,19 +227,28 @@ def run(args) -> dict:
             if not args.quiet and now - last_report > 30:
                 last_report = now
                 failures = sum(g["count"] for g in groups.values())
-                print(f"  {done} cases, {failures} failures, {len(groups)} sites, {now - start:.0f} s",
-                      file=sys.stderr, flush=True)
+                print(
+                    f"  {done} cases, {failures} failures, {len(groups)} sites, {now - start:.0f} s",
+                    file=sys.stderr,
+                    flush=True,
+                )
         seconds = time.monotonic() - start
         minimised = minimise_groups(pool, groups, args) if args.minimise else {}
     finally:
         pool.close()
-    return {"counts": counts, "groups": groups, "minimised": minimised, "done": done, "seconds": seconds,
-            "peak_rss_mb": pool.peak_rss}
+    return {
+        "counts": counts,
+        "groups": groups,
+        "minimised": minimised,
+        "done": done,
+        "seconds": seconds,
+        "peak_rss_mb": pool.peak_rss,
+    }
 
 
 def minimise_groups(pool: Pool, groups: dict, args) -> dict:
     """The minimised program of each failure group (the first ``args.minimise`` groups, largest first)."""
-    order = sorted(groups, key=lambda k: -groups[k]["count"])[:args.minimise]
+    order = sorted(groups, key=lambda k: -groups[k]["count"])[: args.minimise]
     todo = [k for k in order if k[0] in fuzzrun.FAILURES]  # hangs and deaths are not re-run
     out: dict = {}
     hard = args.minimise_budget + args.limit * 3 + 30
@@ -265,7 +276,7 @@ def report(res: dict, args) -> dict:
     for (kind, site), grp in sorted(groups.items(), key=lambda kv: -kv[1]["count"]):
         print(f"{grp['count']:7d}  {kind:<9} {site}  [{grp['generator']}]  {grp['detail'][:100]}")
     if args.show:
-        for key, small in list(res["minimised"].items())[:args.show]:
+        for key, small in list(res["minimised"].items())[: args.show]:
             print(f"--- {key[0]}: {key[1]} ---\n{small.rstrip()}", file=sys.stderr)
     if args.findings:
         write_findings(args.findings, res, total, args)
@@ -293,12 +304,16 @@ def write_findings(path: str, res: dict, total: dict, args) -> None:
     lines = [
         "# Fuzz findings",
         "",
-        (f"`python benchmarks/fuzz.py --cases {args.cases} --seed {args.seed} --generators {args.generators}`: "
-         f"{res['done']} cases in {res['seconds']:.0f} s; outcomes {json.dumps(total)}; "
-         f"peak RSS {res['peak_rss_mb']:.0f} MB."),
+        (
+            f"`python benchmarks/fuzz.py --cases {args.cases} --seed {args.seed} --generators {args.generators}`: "
+            f"{res['done']} cases in {res['seconds']:.0f} s; outcomes {json.dumps(total)}; "
+            f"peak RSS {res['peak_rss_mb']:.0f} MB."
+        ),
         "",
-        ("Each entry: outcome, site (exception and innermost liganimate frame), cases that hit it, "
-         "the generator and seed of its shortest case, and the minimised program."),
+        (
+            "Each entry: outcome, site (exception and innermost liganimate frame), cases that hit it, "
+            "the generator and seed of its shortest case, and the minimised program."
+        ),
         "",
     ]
     groups = res["groups"]
@@ -325,12 +340,16 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="a run of under a minute")
     parser.add_argument("--cases", type=int, help="cases to run (default 100000, or 2000 with --quick)")
-    parser.add_argument("--budget", type=float, help="stop starting cases after this many seconds "
-                                                     "(default none, or 35 with --quick)")
+    parser.add_argument(
+        "--budget", type=float, help="stop starting cases after this many seconds (default none, or 35 with --quick)"
+    )
     parser.add_argument("--seed", type=int, default=1986)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
-    parser.add_argument("--generators", default="grammar,numbers,splice,wild",
-                        help="comma-separated: grammar, numbers, splice, wild, mutate")
+    parser.add_argument(
+        "--generators",
+        default="grammar,numbers,splice,wild",
+        help="comma-separated: grammar, numbers, splice, wild, mutate",
+    )
     parser.add_argument("--limit", type=float, default=2.0, help="seconds per case before it counts as slow")
     parser.add_argument("--memory", type=int, default=1024, help="MB of address space a case may add")
     parser.add_argument("--minimise", type=int, help="failure groups to minimise (default all, 3 with --quick)")

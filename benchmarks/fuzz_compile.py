@@ -44,20 +44,123 @@ CHARS = "()<>,;:-=*+/[]{}'$0123456789.°\n ACXZé\t"
 
 #: Tokens worth inserting: keywords, operators, names from the examples, numbers.
 TOKENS = [
-    "JOINT", "STARTMODEL", "ENDMODEL", "STARTMOTION", "ENDMOTION", "ENDJOINT", "FRAME", "POSITION",
-    "INTERPOLATE", "ACCDCC", "LINEAR", "FIGURE", "MAIN", "LINK", "INITIALIZE", "SCENE", "STARTSCENE",
-    "LENGTH", "SAMEFRAME", "ENDSCENE", "ANIMATE", "FROM", "TO", "USING", "REPEAT", "BACKGROUND", "PRINT",
-    "SHOOTSCENES", "STOP", "END", "DO", "CONTINUE", "IF", "THEN", "ELSE", "BEGIN", "STRIP", "SYNCHRONIZE",
-    "TRANS", "JOINTS", "BY", "SCALE", "MODEL", "EXTREMES", "FRAMES", "ROT", "X", "LIGHTNESS", "BOX",
-    "WIDTH", "HEIGHT", "DEPTH", "AT", "PRIMITIVE", "RETURN", "DRAW", "POLY", "WITH", "REAL", "INTEGER",
-    "VECTOR", "GRAPHICAL", "MOTION", "MOD", "AND", "OR", "NOT", "VIEW", "POINT",
-    ":-", ":=", "=", "<", ">", "(", ")", ",", "+", "-", "*", "/", "[", "]", "$HUMAN",
-    "HUMAN", "SQUAT", "FOOT", "TORSO", "CLOCK", "TIME", "HOP", "WALK", "A", "B", "ROBOT",
-    "0", "1", "-1", "0.0", "2.5", "135°", "1e308", "99999", "(0.0, 0.0, 0.0)", "(0, 0)",
+    "JOINT",
+    "STARTMODEL",
+    "ENDMODEL",
+    "STARTMOTION",
+    "ENDMOTION",
+    "ENDJOINT",
+    "FRAME",
+    "POSITION",
+    "INTERPOLATE",
+    "ACCDCC",
+    "LINEAR",
+    "FIGURE",
+    "MAIN",
+    "LINK",
+    "INITIALIZE",
+    "SCENE",
+    "STARTSCENE",
+    "LENGTH",
+    "SAMEFRAME",
+    "ENDSCENE",
+    "ANIMATE",
+    "FROM",
+    "TO",
+    "USING",
+    "REPEAT",
+    "BACKGROUND",
+    "PRINT",
+    "SHOOTSCENES",
+    "STOP",
+    "END",
+    "DO",
+    "CONTINUE",
+    "IF",
+    "THEN",
+    "ELSE",
+    "BEGIN",
+    "STRIP",
+    "SYNCHRONIZE",
+    "TRANS",
+    "JOINTS",
+    "BY",
+    "SCALE",
+    "MODEL",
+    "EXTREMES",
+    "FRAMES",
+    "ROT",
+    "X",
+    "LIGHTNESS",
+    "BOX",
+    "WIDTH",
+    "HEIGHT",
+    "DEPTH",
+    "AT",
+    "PRIMITIVE",
+    "RETURN",
+    "DRAW",
+    "POLY",
+    "WITH",
+    "REAL",
+    "INTEGER",
+    "VECTOR",
+    "GRAPHICAL",
+    "MOTION",
+    "MOD",
+    "AND",
+    "OR",
+    "NOT",
+    "VIEW",
+    "POINT",
+    ":-",
+    ":=",
+    "=",
+    "<",
+    ">",
+    "(",
+    ")",
+    ",",
+    "+",
+    "-",
+    "*",
+    "/",
+    "[",
+    "]",
+    "$HUMAN",
+    "HUMAN",
+    "SQUAT",
+    "FOOT",
+    "TORSO",
+    "CLOCK",
+    "TIME",
+    "HOP",
+    "WALK",
+    "A",
+    "B",
+    "ROBOT",
+    "0",
+    "1",
+    "-1",
+    "0.0",
+    "2.5",
+    "135°",
+    "1e308",
+    "99999",
+    "(0.0, 0.0, 0.0)",
+    "(0, 0)",
 ]
 
-MUTATIONS = ("delete_line", "duplicate_line", "swap_lines", "delete_chars", "insert_char",
-             "insert_token", "truncate", "replace_token")
+MUTATIONS = (
+    "delete_line",
+    "duplicate_line",
+    "swap_lines",
+    "delete_chars",
+    "insert_char",
+    "insert_token",
+    "truncate",
+    "replace_token",
+)
 
 
 def example_sources() -> list:
@@ -91,7 +194,7 @@ def mutate(text: str, kind: str, u: float, v: float, pick: int) -> str:
     n = len(text)
     i = _index(u, n + 1)
     if kind == "delete_chars":
-        return text[:i] + text[i + 1 + pick % 8:]
+        return text[:i] + text[i + 1 + pick % 8 :]
     if kind == "insert_char":
         return text[:i] + CHARS[pick % len(CHARS)] + text[i:]
     if kind == "insert_token":
@@ -188,18 +291,22 @@ def main(argv=None) -> int:
     seconds = time.perf_counter() - start
     for key, n in sorted(kinds.items(), key=lambda kv: -kv[1]):
         print(f"{n:6d}  {key}")
-    print(json.dumps({
-        "cases": done,
-        "ok": counts["ok"],
-        "diagnostics": counts["diagnostics"],
-        "slow": counts["slow"],
-        "crashes": counts["crash"],
-        "seconds": round(seconds, 2),
-        "rate": round(done / seconds, 1) if seconds > 0 else None,
-        "crash_rate": round(counts["crash"] / done, 5) if done else 0.0,
-        "seed": args.seed,
-        "quick": args.quick,
-    }))
+    print(
+        json.dumps(
+            {
+                "cases": done,
+                "ok": counts["ok"],
+                "diagnostics": counts["diagnostics"],
+                "slow": counts["slow"],
+                "crashes": counts["crash"],
+                "seconds": round(seconds, 2),
+                "rate": round(done / seconds, 1) if seconds > 0 else None,
+                "crash_rate": round(counts["crash"] / done, 5) if done else 0.0,
+                "seed": args.seed,
+                "quick": args.quick,
+            }
+        )
+    )
     return 0
 
 

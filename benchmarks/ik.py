@@ -89,8 +89,13 @@ def ikpy_chain(n: int):
         vec = [0.0, 0.0, 0.0]
         vec[axis] = 1.0
         links.append(
-            URDFLink(f"j{i}", origin_translation=[0, seg if i else 0, 0], origin_orientation=[0, 0, 0],
-                     rotation=vec, bounds=tuple(np.deg2rad(lim)))
+            URDFLink(
+                f"j{i}",
+                origin_translation=[0, seg if i else 0, 0],
+                origin_orientation=[0, 0, 0],
+                rotation=vec,
+                bounds=tuple(np.deg2rad(lim)),
+            )
         )
     links.append(URDFLink("tip", origin_translation=[0, seg, 0], origin_orientation=[0, 0, 0], joint_type="fixed"))
     return Chain(links, active_links_mask=[False] + [True] * n + [False])
@@ -172,12 +177,18 @@ def main(argv=None) -> int:
         setup[n] = (fig, chain, tips)
         solve_ours(fig, n, tips[:10], **OURS)  # warm caches
 
-    print(f"chains: {', '.join(map(str, CHAINS))} hinge joints with limits, length 1; {TARGETS} reachable targets each; "
-          f"success: error < {SUCCESS:g} of the length")
-    print(f"liganimate: DLS, batched, tolerance {TOLERANCE:g}, max 30 iterations, 3 restarts; "
-          f"ikpy: inverse_kinematics, defaults, one call per target")
-    print(f"timing: best of {rounds} interleaved rounds (4 liganimate batches a round)"
-          + (" (ikpy on a subsample: --quick)" if args.quick else ""))
+    print(
+        f"chains: {', '.join(map(str, CHAINS))} hinge joints with limits, length 1; {TARGETS} reachable targets each; "
+        f"success: error < {SUCCESS:g} of the length"
+    )
+    print(
+        f"liganimate: DLS, batched, tolerance {TOLERANCE:g}, max 30 iterations, 3 restarts; "
+        f"ikpy: inverse_kinematics, defaults, one call per target"
+    )
+    print(
+        f"timing: best of {rounds} interleaved rounds (4 liganimate batches a round)"
+        + (" (ikpy on a subsample: --quick)" if args.quick else "")
+    )
 
     results = {}
     for n in CHAINS:
@@ -216,21 +227,28 @@ def main(argv=None) -> int:
         }
         res["speed_ratio"] = round(ours_best / ikpy_best, 1)
         res["speed_ratio_one_per_call"] = round(single_rate / ikpy_best, 1)
-        res["success_ratio"] = round(res["liganimate_on_ikpy_targets"]["success"] / max(res["ikpy"]["success"], 1e-9), 4)
+        res["success_ratio"] = round(
+            res["liganimate_on_ikpy_targets"]["success"] / max(res["ikpy"]["success"], 1e-9), 4
+        )
         # One per call against ikpy on the targets both solved (the first min(k, single_count)).
         both = min(k, single_count)
         res["success_ratio_one_per_call"] = round(
-            float(np.mean(single_err[:both] < SUCCESS)) / max(float(np.mean(ikpy_err[:both] < SUCCESS)), 1e-9), 4)
+            float(np.mean(single_err[:both] < SUCCESS)) / max(float(np.mean(ikpy_err[:both] < SUCCESS)), 1e-9), 4
+        )
         results[n] = res
         print(f"\n{n} joints")
         for name in ("liganimate", "liganimate_no_restarts", "liganimate_one_per_call", "ikpy"):
             s = res[name]
-            print(f"  {name:26s} success {100 * s['success']:6.2f}%  median error {s['median_error']:9.3g}  "
-                  f"{s['solves_per_s']:10.1f} solves/s  ({s['targets']} targets)")
-        print(f"  on ikpy's {k} targets: liganimate {100 * res['liganimate_on_ikpy_targets']['success']:.2f}% "
-              f"vs ikpy {100 * res['ikpy']['success']:.2f}%; speed ratio {res['speed_ratio']:.1f}x batched, "
-              f"{res['speed_ratio_one_per_call']:.1f}x one per call (success ratio one per call "
-              f"{res['success_ratio_one_per_call']:.3f})")
+            print(
+                f"  {name:26s} success {100 * s['success']:6.2f}%  median error {s['median_error']:9.3g}  "
+                f"{s['solves_per_s']:10.1f} solves/s  ({s['targets']} targets)"
+            )
+        print(
+            f"  on ikpy's {k} targets: liganimate {100 * res['liganimate_on_ikpy_targets']['success']:.2f}% "
+            f"vs ikpy {100 * res['ikpy']['success']:.2f}%; speed ratio {res['speed_ratio']:.1f}x batched, "
+            f"{res['speed_ratio_one_per_call']:.1f}x one per call (success ratio one per call "
+            f"{res['success_ratio_one_per_call']:.3f})"
+        )
 
     goals = {
         "success_at_least_ikpy": all(results[n]["success_ratio"] >= 1.0 for n in CHAINS),
@@ -241,8 +259,16 @@ def main(argv=None) -> int:
         "ten_times_ikpy_speed_one_per_call": all(results[n]["speed_ratio_one_per_call"] >= 10 for n in CHAINS),
     }
     print("\ngoals: " + ", ".join(f"{k} {'yes' if v else 'NO'}" for k, v in goals.items()))
-    print(json.dumps({"chains": {str(n): results[n] for n in CHAINS}, "goals": goals,
-                      "cores": os.cpu_count(), "quick": args.quick}))
+    print(
+        json.dumps(
+            {
+                "chains": {str(n): results[n] for n in CHAINS},
+                "goals": goals,
+                "cores": os.cpu_count(),
+                "quick": args.quick,
+            }
+        )
+    )
     return 0
 
 

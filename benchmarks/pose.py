@@ -69,7 +69,9 @@ def loop_setup(fig, motion):
     """What the loop needs, prepared once: tree order and each joint's keyframes."""
     order = []  # (joint index, parent link, child link, reversed), parents before children
     for level in fig.traversal:
-        order += list(zip(level.joints.tolist(), level.parents.tolist(), level.children.tolist(), level.reversed.tolist()))
+        order += list(
+            zip(level.joints.tolist(), level.parents.tolist(), level.children.tolist(), level.reversed.tolist())
+        )
     loc1, loc2 = fig.locations
     tracks = {}
     for k, jid in enumerate(fig.joint_ids):
@@ -144,8 +146,10 @@ def main(argv=None) -> int:
     frames = np.linspace(0.0, motion.length, n_frames)
     loop_frames = frames[:: n_frames // n_loop]
     setup = loop_setup(fig, motion)
-    print(f"model: HUMAN of appendix_a.lig, {L} links, {J} joints, main link {fig.links[fig.main].name}; "
-          f"motion SQUAT, {motion.length:g} frames")
+    print(
+        f"model: HUMAN of appendix_a.lig, {L} links, {J} joints, main link {fig.links[fig.main].name}; "
+        f"motion SQUAT, {motion.length:g} frames"
+    )
 
     # Same answer?
     ref = batched(fig, motion, loop_frames)
@@ -155,12 +159,14 @@ def main(argv=None) -> int:
     assert err < 1e-9, err
 
     best = {"batched": 0.0, "loop": 0.0}
-    print(f"timing: batched over {n_frames} frames a call, loop over {len(loop_frames)} frames "
-          f"100 at a time, best of {rounds} rounds, the two interleaved")
+    print(
+        f"timing: batched over {n_frames} frames a call, loop over {len(loop_frames)} frames "
+        f"100 at a time, best of {rounds} rounds, the two interleaved"
+    )
     # Each timed piece takes a few tens of milliseconds: a batched call over
     # all the frames, or the loop over 100 frames, so that both have about
     # as many chances to meet a quiet moment of the machine.
-    pieces = [loop_frames[i:i + 100] for i in range(0, len(loop_frames), 100)]
+    pieces = [loop_frames[i : i + 100] for i in range(0, len(loop_frames), 100)]
     for _ in range(rounds):
         for piece in pieces:
             t0 = time.perf_counter()

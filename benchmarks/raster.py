@@ -255,8 +255,10 @@ def main(argv=None) -> int:
     tris, _ = scene(0)
     img = rasterize(*scene(0), _camera())
     ys, _ = np.nonzero(img != 255)
-    print(f"scene: {len(tris)} triangles, {SIZE[0]}x{SIZE[1]}, figures span rows {ys.min()}..{ys.max()}, "
-          f"{(img != 255).sum()} pixels covered")
+    print(
+        f"scene: {len(tris)} triangles, {SIZE[0]}x{SIZE[1]}, figures span rows {ys.min()}..{ys.max()}, "
+        f"{(img != 255).sum()} pixels covered"
+    )
     print(f"timing: best of {rounds} rounds of {frames} images (liganimate and mplot3d rounds interleaved)")
 
     lig, lig_nocull, mpl = liganimate_runner(True), liganimate_runner(False), mplot3d_runner()

@@ -168,8 +168,10 @@ def main(argv=None) -> int:
     program, _ = load_program(SCENE)
     captured = capture_draws(program, size, every)
     ntri = len(captured[0][1])
-    print(f"scene: {SCENE}, {TICKS} ticks, {size[0]}x{size[1]}, {ntri} triangles an image "
-          f"(baseline on {len(captured)} of the images)")
+    print(
+        f"scene: {SCENE}, {TICKS} ticks, {size[0]}x{size[1]}, {ntri} triangles an image "
+        f"(baseline on {len(captured)} of the images)"
+    )
 
     # The baseline draws what liganimate draws: how close are the pictures?
     with tempfile.TemporaryDirectory() as out:
@@ -196,9 +198,11 @@ def main(argv=None) -> int:
     print(f"Program.render, default workers ({os.cpu_count()} cores):   {best['render2']:8.1f} images/s")
     print(f"Program.render, one process:                    {best['render1']:8.1f} images/s")
     print(f"per-triangle numpy loop + Pillow, one process:  {best['loop']:8.1f} images/s")
-    print(f"ratios: run/loop {best['cli'] / best['loop']:.1f}x, render/loop {best['render2'] / best['loop']:.1f}x, "
-          f"one process/loop {best['render1'] / best['loop']:.1f}x; target 200 images/s: "
-          f"{'met' if best['cli'] >= 200 else 'NOT met'} by liganimate run")
+    print(
+        f"ratios: run/loop {best['cli'] / best['loop']:.1f}x, render/loop {best['render2'] / best['loop']:.1f}x, "
+        f"one process/loop {best['render1'] / best['loop']:.1f}x; target 200 images/s: "
+        f"{'met' if best['cli'] >= 200 else 'NOT met'} by liganimate run"
+    )
     print(
         json.dumps(
             {

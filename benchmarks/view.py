@@ -30,9 +30,19 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, "five_humans.lig")
 CHROMIUM = "/usr/bin/chromium"
 CHROMEDRIVER = "/usr/bin/chromedriver"
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--window-size=1000,760"]
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--window-size=1000,760",
+]
 
 
 def build_page(folder: str):
@@ -139,8 +149,9 @@ def main(argv=None) -> int:
         summary[name] = {"median_ms": round(med, 2), "max_ms": round(worst, 2)}
     result["generator"] = summary
     result["generator_median_ms"] = round(max(v["median_ms"] for v in summary.values()), 2)
-    result["goals_met"] = bool(size < 10e6 and (times is None or min(times) < 2000)
-                               and result["generator_median_ms"] < 50)
+    result["goals_met"] = bool(
+        size < 10e6 and (times is None or min(times) < 2000) and result["generator_median_ms"] < 50
+    )
     print(json.dumps(result))
     return 0
 

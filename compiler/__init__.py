@@ -35,8 +35,9 @@ class NotParsed(LigDiagnostics):
         self.syntax = syntax
 
 
-def compile_source(source: Source, module_name: str | None = None, *, path: str | None = None,
-                   stack: tuple = (), consume: bool = False) -> Compiled:
+def compile_source(
+    source: Source, module_name: str | None = None, *, path: str | None = None, stack: tuple = (), consume: bool = False
+) -> Compiled:
     """Parse, check and lower a prepared source.
 
     ``path`` is the file the source came from: relative LOADs start there

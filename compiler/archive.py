@@ -85,7 +85,9 @@ def archive_text(path: str, out_path: str) -> str:
         chars[start:end] = list(replacement)
     body = "\n".join(line.rstrip() for line in "".join(chars).split("\n"))
     described = library.descriptions(text)
-    header = [f"{{ Archived from {Path(path).name} by liganimate archive: its models and motions, without its scenes. }}"]
+    header = [
+        f"{{ Archived from {Path(path).name} by liganimate archive: its models and motions, without its scenes. }}"
+    ]
     loaded = set(checked.loaded_names)
     for name, t in sorted(checked.main.types.items()):
         if t in (T.MODEL, T.MOTION) and name not in described and name not in loaded:

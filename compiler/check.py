@@ -107,7 +107,9 @@ class Checker:
 
     def warn(self, node, message: str, hint: str | None = None) -> None:
         if self.final:
-            self.warnings.append(Diagnostic(self.program.filename, node.pos, message, hint, "warning", self.program.source))
+            self.warnings.append(
+                Diagnostic(self.program.filename, node.pos, message, hint, "warning", self.program.source)
+            )
 
     # ---------------------------------------------------------------- run
     def run(self) -> Checked:
@@ -116,14 +118,21 @@ class Checker:
         for p in prog.primitives:
             if p.pattern is None:
                 self.final = True
-                self.err(p.name, f"PRIMITIVE {p.name.name} has no invocation pattern",
-                         f"add a line such as  {p.name.name} ::= '{p.name.name}' 'SIZE' S ;")
+                self.err(
+                    p.name,
+                    f"PRIMITIVE {p.name.name} has no invocation pattern",
+                    f"add a line such as  {p.name.name} ::= '{p.name.name}' 'SIZE' S ;",
+                )
                 self.final = False
                 continue
             sig, problems = signature_from_pattern(p.name.name, p.pattern)
             for node, message in problems:
                 self.final = True
-                self.err(node, message, "a pattern is a series of 'KEYWORD' VALUE pairs separated by ',' (optional parts in [ ])")
+                self.err(
+                    node,
+                    message,
+                    "a pattern is a series of 'KEYWORD' VALUE pairs separated by ',' (optional parts in [ ])",
+                )
                 self.final = False
             sigs[p.name.name] = sig
             self.primitives[p.name.name] = (p, sig, None)
@@ -162,8 +171,18 @@ class Checker:
             pass
         if self.errors:
             raise LigDiagnostics(self.errors)
-        return Checked(prog, main, self.primitives, self.types, self.scenes, self.warnings,
-                       self.libraries, self.loads, self.loaded_names, self.loaded_primitives)
+        return Checked(
+            prog,
+            main,
+            self.primitives,
+            self.types,
+            self.scenes,
+            self.warnings,
+            self.libraries,
+            self.loads,
+            self.loaded_names,
+            self.loaded_primitives,
+        )
 
     # -------------------------------------------------------------- LOAD
     def _loads(self, main: Scope, sigs: dict) -> None:
@@ -188,8 +207,11 @@ class Checker:
                 self.err(stmt.library_pos, message, hint)
                 continue
             if lib.scenes:
-                self.err(stmt.library_pos, f"{lib.display} defines scenes, so it is a program, not a library",
-                         "a library holds models, motions and primitives only")
+                self.err(
+                    stmt.library_pos,
+                    f"{lib.display} defines scenes, so it is a program, not a library",
+                    "a library holds models, motions and primitives only",
+                )
                 continue
             index = next((i for i, known in enumerate(self.libraries) if known.path == lib.path), None)
             if index is None:
@@ -207,19 +229,29 @@ class Checker:
                 if n in origin:
                     where_path, where = origin[n]
                     if where_path == lib.path:
-                        self.warn(name, f"{n} is already loaded from {lib.display} at line {where.line}; "
-                                        "this LOAD of it does nothing")
+                        self.warn(
+                            name,
+                            f"{n} is already loaded from {lib.display} at line {where.line}; "
+                            "this LOAD of it does nothing",
+                        )
                         continue
-                    self.err(name, f"{n} is already loaded from another library at line {where.line}",
-                             "load it from one library only")
+                    self.err(
+                        name,
+                        f"{n} is already loaded from another library at line {where.line}",
+                        "load it from one library only",
+                    )
                     continue
                 if n in defined:
-                    self.err(name, f"{n} is already defined at line {defined[n].line}, so loading it would overwrite it",
-                             "load libraries first, or rename your own definition")
+                    self.err(
+                        name,
+                        f"{n} is already defined at line {defined[n].line}, so loading it would overwrite it",
+                        "load libraries first, or rename your own definition",
+                    )
                     continue
                 if n in sigs and n in lib.signatures:
-                    self.err(name, f"{n} is already a primitive here, so it cannot be loaded",
-                             "rename your own PRIMITIVE")
+                    self.err(
+                        name, f"{n} is already a primitive here, so it cannot be loaded", "rename your own PRIMITIVE"
+                    )
                     continue
                 if n in lib.signatures:
                     sigs[n] = lib.signatures[n]
@@ -336,8 +368,11 @@ class Checker:
             return
         name = target.name
         if value_type == T.PAIR:
-            self.err(value_node, "a pair (min, max) can only be a joint's extremes",
-                     "a vector has three components: (x, y, z)")
+            self.err(
+                value_node,
+                "a pair (min, max) can only be a joint's extremes",
+                "a vector has three components: (x, y, z)",
+            )
             return
         if value_type == T.BOOL:
             return
@@ -352,7 +387,11 @@ class Checker:
         if current == T.GRAPHICAL and value_type == T.MODEL and self._animated_here(value_node):
             return  # §5.1: after ANIMATE, the model is also a graphical object (its pose this tick)
         if not T.fits(current, value_type):
-            hint = "use INT(...) or NINT(...) to make an INTEGER" if current == T.INTEGER and value_type == T.REAL else None
+            hint = (
+                "use INT(...) or NINT(...) to make an INTEGER"
+                if current == T.INTEGER and value_type == T.REAL
+                else None
+            )
             self.err(value_node, f"{name} is {T.NOUN[current]}, so it cannot hold {T.NOUN[value_type]}", hint)
 
     def _animated_here(self, node) -> bool:
@@ -363,8 +402,7 @@ class Checker:
         """
         while isinstance(node, A.Modified):
             node = node.target
-        return (self.scene is not None and isinstance(node, A.Var)
-                and node.name in self.scene.animated)
+        return self.scene is not None and isinstance(node, A.Var) and node.name in self.scene.animated
 
     def _s_Assign(self, s, context):
         if s.target.name in self.signatures:
@@ -382,8 +420,11 @@ class Checker:
         if len(args) >= 4:
             p, sec = _plain_name(args[1]), _plain_name(args[3])
             if p == target and sec == target:
-                self.err(args[3], f"{target} cannot be joined to itself: the model would contain a cycle",
-                         f"join a copy: make another model from {target} first")
+                self.err(
+                    args[3],
+                    f"{target} cannot be joined to itself: the model would contain a cycle",
+                    f"join a copy: make another model from {target} first",
+                )
 
     def _define_as(self, name: A.Name, t: str, message: str) -> None:
         """Declare ``name`` implicitly with type ``t``, or report ``message`` if it has another type."""
@@ -413,8 +454,11 @@ class Checker:
             interpolation.get(name.name)
         except KeyError:
             hint = did_you_mean(name.name, interpolation.names())
-            self.err(name, f"{name.name} is not an interpolation method",
-                     hint or "the methods are " + ", ".join(interpolation.names()))
+            self.err(
+                name,
+                f"{name.name} is not an interpolation method",
+                hint or "the methods are " + ", ".join(interpolation.names()),
+            )
 
     def _position(self, items: list, node) -> None:
         if len(items) == 1:
@@ -423,8 +467,10 @@ class Checker:
             for it in items:
                 self._want_number(it, "an angle")
         else:
-            self.err(items[1] if len(items) > 1 else node,
-                     f"a position is three angles or one vector, not {len(items)} values")
+            self.err(
+                items[1] if len(items) > 1 else node,
+                f"a position is three angles or one vector, not {len(items)} values",
+            )
 
     def _s_DoHeader(self, s, context):  # pragma: no cover - grouped away by the parser
         pass
@@ -456,8 +502,11 @@ class Checker:
             self._joint_args(args, j, in_block=True)
             if args and _const(args[0]) is not None and isinstance(args[0].value, int):
                 if args[0].value in ids:
-                    self.err(args[0], f"joint {args[0].value} appears twice in model {s.name.name}",
-                             f"the first is at line {ids[args[0].value].line}; joint identifiers must be unique")
+                    self.err(
+                        args[0],
+                        f"joint {args[0].value} appears twice in model {s.name.name}",
+                        f"the first is at line {ids[args[0].value].line}; joint identifiers must be unique",
+                    )
                 else:
                     ids[args[0].value] = args[0].pos
         if self.scene is not None:
@@ -468,9 +517,12 @@ class Checker:
 
     def _joint_args(self, args: list, node, in_block: bool) -> None:
         if len(args) < 6 or len(args) > 8:
-            self.err(node, f"JOINT takes an identifier, a primary segment and its location, a secondary segment "
-                           f"and its location, and one to three extreme pairs: {len(args)} values given",
-                     "JOINT id, primary, (x, y, z), secondary, (x, y, z), (min, max), (min, max), (min, max)")
+            self.err(
+                node,
+                f"JOINT takes an identifier, a primary segment and its location, a secondary segment "
+                f"and its location, and one to three extreme pairs: {len(args)} values given",
+                "JOINT id, primary, (x, y, z), secondary, (x, y, z), (min, max), (min, max), (min, max)",
+            )
             for a in args:
                 self.expr(a)
             return
@@ -488,8 +540,11 @@ class Checker:
             elif isinstance(ext, A.Tuple) and all(isinstance(i, (A.Num, A.Neg)) for i in ext.items):
                 lo, hi = (_const(i) for i in ext.items)
                 if lo is not None and hi is not None and lo > hi:
-                    self.err(ext, f"these extremes have a minimum ({_fmt(lo)}) above the maximum ({_fmt(hi)})",
-                             f"write ({_fmt(hi)}, {_fmt(lo)})")
+                    self.err(
+                        ext,
+                        f"these extremes have a minimum ({_fmt(lo)}) above the maximum ({_fmt(hi)})",
+                        f"write ({_fmt(hi)}, {_fmt(lo)})",
+                    )
 
     def _segment(self, e, role: str, in_block: bool) -> None:
         if in_block and role == "primary" and isinstance(e, A.Var):
@@ -497,7 +552,9 @@ class Checker:
             if t is None:
                 self._unknown(e)
             elif t != T.GRAPHICAL:
-                self.err(e, f"inside STARTMODEL the primary segment must be a GRAPHICAL object; {e.name} is {T.NOUN[t]}")
+                self.err(
+                    e, f"inside STARTMODEL the primary segment must be a GRAPHICAL object; {e.name} is {T.NOUN[t]}"
+                )
             self.types[id(e)] = t
             return
         t = self.expr(e)
@@ -511,8 +568,11 @@ class Checker:
             self._want(j.joint, T.INTEGER, "a joint identifier")
             if _const(j.joint) is not None and isinstance(j.joint, A.Num):
                 if j.joint.value in seen:
-                    self.err(j.joint, f"joint {j.joint.value} appears twice in motion {s.name.name}",
-                             f"the first is at line {seen[j.joint.value].line}; put all its keyframes under one JOINT")
+                    self.err(
+                        j.joint,
+                        f"joint {j.joint.value} appears twice in motion {s.name.name}",
+                        f"the first is at line {seen[j.joint.value].line}; put all its keyframes under one JOINT",
+                    )
                 seen[j.joint.value] = j.joint.pos
             if j.start is not None:
                 self._position(j.start, j)
@@ -521,7 +581,10 @@ class Checker:
                 self._keyframe(k)
                 c = _const(k.frame)
                 if c is not None and last is not None and c < last:
-                    self.err(k.frame, f"keyframes must be in ascending frame order: frame {_fmt(c)} comes after frame {_fmt(last)}")
+                    self.err(
+                        k.frame,
+                        f"keyframes must be in ascending frame order: frame {_fmt(c)} comes after frame {_fmt(last)}",
+                    )
                 last = c if c is not None else last
         if self.scene is not None:
             self.scene.assigned.add(s.name.name)
@@ -538,13 +601,17 @@ class Checker:
             self._want(s.start, T.MOTION, "the start motion (FROM)")
         for word, places in s.options.items():
             if word != "GOAL" and len(places) > 1:
-                self.err(places[1], f"{word} is given twice in this REACH",
-                         f"the first is at line {places[0].line}; keep one")
+                self.err(
+                    places[1],
+                    f"{word} is given twice in this REACH",
+                    f"the first is at line {places[0].line}; keep one",
+                )
         if s.joints is not None and s.chain is not None:
             self.err(s.options["MOVE CHAIN"][0], "MOVE JOINTS and MOVE CHAIN both choose the movable joints; keep one")
         if not s.goals:
-            self.err(s, f"REACH {s.name.name} has no GOAL",
-                     "add a line such as  GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10")
+            self.err(
+                s, f"REACH {s.name.name} has no GOAL", "add a line such as  GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10"
+            )
         for g in s.goals:
             if g.joint is not None:
                 self._want(g.joint, T.INTEGER, "a joint identifier")
@@ -562,8 +629,11 @@ class Checker:
                 self._want_number(g.weight, "a goal's weight")
                 c = _const(g.weight)
                 if c is not None and c < 0:
-                    self.err(g.weight, f"a goal's weight cannot be negative ({_fmt(c)})",
-                             "only the ratios of weights matter; 0 switches a goal off")
+                    self.err(
+                        g.weight,
+                        f"a goal's weight cannot be negative ({_fmt(c)})",
+                        "only the ratios of weights matter; 0 switches a goal off",
+                    )
         for j in s.joints or ():
             self._want(j, T.INTEGER, "a joint identifier")
         if s.chain is not None:
@@ -591,9 +661,12 @@ class Checker:
 
     def _s_Scene(self, s, context):
         if self.primitive is not None or context != "top":
-            self.err(s.start_pos, "a scene cannot be defined inside a PRIMITIVE or another scene"
-                     if self.primitive is not None or context == "scene" else
-                     "a scene definition belongs at the program's top level, not inside a loop or IF")
+            self.err(
+                s.start_pos,
+                "a scene cannot be defined inside a PRIMITIVE or another scene"
+                if self.primitive is not None or context == "scene"
+                else "a scene definition belongs at the program's top level, not inside a loop or IF",
+            )
         info = SceneInfo()
         self.scenes[id(s)] = info
         outer = self.scene
@@ -609,8 +682,11 @@ class Checker:
 
     def _s_Animate(self, s, context):
         if context != "scene-body":
-            self.err(s, "ANIMATE belongs between STARTSCENE and ENDSCENE",
-                     "a scene is INITIALIZE SCENE n ... STARTSCENE LENGTH n ... ENDSCENE")
+            self.err(
+                s,
+                "ANIMATE belongs between STARTSCENE and ENDSCENE",
+                "a scene is INITIALIZE SCENE n ... STARTSCENE LENGTH n ... ENDSCENE",
+            )
         self._want_var(s.model, T.MODEL)
         self._want(s.start, T.INTEGER, "a tick number")
         self._want(s.end, T.INTEGER, "a tick number")
@@ -628,8 +704,7 @@ class Checker:
             if t is not None and t not in (T.GRAPHICAL, T.MODEL):
                 self.err(item, f"a background is made of GRAPHICAL objects, not {T.NOUN[t]}")
         if context not in ("scene", "scene-body"):
-            self.warn(s, "BACKGROUND outside a scene has no effect",
-                      "put it between INITIALIZE SCENE and ENDSCENE")
+            self.warn(s, "BACKGROUND outside a scene has no effect", "put it between INITIALIZE SCENE and ENDSCENE")
 
     def _s_Print(self, s, context):
         for item in s.items:
@@ -655,8 +730,11 @@ class Checker:
 
     def _s_Load(self, s, context):
         if self.primitive is not None or context != "top" or id(s) not in self.top_loads:
-            self.err(s, "LOAD belongs at the top level of the program, outside loops, IFs, scenes and primitives",
-                     "a library is loaded once, before the program runs")
+            self.err(
+                s,
+                "LOAD belongs at the top level of the program, outside loops, IFs, scenes and primitives",
+                "a library is loaded once, before the program runs",
+            )
 
     def _s_Return(self, s, context):
         if self.primitive is None:
@@ -700,8 +778,12 @@ class Checker:
         if got is None:
             self._unknown(name)
         elif got != t:
-            self.err(name, what + f"; {name.name} is {T.NOUN[got]}" if what else
-                     f"{name.name} is {T.NOUN[got]}, but {T.NOUN[t]} is needed here")
+            self.err(
+                name,
+                what + f"; {name.name} is {T.NOUN[got]}"
+                if what
+                else f"{name.name} is {T.NOUN[got]}, but {T.NOUN[t]} is needed here",
+            )
 
     def _unknown(self, node) -> None:
         name = node.name
@@ -726,8 +808,7 @@ class Checker:
         t = self.scope.types.get(e.name)
         if t is None:
             if e.name in self.signatures:
-                self.err(e, f"{e.name} is a primitive: call it with its keywords",
-                         self.signatures[e.name].usage())
+                self.err(e, f"{e.name} is a primitive: call it with its keywords", self.signatures[e.name].usage())
             else:
                 self._unknown(e)
         return t
@@ -765,16 +846,25 @@ class Checker:
                 return T.VECTOR
             if op == "+" and lt == rt == T.GRAPHICAL:
                 return T.GRAPHICAL
-            if op == "+" and {lt, rt} <= {T.GRAPHICAL, T.MODEL} and all(
-                    t == T.GRAPHICAL or self._animated_here(side) for t, side in ((lt, e.left), (rt, e.right))):
+            if (
+                op == "+"
+                and {lt, rt} <= {T.GRAPHICAL, T.MODEL}
+                and all(t == T.GRAPHICAL or self._animated_here(side) for t, side in ((lt, e.left), (rt, e.right)))
+            ):
                 return T.GRAPHICAL  # an animated model drawn in this tick's pose
             if op == "+" and lt == rt == T.MOTION:
                 return T.MOTION
             if op == "+" and lt == rt == T.MODEL:
-                self.err(e, "models are combined with JOINT, not +",
-                         "a :- JOINT id, a, (x, y, z), b, (x, y, z), (min, max), ...")
+                self.err(
+                    e,
+                    "models are combined with JOINT, not +",
+                    "a :- JOINT id, a, (x, y, z), b, (x, y, z), (min, max), ...",
+                )
                 return None
-            self.err(e, f"cannot {'add' if op == '+' else 'subtract'} {T.NOUN[rt]} {'to' if op == '+' else 'from'} {T.NOUN[lt]}")
+            self.err(
+                e,
+                f"cannot {'add' if op == '+' else 'subtract'} {T.NOUN[rt]} {'to' if op == '+' else 'from'} {T.NOUN[lt]}",
+            )
             return None
         if op == "*":
             if T.is_numeric(lt) and T.is_numeric(rt):
@@ -785,8 +875,11 @@ class Checker:
                 if lt == T.INTEGER:
                     return T.MOTION
                 if lt == T.REAL:
-                    self.err(e.left, "a repetition count must be an INTEGER, not a REAL",
-                             "write a whole number such as 3 * walk, or use NINT(...)")
+                    self.err(
+                        e.left,
+                        "a repetition count must be an INTEGER, not a REAL",
+                        "write a whole number such as 3 * walk, or use NINT(...)",
+                    )
                     return None
             if lt == T.MOTION and T.is_numeric(rt):
                 self.err(e, "the repetition count comes first: write n * motion")
@@ -846,9 +939,13 @@ class Checker:
             at = self.expr(m.arg)
             label = _MOD_LABEL[m.kind]
             if m.kind not in allowed:
-                target = {"trans_joints": "models", "scale_model": "models", "scale_frames": "motions",
-                          "scale_extremes": "models and motions", "lightness": "graphical objects"}.get(
-                    m.kind, "graphical objects and models")
+                target = {
+                    "trans_joints": "models",
+                    "scale_model": "models",
+                    "scale_frames": "motions",
+                    "scale_extremes": "models and motions",
+                    "lightness": "graphical objects",
+                }.get(m.kind, "graphical objects and models")
                 self.err(m, f"{label} applies to {target}; this is {T.NOUN[t]}")
                 continue
             if at is None:
@@ -884,9 +981,13 @@ class Checker:
             if t is None or ptype is None:
                 continue
             if not T.fits(ptype, t):
-                self.err(c.value, f"{e.name} {c.keyword} needs {T.NOUN.get(ptype, ptype)}, not {T.NOUN[t]}",
-                         f"put the {e.name} call in parentheses to apply <...> or + to the whole object"
-                         if t == T.GRAPHICAL else None)
+                self.err(
+                    c.value,
+                    f"{e.name} {c.keyword} needs {T.NOUN.get(ptype, ptype)}, not {T.NOUN[t]}",
+                    f"put the {e.name} call in parentheses to apply <...> or + to the whole object"
+                    if t == T.GRAPHICAL
+                    else None,
+                )
         return T.GRAPHICAL
 
     def _e_JointExpr(self, e):
@@ -922,13 +1023,22 @@ class Checker:
             if c.op in ("=", "<>", "/=") and lt == rt == T.VECTOR:
                 return
             if not (T.is_numeric(lt) and T.is_numeric(rt)):
-                self.err(c, f"cannot compare {T.NOUN[lt]} with {T.NOUN[rt]}",
-                         "comparisons work on numbers (and = or <> on vectors)")
+                self.err(
+                    c,
+                    f"cannot compare {T.NOUN[lt]} with {T.NOUN[rt]}",
+                    "comparisons work on numbers (and = or <> on vectors)",
+                )
 
 
 _MOD_LABEL = {
-    "trans_joints": "TRANS JOINTS", "trans": "TRANS", "rot": "ROT", "scale_model": "SCALE MODEL",
-    "scale_extremes": "SCALE EXTREMES", "scale_frames": "SCALE FRAMES", "scale": "SCALE", "lightness": "LIGHTNESS",
+    "trans_joints": "TRANS JOINTS",
+    "trans": "TRANS",
+    "rot": "ROT",
+    "scale_model": "SCALE MODEL",
+    "scale_extremes": "SCALE EXTREMES",
+    "scale_frames": "SCALE FRAMES",
+    "scale": "SCALE",
+    "lightness": "LIGHTNESS",
 }
 
 

@@ -223,14 +223,30 @@ def _to_json(lib: Library) -> dict:
         return sources.index(text)
 
     return {
-        "name": lib.name, "path": lib.path, "display": lib.display, "python": lib.python,
-        "types": lib.types, "descriptions": lib.descriptions, "scenes": lib.scenes,
+        "name": lib.name,
+        "path": lib.path,
+        "display": lib.display,
+        "python": lib.python,
+        "types": lib.types,
+        "descriptions": lib.descriptions,
+        "scenes": lib.scenes,
         "deps": [list(d) for d in lib.deps],
-        "signatures": [{"name": s.name, "slots": [[x.keyword, x.param, x.group] for x in s.slots],
-                        "param_types": s.param_types} for s in lib.signatures.values()],
-        "warnings": [{"filename": w.filename, "pos": [w.pos.line, w.pos.column, w.pos.end_line, w.pos.end_column],
-                      "message": w.message, "hint": w.hint, "severity": w.severity,
-                      "source": source_index(w.source), "notes": list(w.notes)} for w in lib.warnings],
+        "signatures": [
+            {"name": s.name, "slots": [[x.keyword, x.param, x.group] for x in s.slots], "param_types": s.param_types}
+            for s in lib.signatures.values()
+        ],
+        "warnings": [
+            {
+                "filename": w.filename,
+                "pos": [w.pos.line, w.pos.column, w.pos.end_line, w.pos.end_column],
+                "message": w.message,
+                "hint": w.hint,
+                "severity": w.severity,
+                "source": source_index(w.source),
+                "notes": list(w.notes),
+            }
+            for w in lib.warnings
+        ],
         "sources": sources,
     }
 
@@ -241,12 +257,30 @@ def _from_json(obj: dict) -> Library:
     sigs = {}
     for s in obj["signatures"]:
         sigs[s["name"]] = Signature(s["name"], [Slot(k, p, g) for k, p, g in s["slots"]], {}, dict(s["param_types"]))
-    warnings = [Diagnostic(w["filename"], Pos(*w["pos"]), w["message"], w["hint"], w["severity"],
-                           None if w["source"] is None else sources[w["source"]], list(w["notes"]))
-                for w in obj["warnings"]]
-    return Library(name=obj["name"], path=obj["path"], display=obj["display"], python=obj["python"],
-                   types=dict(obj["types"]), signatures=sigs, descriptions=dict(obj["descriptions"]),
-                   warnings=warnings, deps=tuple((p, h) for p, h in obj["deps"]), scenes=bool(obj["scenes"]))
+    warnings = [
+        Diagnostic(
+            w["filename"],
+            Pos(*w["pos"]),
+            w["message"],
+            w["hint"],
+            w["severity"],
+            None if w["source"] is None else sources[w["source"]],
+            list(w["notes"]),
+        )
+        for w in obj["warnings"]
+    ]
+    return Library(
+        name=obj["name"],
+        path=obj["path"],
+        display=obj["display"],
+        python=obj["python"],
+        types=dict(obj["types"]),
+        signatures=sigs,
+        descriptions=dict(obj["descriptions"]),
+        warnings=warnings,
+        deps=tuple((p, h) for p, h in obj["deps"]),
+        scenes=bool(obj["scenes"]),
+    )
 
 
 def _from_disk(entry: str, name: str, path: str) -> Library | None:
@@ -287,7 +321,7 @@ def load(name: str, path: str, stack: tuple = ()) -> Library:
         not LIG text.
     """
     if path in stack:
-        chain = [Path(p).name for p in stack[stack.index(path):]] + [Path(path).name]
+        chain = [Path(p).name for p in stack[stack.index(path) :]] + [Path(path).name]
         raise LibraryCycle(chain)
     # The name is part of the key: the compiled text names the library as
     # the LOAD wrote it, and compiling must not depend on what ran before.
@@ -318,8 +352,11 @@ def _compile(name: str, path: str, data: bytes, stack: tuple) -> Library:
     checked = compiled.checked
     loaded = set(checked.loaded_names)
     types = {n: t for n, t in checked.main.types.items() if n not in loaded}
-    sigs = {n: dataclasses.replace(sig, defaults={}, param_types=dict(sig.param_types))
-            for n, (pdef, sig, _) in checked.primitives.items() if pdef is not None}
+    sigs = {
+        n: dataclasses.replace(sig, defaults={}, param_types=dict(sig.param_types))
+        for n, (pdef, sig, _) in checked.primitives.items()
+        if pdef is not None
+    }
     deps = [(path, _sha(data))]
     for lib in checked.libraries:
         deps.extend(lib.deps)
@@ -339,9 +376,12 @@ def _compile(name: str, path: str, data: bytes, stack: tuple) -> Library:
 
 def _withheld(d: Diagnostic) -> Diagnostic:
     """A library's syntax error by position only: a file that does not parse may not be LIG at all."""
-    return Diagnostic(d.filename, Pos(d.pos.line, d.pos.column, d.pos.line, d.pos.column + 1),
-                      "the library does not parse as LIG here (a library that does not parse is not quoted)",
-                      "run liganimate check on the library itself to see its line and the full message")
+    return Diagnostic(
+        d.filename,
+        Pos(d.pos.line, d.pos.column, d.pos.line, d.pos.column + 1),
+        "the library does not parse as LIG here (a library that does not parse is not quoted)",
+        "run liganimate check on the library itself to see its line and the full message",
+    )
 
 
 def failure(exc: Exception, name: str) -> tuple:
@@ -352,14 +392,19 @@ def failure(exc: Exception, name: str) -> tuple:
     """
     if isinstance(exc, LibraryNotFound):
         if not is_path(name):
-            hint = did_you_mean(name.lower(), stdlib_names()) or ("the standard libraries are " + ", ".join(stdlib_names()))
+            hint = did_you_mean(name.lower(), stdlib_names()) or (
+                "the standard libraries are " + ", ".join(stdlib_names())
+            )
             hint += "; a file of your own is named by a path such as 'lib/mine.lig'"
             # Where the package is installed says nothing to the user.
             return f"there is no library '{name}' in the standard library", hint, []
         return f"there is no library '{name}' (looked for {exc.tried[0]})", None, []
     if isinstance(exc, LibraryCycle):
-        return ("libraries load each other in a circle: " + " -> ".join(exc.chain),
-                "move what both need into a third library", [])
+        return (
+            "libraries load each other in a circle: " + " -> ".join(exc.chain),
+            "move what both need into a third library",
+            [],
+        )
     if isinstance(exc, LigDiagnostics):
         return f"the library '{name}' has errors (shown above)", None, list(exc.diagnostics)
     return f"the library '{name}' cannot be read: {exc.strerror or exc}", None, []

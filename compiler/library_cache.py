@@ -35,8 +35,12 @@ _O = getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
 _READ = os.O_RDONLY | _O | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
 _CREATE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | _O
 # Without these (Windows) nothing here can be made safe, so there is no disk cache.
-_SUPPORTED = (hasattr(os, "geteuid") and hasattr(os, "O_NOFOLLOW") and hasattr(os, "O_DIRECTORY")
-              and os.open in os.supports_dir_fd)
+_SUPPORTED = (
+    hasattr(os, "geteuid")
+    and hasattr(os, "O_NOFOLLOW")
+    and hasattr(os, "O_DIRECTORY")
+    and os.open in os.supports_dir_fd
+)
 
 _warned: set = set()
 
@@ -100,8 +104,12 @@ def _open_folder() -> tuple:
 
 def _private_file(fd: int, size: int | None = None) -> bool:
     st = os.fstat(fd)
-    return (stat.S_ISREG(st.st_mode) and st.st_uid == os.geteuid() and not st.st_mode & 0o022
-            and (st.st_size == size if size is not None else st.st_size <= MAX_ENTRY_BYTES))
+    return (
+        stat.S_ISREG(st.st_mode)
+        and st.st_uid == os.geteuid()
+        and not st.st_mode & 0o022
+        and (st.st_size == size if size is not None else st.st_size <= MAX_ENTRY_BYTES)
+    )
 
 
 def _read_all(fd: int, limit: int) -> bytes | None:
@@ -119,7 +127,7 @@ def _read_all(fd: int, limit: int) -> bytes | None:
 def _write_all(fd: int, data: bytes) -> None:
     view = memoryview(data)
     while view:
-        view = view[os.write(fd, view):]
+        view = view[os.write(fd, view) :]
 
 
 def _read_key(dfd: int, folder: Path) -> bytes | None:

@@ -232,7 +232,11 @@ class Lowerer:
                 self.emit(f"{p} = {_ZERO[scope.types.get(p, T.REAL)]}")
             else:
                 code = self.expr(default)
-                if scope.types.get(p) == T.REAL and not isinstance(default, tuple) and self.type_of(default) == T.INTEGER:
+                if (
+                    scope.types.get(p) == T.REAL
+                    and not isinstance(default, tuple)
+                    and self.type_of(default) == T.INTEGER
+                ):
                     code = _as_real(default, code)  # a REAL parameter holds a REAL
                 self.emit(f"{p} = {code}")
             self.indent -= 1
@@ -355,8 +359,10 @@ class Lowerer:
         goals = []
         for g in s.goals:
             link = repr(g.link.name) if g.link is not None else "None"
-            goals.append(f"({g.kind!r}, {link}, {opt(g.joint)}, {opt(g.point)}, {opt(g.target)}, "
-                         f"{opt(g.normal)}, {opt(g.weight)}, {self.at(g)})")
+            goals.append(
+                f"({g.kind!r}, {link}, {opt(g.joint)}, {opt(g.point)}, {opt(g.target)}, "
+                f"{opt(g.normal)}, {opt(g.weight)}, {self.at(g)})"
+            )
         if s.joints is not None:
             movable = "('joints', (" + "".join(self.expr(j) + ", " for j in s.joints) + "))"
         elif s.chain is not None:
@@ -369,8 +375,9 @@ class Lowerer:
         self.emit(f"{target} = rt.reach({self.expr(s.model)}, {opt(s.start)}, {self.expr(s.frames)}, {method}, (")
         for g in goals:
             self.emit(f"    {g},")
-        self.emit(f"), {movable}, {s.translate is not None}, {solver}, {opt(s.tolerance)}, {opt(s.iterations)}, "
-                  f"{self.at(s)})")
+        self.emit(
+            f"), {movable}, {s.translate is not None}, {solver}, {opt(s.tolerance)}, {opt(s.iterations)}, {self.at(s)})"
+        )
 
     def s_FigureStmt(self, s, where):
         if s.kind is None:
@@ -675,12 +682,12 @@ def _source_text(source: str, pos: A.Pos) -> str:
         end = pos.end_column - 1
         # A call's span stops at its last argument (the parser drops the
         # ")" token); take the closing parentheses the label still needs.
-        while line[pos.column - 1:end].count("(") > line[pos.column - 1:end].count(")"):
+        while line[pos.column - 1 : end].count("(") > line[pos.column - 1 : end].count(")"):
             close = line.find(")", end)
             if close < 0:
                 break
             end = close + 1
-        return line[pos.column - 1:end].upper()
+        return line[pos.column - 1 : end].upper()
     return "value"
 
 

@@ -124,8 +124,7 @@ def render_line(line: str, column: int, width: int = 1) -> tuple:
     # The underline ends where the shown text ends (a cut escape is not shown).
     shown_end = starts[shown[-1]] + cells[shown[-1]][1] if shown else caret
     underline = max(1, min(caret_end, shown_end) - caret)
-    return (("…" if left_mark else "") + text + ("…" if right_mark else ""),
-            " " * indent + "^" + "~" * (underline - 1))
+    return (("…" if left_mark else "") + text + ("…" if right_mark else ""), " " * indent + "^" + "~" * (underline - 1))
 
 
 # The last look-up: (source, line number, offset of that line). One tuple,

@@ -54,6 +54,7 @@ def _inlined(callback):
     child filter around the default callback, or the default callback
     alone); any other is kept as it is, which is slower but the same.
     """
+
     def is_default(f):
         return isinstance(f, functools.partial) and getattr(f.func, "__name__", "") == "default_callback"
 
@@ -107,8 +108,12 @@ class Driver:
         size = len(rule.expansion)
         # Lark's ExpandSingleChild hands a lone child back without calling the
         # transformer; when nothing else wraps it, the reduction is a no-op.
-        keeps_child = (size == 1 and type(callback) is ExpandSingleChild and not rule.expansion[0].is_term
-                       and not rule.expansion[0].name.startswith("_"))
+        keeps_child = (
+            size == 1
+            and type(callback) is ExpandSingleChild
+            and not rule.expansion[0].is_term
+            and not rule.expansion[0].name.startswith("_")
+        )
         if keeps_child:
             return size, rule.origin.name, None
         if rule.origin.name.startswith("_"):

@@ -126,7 +126,7 @@ def _words_of(regex: str):
         c = core[i]
         if c == "[":
             j = core.index("]", i)
-            chars = core[i + 1:j]
+            chars = core[i + 1 : j]
             options = [o + ch for o in options for ch in chars]
             i = j + 1
         elif i + 1 < len(core) and core[i + 1] == "?":

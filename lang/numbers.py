@@ -74,6 +74,7 @@ class NumberError(ValueError):
 
 # ------------------------------------------------------------------ literals
 
+
 class BadLiteral:
     """Mixin of a literal outside the language's numbers; it keeps its spelling.
 
@@ -126,7 +127,7 @@ def literal(text: str) -> int | float:
 
 def shown(text: str, width: int = 24) -> str:
     """A literal's spelling for a message, shortened if long."""
-    return text if len(text) <= width else f"{text[:width - 4]}..."
+    return text if len(text) <= width else f"{text[: width - 4]}..."
 
 
 def literal_problem(value) -> tuple[str, str] | None:
@@ -138,14 +139,21 @@ def literal_problem(value) -> tuple[str, str] | None:
         digits = text.lstrip("0")
         spelled = text if len(text) <= 24 else f"{text[:6]}...{text[-3:]} ({len(digits)} digits)"
         fits_real = len(digits) <= 308
-        return (f"the integer {spelled} is too large: an INTEGER lies within ±{INT_MAX}",
-                f"write it as a REAL such as {digits[0]}.{digits[1:4] or '0'}E{len(digits) - 1} if an approximate "
-                "value will do" if fits_real else f"a REAL can hold magnitudes up to about {_REAL_MAX_TEXT}")
-    return (f"the number {shown(text)} is too large for a REAL (the largest is about {_REAL_MAX_TEXT})",
-            "a REAL is a finite double-precision number")
+        return (
+            f"the integer {spelled} is too large: an INTEGER lies within ±{INT_MAX}",
+            f"write it as a REAL such as {digits[0]}.{digits[1:4] or '0'}E{len(digits) - 1} if an approximate "
+            "value will do"
+            if fits_real
+            else f"a REAL can hold magnitudes up to about {_REAL_MAX_TEXT}",
+        )
+    return (
+        f"the number {shown(text)} is too large for a REAL (the largest is about {_REAL_MAX_TEXT})",
+        "a REAL is a finite double-precision number",
+    )
 
 
 # -------------------------------------------------------------- run-time checks
+
 
 def in_range(x) -> bool:
     """Is ``x`` a number the language can hold (an INTEGER within range, a finite REAL)?"""
@@ -188,13 +196,19 @@ def magnitude(x: float) -> str:
 def overflow(value, what: str = "the result") -> NumberError:
     """The error for an arithmetic result outside the language's numbers (the caller raises it)."""
     if isinstance(value, int):
-        return NumberError(f"INTEGER overflow: {what} is {describe(value)}, outside ±{INT_MAX}",
-                           "use REAL numbers for values this large")
+        return NumberError(
+            f"INTEGER overflow: {what} is {describe(value)}, outside ±{INT_MAX}",
+            "use REAL numbers for values this large",
+        )
     if isinstance(value, float) and math.isnan(value):
-        return NumberError(f"REAL overflow: {what} is not a number, because part of it went beyond ±{_REAL_MAX_TEXT}",
-                           "a REAL can hold magnitudes up to about 1.8E308; check for a runaway value")
-    return NumberError(f"REAL overflow: {what} is beyond ±{_REAL_MAX_TEXT}",
-                       "a REAL can hold magnitudes up to about 1.8E308; check for a runaway value")
+        return NumberError(
+            f"REAL overflow: {what} is not a number, because part of it went beyond ±{_REAL_MAX_TEXT}",
+            "a REAL can hold magnitudes up to about 1.8E308; check for a runaway value",
+        )
+    return NumberError(
+        f"REAL overflow: {what} is beyond ±{_REAL_MAX_TEXT}",
+        "a REAL can hold magnitudes up to about 1.8E308; check for a runaway value",
+    )
 
 
 def integer(x, what: str = "the result") -> int:
@@ -210,8 +224,10 @@ def integer(x, what: str = "the result") -> int:
         if not math.isfinite(x):
             raise NumberError(f"{what} is {describe(x)}, which is not an INTEGER")
         if not -INT_MAX <= x <= INT_MAX:
-            raise NumberError(f"INTEGER overflow: {what} is {describe(x)}, outside ±{INT_MAX}",
-                              "keep it a REAL: INTEGERs hold whole numbers up to about 9.2E18")
+            raise NumberError(
+                f"INTEGER overflow: {what} is {describe(x)}, outside ±{INT_MAX}",
+                "keep it a REAL: INTEGERs hold whole numbers up to about 9.2E18",
+            )
         return int(x)
     if not -INT_MAX <= x <= INT_MAX:
         raise overflow(x, what)

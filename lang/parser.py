@@ -190,10 +190,18 @@ def _describe_token(tok: Token) -> str:
 
 _BLOCK_WORDS = re.compile(
     r"\b(STARTMODEL|ENDMODEL|STARTMOTION|ENDMOTION|STARTREACH|ENDREACH|INITIALIZE|ENDSCENE|PRIMITIVE|BEGIN|END"
-    r"|JOINT|ENDJOINT)\b", re.IGNORECASE
+    r"|JOINT|ENDJOINT)\b",
+    re.IGNORECASE,
 )
-_CLOSER = {"STARTMODEL": "ENDMODEL", "STARTMOTION": "ENDMOTION", "STARTREACH": "ENDREACH", "INITIALIZE": "ENDSCENE",
-           "PRIMITIVE": "END", "BEGIN": "END", "JOINT": "ENDJOINT"}
+_CLOSER = {
+    "STARTMODEL": "ENDMODEL",
+    "STARTMOTION": "ENDMOTION",
+    "STARTREACH": "ENDREACH",
+    "INITIALIZE": "ENDSCENE",
+    "PRIMITIVE": "END",
+    "BEGIN": "END",
+    "JOINT": "ENDJOINT",
+}
 # Each closing word, what opens it (as the user would write it), and the opening words.
 _STRAY = {
     "ENDMOTION": ("STARTMOTION", ("STARTMOTION",)),
@@ -313,11 +321,21 @@ def _stray_diagnostic(tok: Token, text: str, source: Source, as_name: bool):
     word = tok.value.upper()
     pos = _token_pos(tok)
     if not as_name and _ASSIGNED.match(text, tok.end_pos):
-        return Diagnostic(source.filename, pos, f"{word} cannot be a variable name here, after an expression",
-                          "choose another name, or start the statement with another one", source=source.text)
+        return Diagnostic(
+            source.filename,
+            pos,
+            f"{word} cannot be a variable name here, after an expression",
+            "choose another name, or start the statement with another one",
+            source=source.text,
+        )
     if word == "CONTINUE":
-        return Diagnostic(source.filename, pos, "CONTINUE needs the label of the DO loop it closes",
-                          "write the loop as DO 10 I = 1, 5 ... 10 CONTINUE", source=source.text)
+        return Diagnostic(
+            source.filename,
+            pos,
+            "CONTINUE needs the label of the DO loop it closes",
+            "write the loop as DO 10 I = 1, 5 ... 10 CONTINUE",
+            source=source.text,
+        )
     opener_text, openers = _STRAY[word]
     stack, closed = _scan_blocks(text, tok.start_pos)
     if any(w in openers for w, _ in stack):
@@ -328,8 +346,10 @@ def _stray_diagnostic(tok: Token, text: str, source: Source, as_name: bool):
     pairs = [(closed[w][1], closed[w][0], w) for w in openers if w in closed]
     if pairs:
         by, at, opened_word = max(pairs)
-        hint = (f"the {_shown(opened_word)} at line {_line_col(text, at)[0]} was already closed "
-                f"by the {word} at line {_line_col(text, by)[0]}")
+        hint = (
+            f"the {_shown(opened_word)} at line {_line_col(text, at)[0]} was already closed "
+            f"by the {word} at line {_line_col(text, by)[0]}"
+        )
     else:
         hint = f"no {opener_text} is open here"
     # Name the block that is open instead, unless it is the JOINT's own STARTMOTION.
@@ -416,8 +436,9 @@ def _end_of_file(tok: Token, expected: set, text: str, source: Source) -> Diagno
         oline, ocol = _line_col(text, at)
         message = f"the file ends before {_CLOSER[word]} closes the {_shown(word)} opened at line {oline}"
         hint = f"add {_CLOSER[word]} after the last statement of the {_shown(word)}"
-        return Diagnostic(source.filename, A.Pos(oline, ocol, oline, ocol + len(word)), message, hint,
-                          source=source.text)
+        return Diagnostic(
+            source.filename, A.Pos(oline, ocol, oline, ocol + len(word)), message, hint, source=source.text
+        )
     # Lark's end token borrows the position of the last real token: point just after it.
     line, col = getattr(tok, "end_line", None), getattr(tok, "end_column", None)
     if not line or not col:

@@ -31,7 +31,8 @@ _PRIMITIVE_HEAD = re.compile(r"(?im)^[ \t*]*PRIMITIVE[ \t]+([A-Za-z][A-Za-z0-9_]
 # LOAD statements, found before parsing for the same reason as PRIMITIVE heads:
 # a loaded primitive's name must already be a PRIM_NAME when the lexer meets it.
 _LOAD = re.compile(
-    r"(?i)(?:^|[;\n])[ \t]*LOAD\s+(?:'([^'\n]*)'|((?:[A-Za-z][A-Za-z0-9_]*\s*,\s*)*[A-Za-z][A-Za-z0-9_]*)\s+FROM\s+'([^'\n]*)')")
+    r"(?i)(?:^|[;\n])[ \t]*LOAD\s+(?:'([^'\n]*)'|((?:[A-Za-z][A-Za-z0-9_]*\s*,\s*)*[A-Za-z][A-Za-z0-9_]*)\s+FROM\s+'([^'\n]*)')"
+)
 _BRACES = re.compile(r"\{[^}]*\}")
 
 # Larger than any program written by hand (the thesis' longest listing is a
@@ -196,15 +197,17 @@ def decode(data: bytes, filename: str) -> str:
         line = good.count("\n") + 1
         col = len(good) - (good.rfind("\n") + 1) + 1
         shown = data.decode("utf-8", errors="replace")
-        raise LigDiagnostics([
-            Diagnostic(
-                filename,
-                Pos(line, col, line, col + 1),
-                f"the file is not valid UTF-8 (byte 0x{data[exc.start]:02x} at offset {exc.start})",
-                "save the file as UTF-8; a degree sign written by an old editor is a common cause",
-                source=shown,
-            )
-        ]) from None
+        raise LigDiagnostics(
+            [
+                Diagnostic(
+                    filename,
+                    Pos(line, col, line, col + 1),
+                    f"the file is not valid UTF-8 (byte 0x{data[exc.start]:02x} at offset {exc.start})",
+                    "save the file as UTF-8; a degree sign written by an old editor is a common cause",
+                    source=shown,
+                )
+            ]
+        ) from None
     text = text.removeprefix("\ufeff")
     return text
 
@@ -229,12 +232,15 @@ def prepare(text: str, filename: str) -> Source:
             counted[0] += text.count("\n", counted[1], match.start())
             counted[1] = match.start()
             number = counted[0]
-            warnings.append(Diagnostic(
-                filename, Pos(number, 1, number, 2),
-                "this line is a comment: a C in column 1 followed by a blank starts a comment line",
-                "indent the line if it is a statement about a variable called C",
-                severity="warning",
-            ))
+            warnings.append(
+                Diagnostic(
+                    filename,
+                    Pos(number, 1, number, 2),
+                    "this line is a comment: a C in column 1 followed by a blank starts a comment line",
+                    "indent the line if it is a statement about a variable called C",
+                    severity="warning",
+                )
+            )
         return ""
 
     prepared = _STAR_FLAG.sub(" ", _COMMENT_LINE.sub(blank, text))
@@ -266,9 +272,14 @@ def load(path: str, display_name: str | None = None) -> Source:
 
 
 def _binary(filename: str, line: int, col: int, code: int) -> LigDiagnostics:
-    return LigDiagnostics([Diagnostic(
-        filename, Pos(line, col, line, col + 1),
-        f"the file holds a control character (U+{code:04X}), so it is not LIG text",
-        "a LIG program is plain UTF-8 text; tab, line feed, form feed and carriage return are the only "
-        "control characters it may hold",
-    )])
+    return LigDiagnostics(
+        [
+            Diagnostic(
+                filename,
+                Pos(line, col, line, col + 1),
+                f"the file holds a control character (U+{code:04X}), so it is not LIG text",
+                "a LIG program is plain UTF-8 text; tab, line feed, form feed and carriage return are the only "
+                "control characters it may hold",
+            )
+        ]
+    )

@@ -26,8 +26,11 @@ def _node_fields(cls) -> tuple:
     """Names of the fields of node type ``cls`` that may hold nodes (not ``pos``, not names or numbers)."""
     names = _FIELDS.get(cls)
     if names is None:
-        names = _FIELDS[cls] = tuple(f.name for f in dataclasses.fields(cls)
-                                     if f.name != "pos" and getattr(f.type, "__name__", f.type) not in _SCALAR)
+        names = _FIELDS[cls] = tuple(
+            f.name
+            for f in dataclasses.fields(cls)
+            if f.name != "pos" and getattr(f.type, "__name__", f.type) not in _SCALAR
+        )
     return names
 
 
@@ -54,12 +57,17 @@ def check_depth(roots: list, source) -> None:
     while stack:
         node, depth = stack.pop()
         if depth > MAX_DEPTH:
-            raise LigDiagnostics([Diagnostic(
-                source.filename, node.pos,
-                f"this is nested more than {MAX_DEPTH} levels deep",
-                "split it into several statements with variables in between",
-                source=source.text,
-            )])
+            raise LigDiagnostics(
+                [
+                    Diagnostic(
+                        source.filename,
+                        node.pos,
+                        f"this is nested more than {MAX_DEPTH} levels deep",
+                        "split it into several statements with variables in between",
+                        source=source.text,
+                    )
+                ]
+            )
         names = fields.get(type(node))
         if names is None:
             names = _node_fields(type(node))
@@ -100,12 +108,17 @@ def _check_blocks(body: list, source) -> None:
         else:
             continue
         if depth > MAX_BLOCKS:
-            raise LigDiagnostics([Diagnostic(
-                source.filename, node.pos,
-                f"blocks (DO, IF, scenes) are nested more than {MAX_BLOCKS} deep here",
-                "move the inner part into a loop of its own or a PRIMITIVE",
-                source=source.text,
-            )])
+            raise LigDiagnostics(
+                [
+                    Diagnostic(
+                        source.filename,
+                        node.pos,
+                        f"blocks (DO, IF, scenes) are nested more than {MAX_BLOCKS} deep here",
+                        "move the inner part into a loop of its own or a PRIMITIVE",
+                        source=source.text,
+                    )
+                ]
+            )
         stack.extend((s, depth + 1) for s in inner if isinstance(s, _BLOCKS))
 
 
@@ -127,40 +140,60 @@ def _group_list(stmts: list, source) -> list:
             if not any(h.label == stmt.label for h, _ in open_dos):
                 if stmt.label in closed:
                     do_line, end_line = closed[stmt.label]
-                    hint = (f"the DO {stmt.label} at line {do_line} was already closed "
-                            f"by the {stmt.label} CONTINUE at line {end_line}")
+                    hint = (
+                        f"the DO {stmt.label} at line {do_line} was already closed "
+                        f"by the {stmt.label} CONTINUE at line {end_line}"
+                    )
                 else:
                     hint = f"a loop is opened with DO {stmt.label} var = first, last in the same block"
-                raise LigDiagnostics([Diagnostic(
-                    source.filename, stmt.pos, f"{stmt.label} CONTINUE closes no DO loop", hint,
-                    source=source.text,
-                )])
+                raise LigDiagnostics(
+                    [
+                        Diagnostic(
+                            source.filename,
+                            stmt.pos,
+                            f"{stmt.label} CONTINUE closes no DO loop",
+                            hint,
+                            source=source.text,
+                        )
+                    ]
+                )
             # FORTRAN lets nested loops share one terminal label: close them all.
             while open_dos and open_dos[-1][0].label == stmt.label:
                 header, start = open_dos.pop()
                 closed[stmt.label] = (header.pos.line, stmt.pos.line)
-                loop = A.Do(header.pos, header.label, header.var, header.start, header.stop, header.step,
-                            out[start:], stmt.pos)
+                loop = A.Do(
+                    header.pos, header.label, header.var, header.start, header.stop, header.step, out[start:], stmt.pos
+                )
                 del out[start:]
                 out.append(loop)
             if open_dos and any(h.label == stmt.label for h, _ in open_dos):
                 inner = open_dos[-1][0]
-                raise LigDiagnostics([Diagnostic(
-                    source.filename, stmt.pos,
-                    f"{stmt.label} CONTINUE closes a DO loop while the inner DO {inner.label} is still open",
-                    f"close DO {inner.label} (line {inner.pos.line}) with {inner.label} CONTINUE first",
-                    source=source.text,
-                )])
+                raise LigDiagnostics(
+                    [
+                        Diagnostic(
+                            source.filename,
+                            stmt.pos,
+                            f"{stmt.label} CONTINUE closes a DO loop while the inner DO {inner.label} is still open",
+                            f"close DO {inner.label} (line {inner.pos.line}) with {inner.label} CONTINUE first",
+                            source=source.text,
+                        )
+                    ]
+                )
             continue
         out.append(stmt)
     if open_dos:
         header = open_dos[0][0]
-        raise LigDiagnostics([Diagnostic(
-            source.filename, header.pos,
-            f"DO {header.label} is never closed by {header.label} CONTINUE",
-            f"add '{header.label} CONTINUE' after the last statement of the loop",
-            source=source.text,
-        )])
+        raise LigDiagnostics(
+            [
+                Diagnostic(
+                    source.filename,
+                    header.pos,
+                    f"DO {header.label} is never closed by {header.label} CONTINUE",
+                    f"add '{header.label} CONTINUE' after the last statement of the loop",
+                    source=source.text,
+                )
+            ]
+        )
     return out
 
 

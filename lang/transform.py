@@ -173,9 +173,19 @@ class ToAst(Transformer):
         link, spec = children[1], children[2]
         kind, point, target, normal = spec
         weight = children[4] if len(children) > 3 else None
-        last = max((n for n in (weight, target, normal) if n is not None), key=lambda n: (n.pos.end_line, n.pos.end_column))
-        goal = A.Goal(_tpos(children[0]).to(last.pos), kind, link if isinstance(link, A.Name) else None,
-                      None if isinstance(link, A.Name) else link, point, target, normal, weight)
+        last = max(
+            (n for n in (weight, target, normal) if n is not None), key=lambda n: (n.pos.end_line, n.pos.end_column)
+        )
+        goal = A.Goal(
+            _tpos(children[0]).to(last.pos),
+            kind,
+            link if isinstance(link, A.Name) else None,
+            None if isinstance(link, A.Name) else link,
+            point,
+            target,
+            normal,
+            weight,
+        )
         return ("GOAL", goal.pos, goal)
 
     def goal_link(self, children):
@@ -303,7 +313,9 @@ class ToAst(Transformer):
     def print_table(self, children):
         tok = children[0]
         pos = _tpos(tok)
-        return A.PrintItem(pos, "table", A.Name(A.Pos(pos.line, pos.column + 1, pos.end_line, pos.end_column), tok.value[1:].upper()))
+        return A.PrintItem(
+            pos, "table", A.Name(A.Pos(pos.line, pos.column + 1, pos.end_line, pos.end_column), tok.value[1:].upper())
+        )
 
     def print_text(self, children):
         tok = children[0]

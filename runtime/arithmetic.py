@@ -100,8 +100,9 @@ class Arithmetic:
         try:
             return fn(x)
         except OverflowError:
-            self.fail(at, f"{name}({N.describe(x)}) is too large for a REAL",
-                      "a REAL can hold magnitudes up to about 1.8E308")
+            self.fail(
+                at, f"{name}({N.describe(x)}) is too large for a REAL", "a REAL can hold magnitudes up to about 1.8E308"
+            )
         except ValueError:
             self.fail(at, f"{name} of {N.describe(x)} is not defined")
 
@@ -145,8 +146,7 @@ class Arithmetic:
         if isinstance(x, int):
             return x
         # FORTRAN's NINT, which the thesis' host language had: halves away from zero.
-        return self._integer(math.copysign(math.floor(abs(x) + 0.5), x) if abs(x) < 2**53 else x,
-                             at, "NINT's result")
+        return self._integer(math.copysign(math.floor(abs(x) + 0.5), x) if abs(x) < 2**53 else x, at, "NINT's result")
 
     def f_REAL(self, x, at):
         return float(x)
@@ -168,8 +168,7 @@ class Arithmetic:
         return self._real(a[0] * b[0] + a[1] * b[1] + a[2] * b[2], at, "DOT's result")
 
     def f_CROSS(self, a, b, at):
-        return self.vector_ok(
-            Vec(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]), at)
+        return self.vector_ok(Vec(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]), at)
 
     def f_NORM(self, a, at):
         # hypot scales internally: NORM((1E200, 1E200, 1E200)) is 1.7E200, not an overflow.

@@ -100,8 +100,9 @@ class Program:
             self._positions = tuple(zip(numbers, numbers, numbers, numbers))
         return self._positions
 
-    def execute(self, mode: str = "check", renderer=None, stdout=None, echo_print: bool = False,
-                progress=None) -> Runtime:
+    def execute(
+        self, mode: str = "check", renderer=None, stdout=None, echo_print: bool = False, progress=None
+    ) -> Runtime:
         """Run the program; return the runtime, whose ``variables`` hold its final values.
 
         In ``"check"`` mode PRINT only checks its items unless ``echo_print``.
@@ -169,8 +170,9 @@ def overflow(program: Program, value, kind, at):
     from liganimate.runtime.arithmetic import overflow_error
 
     exc = overflow_error(value, kind)
-    raise LigDiagnostics([Diagnostic(program.name, Pos(*program.positions[at]), exc.message, exc.hint,
-                                     source=program.source)])
+    raise LigDiagnostics(
+        [Diagnostic(program.name, Pos(*program.positions[at]), exc.message, exc.hint, source=program.source)]
+    )
 
 
 def main(program: Program, argv=None) -> int:
@@ -242,8 +244,15 @@ class Runtime(Arithmetic):
     @staticmethod
     def prim_BOX(rt, CENTRE=None, WIDTH=None, HEIGHT=None, DEPTH=None, LIGHT=None, _at=None) -> Graphical:
         """The built-in BOX primitive (``_at``: the call's position)."""
-        return rt._guard(_at, box, CENTRE if CENTRE is not None else ZERO, WIDTH or 0.0, HEIGHT or 0.0,
-                         DEPTH or 0.0, 40.0 if LIGHT is None else LIGHT)
+        return rt._guard(
+            _at,
+            box,
+            CENTRE if CENTRE is not None else ZERO,
+            WIDTH or 0.0,
+            HEIGHT or 0.0,
+            DEPTH or 0.0,
+            40.0 if LIGHT is None else LIGHT,
+        )
 
     def poly(self, canvas: Canvas, points, at) -> None:
         """DRAW POLY inside a PRIMITIVE."""
@@ -393,11 +402,16 @@ class Runtime(Arithmetic):
         if k < 0:
             self.fail(at, f"keyframe numbers start at 0 (the starting position), not {k}")
         if k > N.MAX_KEYFRAME:
-            self.fail(at, f"keyframe {k} is beyond the last keyframe number allowed, {N.MAX_KEYFRAME:,}",
-                      "number the keyframes of each joint 1, 2, 3, ...")
+            self.fail(
+                at,
+                f"keyframe {k} is beyond the last keyframe number allowed, {N.MAX_KEYFRAME:,}",
+                "number the keyframes of each joint 1, 2, 3, ...",
+            )
         self._keyframe_values(frame, position, at)
         base = m.base if isinstance(m, KeyframeEdits) else m
-        return KeyframeEdits(base, (joint, k, frame, tuple(position), method, at), m if isinstance(m, KeyframeEdits) else None)
+        return KeyframeEdits(
+            base, (joint, k, frame, tuple(position), method, at), m if isinstance(m, KeyframeEdits) else None
+        )
 
     def _apply_edits(self, m: KeyframeEdits, at) -> M.Motion:
         if m._cache is not None:
@@ -428,18 +442,24 @@ class Runtime(Arithmetic):
                 # The keys are 1..n exactly when there are n of them; else find the first gap (O(set), not O(n)).
                 first = next(i for i, k in enumerate(numbers, start=1) if k != i)
                 eat = kfs[n][3] if kfs[n][3] is not None else at
-                self.fail(eat, f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
-                          "number the keyframes of each joint 1, 2, 3, ... without gaps")
+                self.fail(
+                    eat,
+                    f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
+                    "number the keyframes of each joint 1, 2, 3, ... without gaps",
+                )
             seq = [kfs[i] for i in numbers]
             previous = 0.0  # keyframe 0, the starting position, is at frame 0
             for i in range(len(seq)):
                 gap = seq[i][0] - previous
                 if gap < 0 or 0 < gap < N.MIN_FRAME_GAP:
                     eat = seq[i][3] if seq[i][3] is not None else at
-                    self.fail(eat, f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
-                                   + ("before" if gap < 0 else "too close after")
-                                   + f" keyframe {i} at frame {previous:g}",
-                              None if gap < 0 else _GAP_HINT)
+                    self.fail(
+                        eat,
+                        f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
+                        + ("before" if gap < 0 else "too close after")
+                        + f" keyframe {i} at frame {previous:g}",
+                        None if gap < 0 else _GAP_HINT,
+                    )
                 previous = seq[i][0]
             spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
         motion = self._guard(at, M.Motion.from_tracks, spec)
@@ -475,15 +495,30 @@ class Runtime(Arithmetic):
                 built.append(R.AxisGoal(link, tuple(normal), tuple(target), w))
         if movable is not None:
             movable = list(movable[1]) if movable[0] == "joints" else int(movable[1])
-        result = self._guard(at, lambda: R.reach(
-            fig, built, float(frames), method, start=start_motion, movable=movable, translate=bool(translate),
-            solver=solver, tolerance=tolerance, max_iterations=iterations))
+        result = self._guard(
+            at,
+            lambda: R.reach(
+                fig,
+                built,
+                float(frames),
+                method,
+                start=start_motion,
+                movable=movable,
+                translate=bool(translate),
+                solver=solver,
+                tolerance=tolerance,
+                max_iterations=iterations,
+            ),
+        )
         # Unmet goals, in the solver's own words and by its own test of "met",
         # each shown at its GOAL line.
         t = np.asarray(result.translation, dtype=float).reshape(3)
         if not np.all(np.abs(t) <= N.GEOMETRY_MAX):
-            self.fail(at, "the solved translation is not within the geometry limit",
-                      "the goals may be too far away for the model; everything drawn stays within 1E12 units")
+            self.fail(
+                at,
+                "the solved translation is not within the geometry limit",
+                "the goals may be too far away for the model; everything drawn stays within 1E12 units",
+            )
         with np.errstate(all="ignore"):
             residual = R.residual_warnings(fig, built, result.solution)
         for w in residual:
@@ -491,8 +526,11 @@ class Runtime(Arithmetic):
             if m is None:
                 self.warn(at, _sentence(w))
                 continue
-            self.warn(goals[int(m.group(1)) - 1][-1], _sentence(w[m.end():]),
-                      "the model cannot get there within its extremes, or other goals pull it away")
+            self.warn(
+                goals[int(m.group(1)) - 1][-1],
+                _sentence(w[m.end() :]),
+                "the model cannot get there within its extremes, or other goals pull it away",
+            )
         return result.motion, Vec(float(t[0]), float(t[1]), float(t[2]))
 
     def motion_block(self, joints, at):
@@ -504,14 +542,18 @@ class Runtime(Arithmetic):
             for frame, pos, _method, kat in kfs:
                 self._keyframe_values(frame, pos, kat)
                 if frame < last:
-                    self.fail(kat, f"keyframes must be in ascending frame order: frame {frame:g} comes after frame {last:g}")
+                    self.fail(
+                        kat, f"keyframes must be in ascending frame order: frame {frame:g} comes after frame {last:g}"
+                    )
                 if 0 < frame - last < N.MIN_FRAME_GAP:
                     self.fail(kat, f"frame {frame:g} is too close after frame {last:g}", _GAP_HINT)
                 last = frame
             if start is not None:
                 self._angles(start, jat)
-            spec[joint] = (tuple(start) if start is not None else (0.0, 0.0, 0.0),
-                           [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs])
+            spec[joint] = (
+                tuple(start) if start is not None else (0.0, 0.0, 0.0),
+                [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
+            )
         return self._guard(at, M.Motion.from_tracks, spec)
 
     def _keyframe_values(self, frame, position, at) -> None:
@@ -519,14 +561,20 @@ class Runtime(Arithmetic):
         if frame < 0:
             self.fail(at, f"frame {frame:g} is before the motion starts")
         if frame > N.MAX_FRAME:
-            self.fail(at, f"frame {N.magnitude(frame)} is beyond the last frame a keyframe may have, {N.magnitude(N.MAX_FRAME)}")
+            self.fail(
+                at,
+                f"frame {N.magnitude(frame)} is beyond the last frame a keyframe may have, {N.magnitude(N.MAX_FRAME)}",
+            )
         self._angles(position, at)
 
     def _angles(self, position, at) -> None:
         if not max(abs(a) for a in position) <= N.MAX_ANGLE:
             far = max(abs(a) for a in position)
-            self.fail(at, f"an angle of {N.magnitude(far)} degrees is beyond the largest a keyframe may hold, {N.magnitude(N.MAX_ANGLE)}",
-                      "angles are in degrees; a joint's extremes clip them anyway")
+            self.fail(
+                at,
+                f"an angle of {N.magnitude(far)} degrees is beyond the largest a keyframe may hold, {N.magnitude(N.MAX_ANGLE)}",
+                "angles are in degrees; a joint's extremes clip them anyway",
+            )
 
     def concat(self, a, b, at):
         return self._guard(at, M.concat, self._motion(a, at), self._motion(b, at))
@@ -590,8 +638,11 @@ class Runtime(Arithmetic):
         if length < 0:
             self.fail(at, f"a scene's LENGTH cannot be negative ({length})")
         if length > N.MAX_SCENE_LENGTH:
-            self.fail(at, f"a scene of {length:,} ticks is longer than the longest allowed, {N.MAX_SCENE_LENGTH:,}",
-                      "that is about 4.6 days at 24 frames a second; split the action into several scenes")
+            self.fail(
+                at,
+                f"a scene of {length:,} ticks is longer than the longest allowed, {N.MAX_SCENE_LENGTH:,}",
+                "that is about 4.6 days at 24 frames a second; split the action into several scenes",
+            )
         if sameframe < 1:
             self.fail(at if sameframe_at is None else sameframe_at, f"SAMEFRAME must be at least 1, not {sameframe}")
         state = self.scene
@@ -634,8 +685,11 @@ class Runtime(Arithmetic):
         self._bind_cache[key] = (fig, motion)
         missing = [j for j in motion.joints if j not in set(fig.joint_ids)]
         if missing:
-            self.warn(at, f"the motion drives joint{'s' if len(missing) > 1 else ''} "
-                          f"{', '.join(map(str, missing))}, which the model does not have")
+            self.warn(
+                at,
+                f"the motion drives joint{'s' if len(missing) > 1 else ''} "
+                f"{', '.join(map(str, missing))}, which the model does not have",
+            )
 
     def background(self, items, at):
         out = []
@@ -689,7 +743,9 @@ class Runtime(Arithmetic):
             return f"MODEL {label}\n" + fig.describe_table()
         if kind == "MOTION":
             motion = self._motion(value, at)
-            lines = [f"MOTION {label}: length {motion.length:g} frames, joints {', '.join(map(str, motion.joints)) or 'none'}"]
+            lines = [
+                f"MOTION {label}: length {motion.length:g} frames, joints {', '.join(map(str, motion.joints)) or 'none'}"
+            ]
             try:
                 for j in motion.joints:
                     start, kfs = motion.keyframes(j, limit=1000)
@@ -721,7 +777,7 @@ class SceneState:
         self.at = at
 
 
-_GAP_HINT = (f"two keyframes of a joint share a frame (a step) or lie at least {N.MIN_FRAME_GAP:g} frames apart")
+_GAP_HINT = f"two keyframes of a joint share a frame (a step) or lie at least {N.MIN_FRAME_GAP:g} frames apart"
 
 
 def _fmt_vec(v) -> str:

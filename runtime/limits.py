@@ -42,8 +42,11 @@ def check_graphical(g: Graphical, what: str = "this object") -> Graphical:
     """``g`` if all its vertices are within the geometry limit, else LigError."""
     e = g.extent()
     if not e <= GEOMETRY_MAX:
-        raise LigError(f"{what} reaches {_fmt(e)} units from the origin along an axis, beyond the limit of "
-                       f"{_fmt(GEOMETRY_MAX)} for anything drawn", _HINT)
+        raise LigError(
+            f"{what} reaches {_fmt(e)} units from the origin along an axis, beyond the limit of "
+            f"{_fmt(GEOMETRY_MAX)} for anything drawn",
+            _HINT,
+        )
     return g
 
 
@@ -89,10 +92,12 @@ def check_figure(fig, what: str = "the model"):
     with np.errstate(all="ignore"):
         far = float(np.linalg.norm(p[:3, :3]) * reach + np.max(np.abs(p[:3, 3])))
     if not far <= GEOMETRY_MAX:
-        raise LigError(f"{what} can reach {_fmt(far)} units from the origin, beyond the limit of "
-                       f"{_fmt(GEOMETRY_MAX)} for anything drawn",
-                       "a model is measured by its segments and joint locations, so that it stays within the "
-                       "limit in every pose; " + _HINT)
+        raise LigError(
+            f"{what} can reach {_fmt(far)} units from the origin, beyond the limit of "
+            f"{_fmt(GEOMETRY_MAX)} for anything drawn",
+            "a model is measured by its segments and joint locations, so that it stays within the "
+            "limit in every pose; " + _HINT,
+        )
     return fig
 
 
@@ -101,13 +106,18 @@ def check_view_point(point) -> tuple:
     x, y, z = (float(c) for c in point)
     far = max(abs(x), abs(y), abs(z))
     if not far <= GEOMETRY_MAX:
-        raise LigError(f"the VIEW POINT is {_fmt(far)} units from the origin along an axis, beyond the limit of "
-                       f"{_fmt(GEOMETRY_MAX)}", _HINT)
+        raise LigError(
+            f"the VIEW POINT is {_fmt(far)} units from the origin along an axis, beyond the limit of "
+            f"{_fmt(GEOMETRY_MAX)}",
+            _HINT,
+        )
     if math.hypot(x, y, z) < GEOMETRY_MIN:
         if x == y == z == 0:
             raise LigError("the VIEW POINT cannot be the origin: the camera looks at the origin")
-        raise LigError(f"the VIEW POINT is closer to the origin than {_fmt(GEOMETRY_MIN)}, so the camera has no "
-                       "usable direction", "the camera looks at the origin from the VIEW POINT")
+        raise LigError(
+            f"the VIEW POINT is closer to the origin than {_fmt(GEOMETRY_MIN)}, so the camera has no usable direction",
+            "the camera looks at the origin from the VIEW POINT",
+        )
     return (x, y, z)
 
 
@@ -117,6 +127,8 @@ def check_view_width(width) -> float:
     if not w > 0:
         raise LigError(f"the VIEW WIDTH must be positive, not {w:g}")
     if w < GEOMETRY_MIN:
-        raise LigError(f"the VIEW WIDTH {w:g} is below the smallest width, {_fmt(GEOMETRY_MIN)}",
-                       "VIEW WIDTH is the width of the view around the origin, in world units")
+        raise LigError(
+            f"the VIEW WIDTH {w:g} is below the smallest width, {_fmt(GEOMETRY_MIN)}",
+            "VIEW WIDTH is the width of the view around the origin, in world units",
+        )
     return w

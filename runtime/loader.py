@@ -26,7 +26,7 @@ def exec_module(text: str, filename: str, namespace: dict) -> dict:
     start = 0
     while True:
         end = text.find(PIECE_MARK, start + 1)
-        piece = text[start:] if end < 0 else text[start:end + 1]
+        piece = text[start:] if end < 0 else text[start : end + 1]
         exec(compile(piece, filename, "exec"), namespace)  # noqa: S102 - the module the lowerer wrote
         if end < 0:
             return namespace

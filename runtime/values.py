@@ -137,8 +137,10 @@ def check_triangles(n: int, what: str) -> None:
         Names the object in the message.
     """
     if n > MAX_TRIANGLES:
-        raise LigError(f"{what} would have {n:,} triangles, beyond the limit of {MAX_TRIANGLES:,} "
-                       f"for one graphical object", _MANY_HINT)
+        raise LigError(
+            f"{what} would have {n:,} triangles, beyond the limit of {MAX_TRIANGLES:,} for one graphical object",
+            _MANY_HINT,
+        )
 
 
 class Canvas:
@@ -169,8 +171,11 @@ class Canvas:
             raise LigError(f"a polygon needs at least three corners; this one has {len(pts)}")
         far = max(abs(c) for p in pts for c in p)
         if not far <= GEOMETRY_MAX:
-            raise LigError(f"this polygon has a corner {magnitude(far)} units along an axis, beyond the limit of "
-                           f"{magnitude(GEOMETRY_MAX)} for anything drawn", _FAR_HINT)
+            raise LigError(
+                f"this polygon has a corner {magnitude(far)} units along an axis, beyond the limit of "
+                f"{magnitude(GEOMETRY_MAX)} for anything drawn",
+                _FAR_HINT,
+            )
         self.triangles += len(pts) - 2
         check_triangles(self.triangles, "the primitive's drawing")
         self.polys.append((np.asarray(pts, dtype=np.float64), self.light))
@@ -295,8 +300,11 @@ def box(centre, width, height, depth, light) -> Graphical:
     w, h, d = float(width), float(height), float(depth)
     far = float(np.max(np.abs(c))) + max(abs(w), abs(h), abs(d)) / 2  # its corners are c +- size / 2
     if not far <= GEOMETRY_MAX:
-        raise LigError(f"this BOX reaches {magnitude(far)} units from the origin along an axis, beyond the limit of "
-                       f"{magnitude(GEOMETRY_MAX)} for anything drawn", _FAR_HINT)
+        raise LigError(
+            f"this BOX reaches {magnitude(far)} units from the origin along an axis, beyond the limit of "
+            f"{magnitude(GEOMETRY_MAX)} for anything drawn",
+            _FAR_HINT,
+        )
     light = _clip_lightness(light)
     l1, l2 = light, light * 1.5
     ftr = c + (w / 2, h / 2, d / 2)

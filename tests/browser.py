@@ -19,10 +19,22 @@ import pytest
 
 CHROMIUM = os.environ.get("LIGANIMATE_CHROMIUM", "/usr/bin/chromium")
 CHROMEDRIVER = os.environ.get("LIGANIMATE_CHROMEDRIVER", "/usr/bin/chromedriver")
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--disable-default-apps", "--disable-extensions", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-         "--force-device-scale-factor=1", "--hide-scrollbars"]
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-default-apps",
+    "--disable-extensions",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--force-device-scale-factor=1",
+    "--hide-scrollbars",
+]
 
 
 def require_chromium() -> None:
@@ -33,8 +45,11 @@ def require_chromium() -> None:
     except ImportError:
         missing.append("the selenium package")
     if missing:
-        why = ("browser tests need " + ", ".join(missing)
-               + " (apt-get install chromium chromium-driver; pip install -e '.[test]')")
+        why = (
+            "browser tests need "
+            + ", ".join(missing)
+            + " (apt-get install chromium chromium-driver; pip install -e '.[test]')"
+        )
         if os.environ.get("CI"):
             pytest.fail(why)
         pytest.skip(why)

@@ -36,8 +36,13 @@ def validator_or_skip() -> str:
         pytest.skip(f"{' and '.join(missing)} not found, so the Khronos glTF-Validator cannot run here")
     if not os.path.isfile(os.path.join(VALIDATOR_MODULE, "index.js")):
         os.makedirs(VALIDATOR_DIR, exist_ok=True)
-        r = subprocess.run([npm, "install", "--no-audit", "--no-fund", "--prefix", VALIDATOR_DIR, "gltf-validator"],
-                           check=False, capture_output=True, text=True, timeout=600)
+        r = subprocess.run(
+            [npm, "install", "--no-audit", "--no-fund", "--prefix", VALIDATOR_DIR, "gltf-validator"],
+            check=False,
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
         if r.returncode != 0 or not os.path.isfile(os.path.join(VALIDATOR_MODULE, "index.js")):
             message = f"npm install gltf-validator failed:\n{r.stdout}\n{r.stderr}"
             if os.environ.get("CI"):
@@ -86,11 +91,13 @@ def accessor(doc, blob, index) -> np.ndarray:
 
 def _quat_matrix(q) -> np.ndarray:
     x, y, z, w = q / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def _local(node, override) -> np.ndarray:

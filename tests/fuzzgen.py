@@ -29,8 +29,7 @@ import re
 
 from fuzzgrammar import grammar_program
 
-__all__ = ["EXTREMES", "GENERATORS", "TEMPLATES", "grammar_program", "number_program", "splice_program",
-           "wild_program"]
+__all__ = ["EXTREMES", "GENERATORS", "TEMPLATES", "grammar_program", "number_program", "splice_program", "wild_program"]
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -39,21 +38,85 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 _BIG = "1" + "0" * 400  # 401 digits
 #: Values for a numeric slot: literals, and expressions that make inf, NaN, huge integers.
 EXTREMES = [
-    "1e308", "1e309", "1E400", "-0.0", "0.0", "0", "5e-324", "4.9e-324", "1e-320", "2.2250738585072014e-308",
-    "9223372036854775808", "9223372036854775807", "-9223372036854775809", "18446744073709551616",
-    "2147483648", "4294967296", "1e18", "1000000000000", "1e300", "-1e308", "1e309°", "1e308°", "1e-300",
-    _BIG, "9" * 401, "-" + _BIG, "1" * 4301, "1" * 5000,
-    "1e308*10", "-(1e308*10)", "1e308*10-1e308*10", "0*(1e308*10)", "1e308+1e308", "1e308*1e308",
-    "1/(1e308*10)", "-5e-324", f"{_BIG} / 3", f"{_BIG} MOD 7", f"{_BIG} * {_BIG}", f"({_BIG}) * 1.5",
-    "INT(1e308)", "NINT(1e300)", "INT(1e308*10)", "NINT(1e308*10-1e308*10)", "(1e308*10) MOD 7",
-    "7 MOD (1e308*10)", "COS(1e308*10)", "SIN(1e308)", "TAN(90)", "SQRT(1e308*10)", "EXP(1000)", "EXP(709.7)",
-    "LOG(5e-324)", "ABS(1e308*10-1e308*10)", "MAX(1e308*10, 0)", "MIN(1e308*10-1e308*10, 1)",
-    "NORM((1e200, 1e200, 1e200))", "NORM((1e308*10, 0, 0))", f"REAL({_BIG})", "REAL(1e309)",
-    "DOT((1e200, 1e200, 1e200), (1e200, 1e200, 1e200))", "X(CROSS((1e308, 0, 0), (0, 1e308, 0)))",
-    "-1e309", "1e-400", "1e308*-10", "-(1e308*10)+(1e308*10)", "1e-100", "1e-101", "0.5e-100",
+    "1e308",
+    "1e309",
+    "1E400",
+    "-0.0",
+    "0.0",
+    "0",
+    "5e-324",
+    "4.9e-324",
+    "1e-320",
+    "2.2250738585072014e-308",
+    "9223372036854775808",
+    "9223372036854775807",
+    "-9223372036854775809",
+    "18446744073709551616",
+    "2147483648",
+    "4294967296",
+    "1e18",
+    "1000000000000",
+    "1e300",
+    "-1e308",
+    "1e309°",
+    "1e308°",
+    "1e-300",
+    _BIG,
+    "9" * 401,
+    "-" + _BIG,
+    "1" * 4301,
+    "1" * 5000,
+    "1e308*10",
+    "-(1e308*10)",
+    "1e308*10-1e308*10",
+    "0*(1e308*10)",
+    "1e308+1e308",
+    "1e308*1e308",
+    "1/(1e308*10)",
+    "-5e-324",
+    f"{_BIG} / 3",
+    f"{_BIG} MOD 7",
+    f"{_BIG} * {_BIG}",
+    f"({_BIG}) * 1.5",
+    "INT(1e308)",
+    "NINT(1e300)",
+    "INT(1e308*10)",
+    "NINT(1e308*10-1e308*10)",
+    "(1e308*10) MOD 7",
+    "7 MOD (1e308*10)",
+    "COS(1e308*10)",
+    "SIN(1e308)",
+    "TAN(90)",
+    "SQRT(1e308*10)",
+    "EXP(1000)",
+    "EXP(709.7)",
+    "LOG(5e-324)",
+    "ABS(1e308*10-1e308*10)",
+    "MAX(1e308*10, 0)",
+    "MIN(1e308*10-1e308*10, 1)",
+    "NORM((1e200, 1e200, 1e200))",
+    "NORM((1e308*10, 0, 0))",
+    f"REAL({_BIG})",
+    "REAL(1e309)",
+    "DOT((1e200, 1e200, 1e200), (1e200, 1e200, 1e200))",
+    "X(CROSS((1e308, 0, 0), (0, 1e308, 0)))",
+    "-1e309",
+    "1e-400",
+    "1e308*-10",
+    "-(1e308*10)+(1e308*10)",
+    "1e-100",
+    "1e-101",
+    "0.5e-100",
     # Either side of the language's limits (lang/numbers.py): geometry, angles, keyframes, scene length.
-    "1e12", "1000000000000.5", "999999999999.9999", "1e9", "1000000001", "1000000", "1000001",
-    "10000000", "10000001",
+    "1e12",
+    "1000000000000.5",
+    "999999999999.9999",
+    "1e9",
+    "1000000001",
+    "1000000",
+    "1000001",
+    "10000000",
+    "10000001",
 ]
 
 # Slots: «N:default» a number, «V:(x, y, z)» a vector, «P:(lo, hi)» a pair of extremes.
@@ -104,13 +167,16 @@ TEMPLATES = {
       P = P * «N:2» + P / «N:4»
       PRINT S, N, P
 """,
-    "figure": _FIGURE + """\
+    "figure": _FIGURE
+    + """\
       G1 :- G1 <TRANS «V:(0.0, -0.5, 0.0)», ROT X «N:10», ROT Y «N:0», SCALE «N:1.0», LIGHTNESS «N:60»>
       G3 :- G1 + G2 <ROT Z «N:15»>
       M :- M <TRANS «V:(0.0, 0.0, 0.0)», ROT Z «N:0», SCALE MODEL «N:1.0», SCALE EXTREMES «N:1.0»>
       M :- M <TRANS JOINTS BY «N:0», SCALE «N:1.0»>
       FIGURE M MAIN JOINT «N:1»
-""" + _SCENE + """\
+"""
+    + _SCENE
+    + """\
       INITIALIZE SCENE 2
           VIEW POINT = (0.0, 0.5, -6.0)
           VIEW WIDTH = 4.0
@@ -119,7 +185,8 @@ TEMPLATES = {
       ENDSCENE
       SHOOTSCENES
 """,
-    "motion": _FIGURE + """\
+    "motion": _FIGURE
+    + """\
       MOTION W2, W3, W4
       STARTMOTION W2
         JOINT «N:2» POSITION «N:0.0», «N:0.0», «N:10.0»
@@ -274,6 +341,7 @@ def fill(template: str, values: dict) -> str:
 
 def extreme(rng, kind: str) -> str:
     """An extreme value for a slot of ``kind`` (N, V or P): an extreme number, or a tuple holding some."""
+
     def number():
         v = rng.choice(EXTREMES)
         return v if re.fullmatch(r"[0-9.eE+°]+", v) else f"({v})"
@@ -302,8 +370,14 @@ def number_program(rng) -> str:
 # ================================================================ splices
 
 _OPENERS = re.compile(r"(?i)^[ \t*]*(STARTMODEL|STARTMOTION|STARTREACH|INITIALIZE|PRIMITIVE|BEGIN)\b")
-_CLOSERS = {"STARTMODEL": "ENDMODEL", "STARTMOTION": "ENDMOTION", "STARTREACH": "ENDREACH",
-            "INITIALIZE": "ENDSCENE", "PRIMITIVE": "END", "BEGIN": "END"}
+_CLOSERS = {
+    "STARTMODEL": "ENDMODEL",
+    "STARTMOTION": "ENDMOTION",
+    "STARTREACH": "ENDREACH",
+    "INITIALIZE": "ENDSCENE",
+    "PRIMITIVE": "END",
+    "BEGIN": "END",
+}
 _DO = re.compile(r"(?i)^[ \t]*DO[ \t]+(\d+)")
 _LENGTH = re.compile(r"(?i)(\bLENGTH[ \t]+)(\d+)")
 #: Longest scene a splice keeps: the examples' long scenes would make cases slow.
@@ -330,8 +404,11 @@ def _is_code(line: str) -> bool:
 def _continues(prev: str, line: str) -> bool:
     """Does ``line`` continue the statement of code line ``prev`` (an open parenthesis, a trailing comma...)?"""
     code = re.sub(r"\{[^}]*\}|'[^'\n]*'", "", prev).rstrip()
-    return (code.count("(") > code.count(")") or code[-1:] in (",", "(", "+", "-", "*", "/", "=", "<")
-            or re.match(r"(?i)\s*(TO|INTERPOLAT\w*)\b", line) is not None)
+    return (
+        code.count("(") > code.count(")")
+        or code[-1:] in (",", "(", "+", "-", "*", "/", "=", "<")
+        or re.match(r"(?i)\s*(TO|INTERPOLAT\w*)\b", line) is not None
+    )
 
 
 @functools.cache
@@ -408,5 +485,4 @@ def wild_program(rng) -> str:
 
 
 #: The generators by name, as the benchmark and the tests call them.
-GENERATORS = {"grammar": grammar_program, "numbers": number_program, "splice": splice_program,
-              "wild": wild_program}
+GENERATORS = {"grammar": grammar_program, "numbers": number_program, "splice": splice_program, "wild": wild_program}

@@ -41,8 +41,12 @@ NUM, INT, VEC, PAIR, GRAPH, MODEL, MOTION, COND = "N", "I", "V", "P", "G", "M", 
 
 #: The prelude's names, by kind.
 PRELUDE_NAMES = {
-    INT: ["I", "J", "K"], NUM: ["A", "B"], VEC: ["V1", "V2"], GRAPH: ["G1", "G2", "G3"],
-    MODEL: ["M1", "M2"], MOTION: ["W1", "W2"],
+    INT: ["I", "J", "K"],
+    NUM: ["A", "B"],
+    VEC: ["V1", "V2"],
+    GRAPH: ["G1", "G2", "G3"],
+    MODEL: ["M1", "M2"],
+    MOTION: ["W1", "W2"],
 }
 DECLARATIONS = """\
       INTEGER I, J, K
@@ -72,40 +76,106 @@ VALUES = """\
 
 # The built-in functions (compiler/types.py), as argument kinds and result kind.
 _FUNCTIONS = {
-    "SIN": ([NUM], NUM), "COS": ([NUM], NUM), "TAN": ([NUM], NUM), "ASIN": ([NUM], NUM),
-    "ACOS": ([NUM], NUM), "ATAN": ([NUM], NUM), "ATAN2": ([NUM, NUM], NUM), "SQRT": ([NUM], NUM),
-    "EXP": ([NUM], NUM), "LOG": ([NUM], NUM), "ABS": ([NUM], NUM), "INT": ([NUM], NUM),
-    "NINT": ([NUM], NUM), "REAL": ([NUM], NUM), "FLOAT": ([NUM], NUM), "MIN": ([NUM, NUM], NUM),
-    "MAX": ([NUM, NUM], NUM), "MOD": ([NUM, NUM], NUM), "DOT": ([VEC, VEC], NUM),
-    "CROSS": ([VEC, VEC], VEC), "NORM": ([VEC], NUM), "X": ([VEC], NUM), "Y": ([VEC], NUM),
-    "Z": ([VEC], NUM), "LEN": ([MOTION], NUM),
+    "SIN": ([NUM], NUM),
+    "COS": ([NUM], NUM),
+    "TAN": ([NUM], NUM),
+    "ASIN": ([NUM], NUM),
+    "ACOS": ([NUM], NUM),
+    "ATAN": ([NUM], NUM),
+    "ATAN2": ([NUM, NUM], NUM),
+    "SQRT": ([NUM], NUM),
+    "EXP": ([NUM], NUM),
+    "LOG": ([NUM], NUM),
+    "ABS": ([NUM], NUM),
+    "INT": ([NUM], NUM),
+    "NINT": ([NUM], NUM),
+    "REAL": ([NUM], NUM),
+    "FLOAT": ([NUM], NUM),
+    "MIN": ([NUM, NUM], NUM),
+    "MAX": ([NUM, NUM], NUM),
+    "MOD": ([NUM, NUM], NUM),
+    "DOT": ([VEC, VEC], NUM),
+    "CROSS": ([VEC, VEC], VEC),
+    "NORM": ([VEC], NUM),
+    "X": ([VEC], NUM),
+    "Y": ([VEC], NUM),
+    "Z": ([VEC], NUM),
+    "LEN": ([MOTION], NUM),
 }
-_NUMBERS = ["0", "1", "2", "3", "0.5", "1.5", "2.5", "10", "45", "90", "180", "360", "0.25", ".5", "7",
-            "135°", "30°", "1e3", "0.0", "1.0"]
+_NUMBERS = [
+    "0",
+    "1",
+    "2",
+    "3",
+    "0.5",
+    "1.5",
+    "2.5",
+    "10",
+    "45",
+    "90",
+    "180",
+    "360",
+    "0.25",
+    ".5",
+    "7",
+    "135°",
+    "30°",
+    "1e3",
+    "0.0",
+    "1.0",
+]
 _ODD_NUMBERS = ["1e6", "99999", "1e308", "1e-5", "0.000001", "123456789", "1e30", "4e2°"]
 _EDGE_NUMBERS = ["1e309", "5e-324", "9223372036854775808", "1" + "0" * 400, "1e12", "1e9", "0.0000", "0e0"]
 _SMALL = ["0", "1", "2", "1", "2", "3"]
 _INTERPOLATIONS = ["LINEAR", "ACCDCC", "ACCELERATE", "DECELERATE", "LINEAR", "BOUNCE"]
 _SOLVERS = ["DLS", "TRANSPOSE", "CCD", "NEWTON"]
 #: BOX's clauses as (word, kind, optional), in order.
-_BOX = [("AT", VEC, True), ("WIDTH", NUM, False), ("HEIGHT", NUM, False), ("DEPTH", NUM, False),
-        ("LIGHTNESS", NUM, True)]
+_BOX = [
+    ("AT", VEC, True),
+    ("WIDTH", NUM, False),
+    ("HEIGHT", NUM, False),
+    ("DEPTH", NUM, False),
+    ("LIGHTNESS", NUM, True),
+]
 _PRIMITIVE_HEADS = ["PEG", "SLAB"]
 _PARAMS = ["CENTRE", "S", "W", "LIGHT"]
 _LINE_STARTS = ("statement", "top", "joint_stmt", "motion_joint", "keyframe", "reach_item", "_prim_item")
 _NESTING = ("if_stmt", "block", "scene_block", "model_block", "motion_block", "primitive_def", "reach_block")
 _BLOCKS = ("if_stmt", "model_block", "motion_block", "scene_block", "reach_block", "do_stmt")
 _STATEMENT_WEIGHTS = {
-    "declaration": 1.0, "assignment": 9.0, "keyframe_assign": 2.0, "do_stmt": 1.0, "continue_stmt": 0.02,
-    "if_stmt": 1.2, "model_block": 0.8, "motion_block": 0.8, "figure_stmt": 0.5, "scene_block": 1.5,
-    "animate_stmt": 0.05, "background_stmt": 0.1, "print_stmt": 1.5, "view_stmt": 0.1, "shoot_stmt": 0.8,
-    "stop_stmt": 0.1, "return_stmt": 0.02, "draw_with": 0.02, "draw_poly": 0.02, "load_stmt": 0.5,
+    "declaration": 1.0,
+    "assignment": 9.0,
+    "keyframe_assign": 2.0,
+    "do_stmt": 1.0,
+    "continue_stmt": 0.02,
+    "if_stmt": 1.2,
+    "model_block": 0.8,
+    "motion_block": 0.8,
+    "figure_stmt": 0.5,
+    "scene_block": 1.5,
+    "animate_stmt": 0.05,
+    "background_stmt": 0.1,
+    "print_stmt": 1.5,
+    "view_stmt": 0.1,
+    "shoot_stmt": 0.8,
+    "stop_stmt": 0.1,
+    "return_stmt": 0.02,
+    "draw_with": 0.02,
+    "draw_poly": 0.02,
+    "load_stmt": 0.5,
     "reach_block": 0.5,
 }
 _MODIFIER_WEIGHTS = {
     GRAPH: {"mod_trans": 3, "mod_rot": 3, "mod_scale": 2, "mod_lightness": 2},
-    MODEL: {"mod_trans": 3, "mod_rot": 2, "mod_scale_model": 2, "mod_scale_extremes": 1, "mod_scale": 1,
-            "mod_trans_joints": 1, "mod_lightness": 0.1},
+    MODEL: {
+        "mod_trans": 3,
+        "mod_rot": 2,
+        "mod_scale_model": 2,
+        "mod_scale_extremes": 1,
+        "mod_scale": 1,
+        "mod_trans_joints": 1,
+        "mod_lightness": 0.1,
+    },
     MOTION: {"mod_scale_frames": 3, "mod_scale_extremes": 2},
 }
 
@@ -406,9 +476,13 @@ class Expander:
             kinds = [kind] * count
         for i, k in enumerate(kinds):
             # Separators (";") after an item are rare: the newline usually does it.
-            rule = self.pick([(0.15 if any(s.name == "__start_star_0" for s in r.expansion) else 1.0, r)
-                              for r in (base if i == 0 else more)])
-            for sym in [s.name for s in rule.expansion][0 if i == 0 else 1:]:
+            rule = self.pick(
+                [
+                    (0.15 if any(s.name == "__start_star_0" for s in r.expansion) else 1.0, r)
+                    for r in (base if i == 0 else more)
+                ]
+            )
+            for sym in [s.name for s in rule.expansion][0 if i == 0 else 1 :]:
                 if self.g.is_terminal(sym):
                     self.tokens.append(self.terminal(sym, k, {}))
                 else:
@@ -441,8 +515,12 @@ class Expander:
         if name in ("_prim_head", "_load_name"):
             return 10.0 if head == "NAME" else 1.0
         if name == "rhs":
-            return {"expr": 5.0, "joint_expr": 4.0 if kind == MODEL else 0.1,
-                    "strip_expr": 1.5 if kind == MOTION else 0.1, "sync_expr": 1.5 if kind == MOTION else 0.1}[head]
+            return {
+                "expr": 5.0,
+                "joint_expr": 4.0 if kind == MODEL else 0.1,
+                "strip_expr": 1.5 if kind == MOTION else 0.1,
+                "sync_expr": 1.5 if kind == MOTION else 0.1,
+            }[head]
         if name in ("atom", "catom"):
             w = _atom_weight(alias, symbols, kind) * (0.3 if deep and len(symbols) > 1 else 1.0)
             if self.in_model and kind == GRAPH and alias != "var":
@@ -599,8 +677,14 @@ class Expander:
             return "$" + self.name_of(MODEL)
         if sym == "TYPE_KW":
             word = rng.choice(["INTEGER", "REAL", "VECTOR", "GRAPHICAL", "MODEL", "MOTION"])
-            local["kind"] = {"INTEGER": INT, "REAL": NUM, "VECTOR": VEC, "GRAPHICAL": GRAPH,
-                             "MODEL": MODEL, "MOTION": MOTION}[word]
+            local["kind"] = {
+                "INTEGER": INT,
+                "REAL": NUM,
+                "VECTOR": VEC,
+                "GRAPHICAL": GRAPH,
+                "MODEL": MODEL,
+                "MOTION": MOTION,
+            }[word]
             return self.cased(word)
         t = self.g.terminals[sym]
         text = t.pattern.value if t.pattern.type == "str" else sample_regex(t.pattern.value, rng)
@@ -737,8 +821,9 @@ def grammar_program(rng, wild: tuple = (), wild_rate: float = 0.0) -> str:
     """
     r = rng.random()
     prelude = "" if r < 0.1 else (DECLARATIONS if r < 0.3 else DECLARATIONS + VALUES)
-    ex = Expander(rng, PRELUDE_NAMES if prelude else {k: v[:1] for k, v in PRELUDE_NAMES.items()},
-                  tuple(wild), wild_rate)
+    ex = Expander(
+        rng, PRELUDE_NAMES if prelude else {k: v[:1] for k, v in PRELUDE_NAMES.items()}, tuple(wild), wild_rate
+    )
     ex.expand("start", 0)
     while ex.labels and rng.random() < 0.9:
         ex.tokens += [None, ex.labels.pop(), "CONTINUE"]

@@ -57,11 +57,15 @@ MEMORY = 1 << 30
 
 _PACKAGE_ROOTS = tuple(
     os.path.realpath(p) + os.sep
-    for p in {os.path.dirname(os.path.dirname(liganimate.__file__)),  # repo root (editable install)
-              os.path.dirname(liganimate.__file__)}
+    for p in {
+        os.path.dirname(os.path.dirname(liganimate.__file__)),  # repo root (editable install)
+        os.path.dirname(liganimate.__file__),
+    }
 )
 # Text that must never appear in a diagnostic's sentence or hint.
-_PYTHON_TEXT = re.compile(r"Traceback|array\(|site-packages|\w/[\w/.-]*\.py\b|object at 0x|<liganimate|\bnan\b|\binf\b|Errno")
+_PYTHON_TEXT = re.compile(
+    r"Traceback|array\(|site-packages|\w/[\w/.-]*\.py\b|object at 0x|<liganimate|\bnan\b|\binf\b|Errno"
+)
 
 
 class Slow(BaseException):
@@ -153,7 +157,7 @@ def site_of(exc: BaseException) -> str:
             continue
         path = os.path.realpath(fr.filename)
         for root in _PACKAGE_ROOTS:
-            if path.startswith(root) and "site-packages" not in path[len(root):]:
+            if path.startswith(root) and "site-packages" not in path[len(root) :]:
                 where = f"{os.path.relpath(path, root)}:{fr.name}"
                 break
     return f"{type(exc).__name__} at {where}"
@@ -190,8 +194,9 @@ def _runtime_warnings(caught) -> list:
     return [w for w in caught if issubclass(w.category, RuntimeWarning)]
 
 
-def run_case(text: str, limit: float = 2.0, render: bool = True, memory: int = MEMORY,
-             workdir: str | None = None) -> Outcome:
+def run_case(
+    text: str, limit: float = 2.0, render: bool = True, memory: int = MEMORY, workdir: str | None = None
+) -> Outcome:
     """Compile, check and (if ``render``) render ``text``; return its :class:`Outcome`.
 
     ``limit`` is in seconds (0: none); ``memory`` is the address space the
@@ -217,13 +222,13 @@ def run_case(text: str, limit: float = 2.0, render: bool = True, memory: int = M
                 program.check()
                 if render:
                     stage = "render"
-                    program.render(os.path.join(tmp, "out"), checked=True, size=SIZE, quiet=True, workers=1,
-                                   stdout=io.StringIO())
+                    program.render(
+                        os.path.join(tmp, "out"), checked=True, size=SIZE, quiet=True, workers=1, stdout=io.StringIO()
+                    )
         leaked = _runtime_warnings(caught)
         if leaked:
             w = leaked[0]
-            return Outcome("leak", stage, f"{w.category.__name__} from {os.path.basename(w.filename)}",
-                           str(w.message))
+            return Outcome("leak", stage, f"{w.category.__name__} from {os.path.basename(w.filename)}", str(w.message))
         return Outcome("ok", stage)
     except Slow:
         return Outcome("slow", stage, detail=f"over {limit:g} s")
@@ -231,16 +236,14 @@ def run_case(text: str, limit: float = 2.0, render: bool = True, memory: int = M
         raise
     except LigDiagnostics as exc:
         if stage == "render":
-            return Outcome("disagree", stage, f"check passed, render raised {site_of(exc)}",
-                           _first_line(str(exc)), exc)
+            return Outcome("disagree", stage, f"check passed, render raised {site_of(exc)}", _first_line(str(exc)), exc)
         bad = _bad_diagnostic(exc.diagnostics)
         if bad:
             return Outcome("baddiag", stage, f"bad diagnostic from {site_of(exc)}", bad, exc)
         return Outcome("diagnosed", stage, detail=_first_line(str(exc)), exc=exc)
     except (LigError, OSError, RecursionError) as exc:
         if stage == "render":
-            return Outcome("disagree", stage, f"check passed, render raised {site_of(exc)}",
-                           _first_line(str(exc)), exc)
+            return Outcome("disagree", stage, f"check passed, render raised {site_of(exc)}", _first_line(str(exc)), exc)
         return Outcome("error", stage, detail=f"{type(exc).__name__}: {_first_line(str(exc))}", exc=exc)
     except Exception as exc:  # noqa: BLE001 - what the CLI would call an internal error is the finding
         return Outcome("crash", stage, site_of(exc), f"{type(exc).__name__}: {_first_line(str(exc))}", exc)
@@ -267,8 +270,10 @@ def timed(text: str, **options) -> Outcome:
 # ------------------------------------------------------------------ minimising
 
 # A token and the blanks after it: removing a token never glues its neighbours together.
-_TOKEN = re.compile(r"(?:\{[^}]*\}|'[^'\n]*'|[A-Za-z_][A-Za-z0-9_]*|[0-9.]+(?:[eE][-+]?\d+)?°?|::=|:-|:=|\S)\s*"
-                    r"|\s+")
+_TOKEN = re.compile(
+    r"(?:\{[^}]*\}|'[^'\n]*'|[A-Za-z_][A-Za-z0-9_]*|[0-9.]+(?:[eE][-+]?\d+)?°?|::=|:-|:=|\S)\s*"
+    r"|\s+"
+)
 
 
 def _ddmin(parts: list, keeps, deadline: float, join) -> list:
@@ -280,7 +285,7 @@ def _ddmin(parts: list, keeps, deadline: float, join) -> list:
         for i in range(0, len(parts), chunk):
             if time.monotonic() >= deadline:
                 break
-            trial = parts[:i] + parts[i + chunk:]
+            trial = parts[:i] + parts[i + chunk :]
             if trial and keeps(join(trial)):
                 parts = trial
                 n = max(n - 1, 2)
@@ -298,7 +303,7 @@ def _drop_runs(lines: list, keeps, deadline: float, longest: int = 8) -> list:
     for width in range(min(longest, len(lines) - 1), 1, -1):
         i = 0
         while i + width <= len(lines) and time.monotonic() < deadline:
-            trial = lines[:i] + lines[i + width:]
+            trial = lines[:i] + lines[i + width :]
             if keeps("\n".join(trial)):
                 lines = trial
             else:

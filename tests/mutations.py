@@ -12,7 +12,9 @@ import os
 from hypothesis import strategies as st
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-_spec = importlib.util.spec_from_file_location("liganimate_fuzz_compile", os.path.join(ROOT, "benchmarks", "fuzz_compile.py"))
+_spec = importlib.util.spec_from_file_location(
+    "liganimate_fuzz_compile", os.path.join(ROOT, "benchmarks", "fuzz_compile.py")
+)
 fuzz = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(fuzz)
 

@@ -50,8 +50,9 @@ def render(tmp_path: pathlib.Path, body: str, name: str) -> list:
 
 
 def test_a_model_animated_in_a_scene_is_a_graphical_object_in_this_ticks_pose(tmp_path):
-    moved = render(tmp_path, "          G :- M <TRANS (1.5, 0.0, 0.0)>\n          G = G + FLOOR\n"
-                             "          BACKGROUND G\n", "moved")
+    moved = render(
+        tmp_path, "          G :- M <TRANS (1.5, 0.0, 0.0)>\n          G = G + FLOOR\n          BACKGROUND G\n", "moved"
+    )
     alone = render(tmp_path, "", "alone")
     right = slice(110, 160)  # where the translated copy is drawn, away from M itself
     assert all((m[:, right] != a[:, right]).any() for m, a in zip(moved, alone))
@@ -69,8 +70,11 @@ def test_background_of_an_animated_model_is_drawn_in_its_pose_not_neutral(tmp_pa
 
 def test_a_model_not_animated_is_still_not_a_graphical_object(tmp_path):
     src = tmp_path / "bad.lig"
-    src.write_text(HEAD.replace("          ANIMATE M FROM 0 TO 6 USING SWING\n", "")
-                   + "          G :- M <TRANS (1.5, 0.0, 0.0)>\n" + TAIL)
+    src.write_text(
+        HEAD.replace("          ANIMATE M FROM 0 TO 6 USING SWING\n", "")
+        + "          G :- M <TRANS (1.5, 0.0, 0.0)>\n"
+        + TAIL
+    )
     with pytest.raises((NotParsed, LigDiagnostics)) as err:
         load_program(str(src))
     assert "G is a GRAPHICAL object, so it cannot hold a MODEL" in str(err.value)
@@ -92,8 +96,10 @@ def test_check_writes_print_output_and_run_writes_it_once(tmp_path):
 def test_superposition_beyond_the_triangle_limit_is_a_positioned_error(tmp_path, monkeypatch):
     monkeypatch.setattr(values, "MAX_TRIANGLES", 1000)
     src = tmp_path / "big.lig"
-    src.write_text("      GRAPHICAL G\n      G :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0\n"
-                   "      DO 10 I = 1, 30\n        G = G + G\n 10   CONTINUE\n      END\n")
+    src.write_text(
+        "      GRAPHICAL G\n      G :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0\n"
+        "      DO 10 I = 1, 30\n        G = G + G\n 10   CONTINUE\n      END\n"
+    )
     program, _ = load_program(str(src))
     with pytest.raises(LigDiagnostics) as err:
         program.check()

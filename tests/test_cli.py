@@ -57,8 +57,12 @@ def test_check_runs_scenes_without_rendering(tmp_path):
 def test_compiled_module_renders_like_run(tmp_path):
     r = run("compile", str(EXAMPLES / "appendix_a.lig"), "-o", "appendix.py", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    p = subprocess.run([sys.executable, "appendix.py", "-o", "mod", "--size", "160x120", "--quiet"],
-                       capture_output=True, text=True, cwd=tmp_path)
+    p = subprocess.run(
+        [sys.executable, "appendix.py", "-o", "mod", "--size", "160x120", "--quiet"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
     assert p.returncode == 0, p.stderr
     r2 = run("run", str(EXAMPLES / "appendix_a.lig"), "-o", "cli", "--size", "160x120", "--quiet", cwd=tmp_path)
     assert r2.returncode == 0
@@ -128,8 +132,13 @@ def test_print_labels_whole_calls_and_nint_rounds_like_fortran(tmp_path):
     prog.write_text("PRINT MOD(-7, 3), NINT(-2.5), NINT(2.5), NINT(-2.4), MAX(ABS(-2), 1)\n")
     r = run("run", str(prog), "--quiet", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    assert r.stdout.splitlines() == ["MOD(-7, 3) = 2", "NINT(-2.5) = -3", "NINT(2.5) = 3", "NINT(-2.4) = -2",
-                                     "MAX(ABS(-2), 1) = 2"]
+    assert r.stdout.splitlines() == [
+        "MOD(-7, 3) = 2",
+        "NINT(-2.5) = -3",
+        "NINT(2.5) = 3",
+        "NINT(-2.4) = -2",
+        "MAX(ABS(-2), 1) = 2",
+    ]
 
 
 def test_command_line_errors_escape_control_characters_in_paths(tmp_path):

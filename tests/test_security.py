@@ -86,8 +86,11 @@ SHOOTSCENES
 def every_command(folder, name: str) -> list:
     """check, run and compile the program ``name``, then run the compiled module; nothing may execute."""
     results = []
-    for args in (("check", name), ("run", name, "--size", "32x24", "--quiet", "-o", "out"),
-                 ("compile", name, "-o", "mod.py")):
+    for args in (
+        ("check", name),
+        ("run", name, "--size", "32x24", "--quiet", "-o", "out"),
+        ("compile", name, "-o", "mod.py"),
+    ):
         results.append(liganimate(*args, cwd=folder))
         success_or_diagnostic(results[-1])
         no_marker(folder)
@@ -106,8 +109,8 @@ def test_no_channel_runs_python(tmp_path, brk):
     (tmp_path / "lib.lig").write_text(LIB)
     # The library's file name and its own text carry the payload too.
     (tmp_path / "lib" / f"{quoted}.lig").write_text(
-        f"{{@ WEDGE: {p.replace('}', ')')} }}\nWEDGE :- BOX WIDTH 1, HEIGHT 2, DEPTH 1\nPRINT '{quoted}'\n",
-        newline="")
+        f"{{@ WEDGE: {p.replace('}', ')')} }}\nWEDGE :- BOX WIDTH 1, HEIGHT 2, DEPTH 1\nPRINT '{quoted}'\n", newline=""
+    )
     name = f"{p}.lig"  # the program's own file name
     (tmp_path / name).write_text(program(p), newline="")
     results = every_command(tmp_path, name)
@@ -127,8 +130,9 @@ def test_no_channel_runs_python(tmp_path, brk):
 def test_a_file_name_with_u0085_compiles_to_a_module_that_runs(tmp_path):
     # The test above cannot take U+0085 through its file name alone: the text refuses it first.
     name = f"a\u0085{CODE}\u0085#.lig"
-    (tmp_path / name).write_text("INITIALIZE SCENE 1\nBACKGROUND BOX WIDTH 1, HEIGHT 1, DEPTH 1\n"
-                                 "STARTSCENE LENGTH 1\nENDSCENE\nSHOOTSCENES\n")
+    (tmp_path / name).write_text(
+        "INITIALIZE SCENE 1\nBACKGROUND BOX WIDTH 1, HEIGHT 1, DEPTH 1\nSTARTSCENE LENGTH 1\nENDSCENE\nSHOOTSCENES\n"
+    )
     results = every_command(tmp_path, name)
     assert [r[0] for r in results] == [0, 0, 0, 0], results
     assert (tmp_path / "out2" / "scene1" / "00000.png").exists()
@@ -155,8 +159,9 @@ def cached(tmp_path, monkeypatch):
     monkeypatch.setenv("LIGANIMATE_CACHE", str(cache))
     library.forget()
     path = os.path.realpath(tmp_path / "lib.lig")
-    entry = library_cache.entry_name(library.compiler_fingerprint().encode(), path.encode(), b"lib.lig",
-                                     (tmp_path / "lib.lig").read_bytes())
+    entry = library_cache.entry_name(
+        library.compiler_fingerprint().encode(), path.encode(), b"lib.lig", (tmp_path / "lib.lig").read_bytes()
+    )
     return tmp_path, cache, entry
 
 
@@ -176,8 +181,9 @@ def forged(folder) -> dict:
 
 
 def runs_cleanly(folder, env) -> None:
-    code, out, err = liganimate("run", "p.lig", "--size", "32x24", "--quiet", "-o", "out", cwd=folder, env=env,
-                                timeout=60)
+    code, out, err = liganimate(
+        "run", "p.lig", "--size", "32x24", "--quiet", "-o", "out", cwd=folder, env=env, timeout=60
+    )
     assert code == 0, out + err
     assert "Traceback" not in err
     assert (folder / "out" / "scene1" / "00000.png").exists()
@@ -234,9 +240,19 @@ def plant_readable_key(cache, entry, folder):
     (cache / library_cache.KEY_FILE).chmod(0o644)
 
 
-@pytest.mark.parametrize("plant", [plant_pickle, plant_bad_mac, plant_fifo, plant_symlink, plant_other_owner,
-                                   plant_in_a_shared_folder, plant_readable_key],
-                         ids=lambda f: f.__name__[6:])
+@pytest.mark.parametrize(
+    "plant",
+    [
+        plant_pickle,
+        plant_bad_mac,
+        plant_fifo,
+        plant_symlink,
+        plant_other_owner,
+        plant_in_a_shared_folder,
+        plant_readable_key,
+    ],
+    ids=lambda f: f.__name__[6:],
+)
 def test_a_planted_entry_never_runs_nor_hangs(cached, plant):
     folder, cache, entry = cached
     if plant is plant_other_owner and os.geteuid() != 0:
@@ -331,8 +347,9 @@ def test_load_never_shows_a_foreign_file(tmp_path):
         "../folder.lig": "cannot be read: not an ordinary file but a folder",
     }
     (tmp_path / "sub" / "p.lig").write_text("".join(f"LOAD '{n}'\n" for n in loads))
-    code, out, err = liganimate("check", "p.lig", cwd=tmp_path / "sub", env={"LIG_ENV_SECRET": "ENV-SECRET-51c2"},
-                                timeout=60)
+    code, out, err = liganimate(
+        "check", "p.lig", cwd=tmp_path / "sub", env={"LIG_ENV_SECRET": "ENV-SECRET-51c2"}, timeout=60
+    )
     assert code == 1
     for line, (name, said) in enumerate(loads.items(), start=1):
         assert f"p.lig:{line}:6: error: " in err, (name, err)
@@ -399,8 +416,10 @@ def test_a_binary_program_file_is_refused_at_its_first_control_character(tmp_pat
 
 
 def test_a_library_that_fails_is_reported_even_when_the_program_then_fails_to_parse(tmp_path):
-    (tmp_path / "bad.lig").write_text("PRIMITIVE PRISM\n  REAL S\n  PRISM ::= 'PRISM' 'SIZE' S ;\n"
-                                      "  DRAW POLY FROM (0, 0, 0) TO (S, 0, 0) TO (0, S, 0)\n  RETURN\nEND\nX = 1 +\n")
+    (tmp_path / "bad.lig").write_text(
+        "PRIMITIVE PRISM\n  REAL S\n  PRISM ::= 'PRISM' 'SIZE' S ;\n"
+        "  DRAW POLY FROM (0, 0, 0) TO (S, 0, 0) TO (0, S, 0)\n  RETURN\nEND\nX = 1 +\n"
+    )
     (tmp_path / "p.lig").write_text("LOAD 'bad.lig'\nG :- PRISM SIZE 3\n")
     with pytest.raises(LigDiagnostics) as info:
         compile_file(str(tmp_path / "p.lig"))

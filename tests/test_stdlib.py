@@ -159,8 +159,10 @@ def test_all_libraries_load_together_without_a_clash():
 
 
 def test_named_loads_bring_only_the_names():
-    v = values("LOAD HUMANOID, WALK, WAVE FROM 'humanoid'\nLOAD CYLINDER FROM 'shapes'\n"
-               "POLE :- CYLINDER RADIUS 0.05, HEIGHT 2.0\n")["variables"]
+    v = values(
+        "LOAD HUMANOID, WALK, WAVE FROM 'humanoid'\nLOAD CYLINDER FROM 'shapes'\n"
+        "POLE :- CYLINDER RADIUS 0.05, HEIGHT 2.0\n"
+    )["variables"]
     assert {"HUMANOID", "WALK", "WAVE", "POLE"} <= set(v)
     assert "RUN" not in v and "R_THIGH" not in v
 
@@ -256,8 +258,9 @@ def test_humanoid_left_side_mirrors_the_right(humanoid):
         left = "L" + right[1:]
         r = world[table.link == names.index(right)].reshape(-1, 3) * (1.0, 1.0, -1.0)
         l = world[table.link == names.index(left)].reshape(-1, 3)
-        np.testing.assert_allclose(np.unique(r.round(9), axis=0), np.unique(l.round(9), axis=0), atol=1e-9,
-                                   err_msg=right)
+        np.testing.assert_allclose(
+            np.unique(r.round(9), axis=0), np.unique(l.round(9), axis=0), atol=1e-9, err_msg=right
+        )
 
 
 # ------------------------------------------------------------- motions
@@ -285,7 +288,8 @@ def test_motion_stays_within_its_models_limits(lib, model, motion):
             lo, hi = ext[axis]
             assert lo - 1e-9 <= a.min() and a.max() <= hi + 1e-9, (
                 f"{motion} takes joint {jid} {'XYZ'[axis]} to [{a.min():g}, {a.max():g}], "
-                f"outside {model}'s ({lo:g}, {hi:g})")
+                f"outside {model}'s ({lo:g}, {hi:g})"
+            )
     # So posing the model changes nothing: the clamped angles are the written ones.
     clamped = P.joint_angles(fig, m, times)
     cols = [fig.joint_index(j) for j in m.joints]
@@ -343,8 +347,10 @@ def test_walk_keeps_the_feet_near_the_ground():
 
 
 def test_squat_rooted_at_a_foot_keeps_both_feet_planted():
-    v = values("LOAD HUMANOID, SQUAT FROM 'humanoid'\nLOAD ROBOT, ROBOT_SQUAT FROM 'robot'\n"
-               "FIGURE HUMANOID MAIN LINK R_FOOT\nFIGURE ROBOT MAIN JOINT 7\n")["variables"]
+    v = values(
+        "LOAD HUMANOID, SQUAT FROM 'humanoid'\nLOAD ROBOT, ROBOT_SQUAT FROM 'robot'\n"
+        "FIGURE HUMANOID MAIN LINK R_FOOT\nFIGURE ROBOT MAIN JOINT 7\n"
+    )["variables"]
     for fig, motion in ((v["HUMANOID"], v["SQUAT"]), (v["ROBOT"], v["ROBOT_SQUAT"])):
         times = np.arange(0.0, motion.length + 1)
         angles = P.joint_angles(fig, motion, times)

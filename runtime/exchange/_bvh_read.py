@@ -122,8 +122,10 @@ class _Tokens:
             if self.line >= len(self.lines):
                 return False
             number = self.line + 1
-            self.pending = [(m.group(), Pos(number, m.start() + 1, number, m.end() + 1))
-                            for m in _TOKEN.finditer(self.lines[self.line])]
+            self.pending = [
+                (m.group(), Pos(number, m.start() + 1, number, m.end() + 1))
+                for m in _TOKEN.finditer(self.lines[self.line])
+            ]
             self.line += 1
         return True
 
@@ -196,8 +198,11 @@ def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
             tk.fail(count_pos, f"the number of channels must be a whole number, not '{count_tok}'")
         listed = tk.rest_of_line()
         if count < 0 or count != len(listed):
-            tk.fail(count_pos, f"CHANNELS says {count_tok} but the line lists {len(listed)} channels",
-                    "list the channel names on the CHANNELS line itself")
+            tk.fail(
+                count_pos,
+                f"CHANNELS says {count_tok} but the line lists {len(listed)} channels",
+                "list the channel names on the CHANNELS line itself",
+            )
         seen = []
         for name, npos in listed:
             canonical = _CHANNEL_KEYS.get(name.lower())
@@ -231,8 +236,11 @@ def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
     joint(-1, pos)
     after = tk.peek()
     if after is None:
-        tk.fail(tk.end_pos(), "the file has no MOTION section",
-                "a BVH file needs MOTION, then 'Frames: N', 'Frame Time: t' and N lines of channel values")
+        tk.fail(
+            tk.end_pos(),
+            "the file has no MOTION section",
+            "a BVH file needs MOTION, then 'Frames: N', 'Frame Time: t' and N lines of channel values",
+        )
     tok, pos = tk.next("MOTION")
     if tok == "ROOT":
         tk.fail(pos, "this file has several ROOT joints; liganimate imports one skeleton per file")
@@ -285,8 +293,11 @@ def _frames(tk: _Tokens, start: int, n_frames: int, n_channels: int) -> np.ndarr
     rows = [(i, line) for i, line in enumerate(tk.lines[start:], start) if line.strip()]
     if len(rows) > n_frames:
         i = rows[n_frames][0]
-        tk.fail(Pos(i + 1, 1, i + 1, 2), f"there are more frame lines than the {n_frames} that 'Frames: {n_frames}' announces",
-                "correct the Frames: line, or remove the extra lines")
+        tk.fail(
+            Pos(i + 1, 1, i + 1, 2),
+            f"there are more frame lines than the {n_frames} that 'Frames: {n_frames}' announces",
+            "correct the Frames: line, or remove the extra lines",
+        )
     split = [line.split() for _, line in rows]
     counts = np.fromiter(map(len, split), dtype=np.int64, count=len(split))
     bad = np.flatnonzero(counts != n_channels)
@@ -302,13 +313,22 @@ def _frames(tk: _Tokens, start: int, n_frames: int, n_channels: int) -> np.ndarr
             end = len(line.rstrip()) + 1
             where = Pos(i + 1, end, i + 1, end)
         if last and counts[k] < n_channels:
-            tk.fail(where, f"the file ends in the middle of frame {k + 1}: it has {counts[k]} of its {n_channels} values",
-                    "the file may have been cut short")
-        tk.fail(where, f"frame {k + 1} has {counts[k]} values, but the hierarchy's channels need {n_channels}",
-                "each frame is one line with one value per channel, in the order the hierarchy lists them")
+            tk.fail(
+                where,
+                f"the file ends in the middle of frame {k + 1}: it has {counts[k]} of its {n_channels} values",
+                "the file may have been cut short",
+            )
+        tk.fail(
+            where,
+            f"frame {k + 1} has {counts[k]} values, but the hierarchy's channels need {n_channels}",
+            "each frame is one line with one value per channel, in the order the hierarchy lists them",
+        )
     if len(rows) < n_frames:
-        tk.fail(tk.end_pos(), f"the file ends after {len(rows)} of the {n_frames} frames that 'Frames: {n_frames}' announces",
-                "the file may have been cut short; re-export it, or correct the Frames: line")
+        tk.fail(
+            tk.end_pos(),
+            f"the file ends after {len(rows)} of the {n_frames} frames that 'Frames: {n_frames}' announces",
+            "the file may have been cut short; re-export it, or correct the Frames: line",
+        )
     flat = [t for toks in split for t in toks]
     try:
         values = np.fromiter(map(float, flat), dtype=np.float64, count=len(flat))
@@ -324,7 +344,9 @@ def _frames(tk: _Tokens, start: int, n_frames: int, n_channels: int) -> np.ndarr
                 if not ok:
                     i, line = rows[k]
                     m = list(_TOKEN.finditer(line))[n]
-                    tk.fail(Pos(i + 1, m.start() + 1, i + 1, m.end() + 1),
-                            f"'{t}' in frame {k + 1} is not a finite number",
-                            "every channel value must be a number such as -12.5")
+                    tk.fail(
+                        Pos(i + 1, m.start() + 1, i + 1, m.end() + 1),
+                        f"'{t}' in frame {k + 1} is not a finite number",
+                        "every channel value must be a number such as -12.5",
+                    )
     return values.reshape(n_frames, n_channels)

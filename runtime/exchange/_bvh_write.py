@@ -186,8 +186,10 @@ def bvh_files(scenes, path: str, fps: float) -> list:
     """
     models = [(take.id, m) for take in scenes for m in take.models]
     if not models:
-        raise LigError("the program draws no animated model, so there is nothing to write as BVH.",
-                       "a model is drawn while an ANIMATE covers it in a shot scene")
+        raise LigError(
+            "the program draws no animated model, so there is nothing to write as BVH.",
+            "a model is drawn while an ANIMATE covers it in a shot scene",
+        )
     if len(models) == 1:
         return [(path, bvh_text(models[0][1], fps, models[0][0]))]
     stem, ext = os.path.splitext(path)

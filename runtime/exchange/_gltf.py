@@ -132,8 +132,9 @@ class _Builder:
             c = float(_linear_from_grey(grey))
             m = G.Material(
                 name=f"grey {grey}" + (" two-sided" if double else ""),
-                pbrMetallicRoughness=G.PbrMetallicRoughness(baseColorFactor=[c, c, c, 1.0], metallicFactor=0.0,
-                                                            roughnessFactor=1.0),
+                pbrMetallicRoughness=G.PbrMetallicRoughness(
+                    baseColorFactor=[c, c, c, 1.0], metallicFactor=0.0, roughnessFactor=1.0
+                ),
                 doubleSided=double,
                 extensions={"KHR_materials_unlit": {}},
             )
@@ -152,8 +153,11 @@ class _Builder:
             for m in np.unique(mat):
                 tris = np.asarray(triangles)[mat == m].reshape(-1, 3)
                 acc = self._accessor(tris, G.VEC3, 0, True)
-                prims.append(G.Primitive(attributes=G.Attributes(POSITION=acc),
-                                         material=self._material(int(m // 2), bool(m % 2)), mode=4))
+                prims.append(
+                    G.Primitive(
+                        attributes=G.Attributes(POSITION=acc), material=self._material(int(m // 2), bool(m % 2)), mode=4
+                    )
+                )
             self.doc.meshes.append(G.Mesh(name=name, primitives=prims))
             index = len(self.doc.meshes) - 1
         if key is not None:
@@ -173,11 +177,13 @@ class _Builder:
 
     def _channel(self, anim, node, path, ticks, values, interp):
         kind = {"translation": G.VEC3, "rotation": G.VEC4, "scale": G.VEC3}[path]
-        sampler = G.AnimationSampler(input=self._times(ticks), output=self._accessor(values, kind, 1, False),
-                                     interpolation=interp)
+        sampler = G.AnimationSampler(
+            input=self._times(ticks), output=self._accessor(values, kind, 1, False), interpolation=interp
+        )
         anim.samplers.append(sampler)
-        anim.channels.append(G.AnimationChannel(sampler=len(anim.samplers) - 1,
-                                                target=G.AnimationChannelTarget(node=node, path=path)))
+        anim.channels.append(
+            G.AnimationChannel(sampler=len(anim.samplers) - 1, target=G.AnimationChannelTarget(node=node, path=path))
+        )
 
     def scene(self, take) -> None:
         anim = G.Animation(name=f"scene {take.id}")
@@ -247,10 +253,12 @@ class _Builder:
                 near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
                 sp = scales[p]
                 jid = fig.joints[k].id
-                jn = self._node(name=f"{model.name} joint {jid}", translation=[float(v) for v in near / sp],
-                                rotation=[float(v) for v in qj[0, k]],
-                                extras={"liganimate": {"scene": take.id, "model": model.name, "joint": jid,
-                                                       "reversed": bool(r)}})
+                jn = self._node(
+                    name=f"{model.name} joint {jid}",
+                    translation=[float(v) for v in near / sp],
+                    rotation=[float(v) for v in qj[0, k]],
+                    extras={"liganimate": {"scene": take.id, "model": model.name, "joint": jid, "reversed": bool(r)}},
+                )
                 if sp != 1.0:
                     self.doc.nodes[jn].scale = [1.0 / sp] * 3
                 self.doc.nodes[seg[p]].children.append(jn)
@@ -262,11 +270,19 @@ class _Builder:
     def _segment(self, model, fig, i, parent, take, offset=None) -> int:
         link = fig.links[i]
         up = fig.parent_joint_of(i)
-        n = self._node(name=f"{model.name} {link.label}" + (f" {up.id}" if up is not None else ""),
-                       mesh=self._link_mesh(link),
-                       extras={"liganimate": {"scene": take.id, "model": model.name, "link": link.name,
-                                              "segment": int(i),
-                                              "joint": None if up is None else up.id}})
+        n = self._node(
+            name=f"{model.name} {link.label}" + (f" {up.id}" if up is not None else ""),
+            mesh=self._link_mesh(link),
+            extras={
+                "liganimate": {
+                    "scene": take.id,
+                    "model": model.name,
+                    "link": link.name,
+                    "segment": int(i),
+                    "joint": None if up is None else up.id,
+                }
+            },
+        )
         node = self.doc.nodes[n]
         if offset is not None and offset.any():
             node.translation = [float(v) for v in offset]
@@ -277,8 +293,9 @@ class _Builder:
 
     def _background(self, take, n, obj, ticks, anim, all_ticks) -> int:
         if isinstance(obj, Graphical):
-            mesh = self._mesh(("link", id(obj)), f"background {n + 1}", obj.triangles, grey_levels(obj.lightness),
-                              obj.closed)
+            mesh = self._mesh(
+                ("link", id(obj)), f"background {n + 1}", obj.triangles, grey_levels(obj.lightness), obj.closed
+            )
         else:
             tris, grey, closed = static_triangles(obj)
             mesh = self._mesh(("figure", id(obj)), f"background {n + 1}", tris, grey, closed)
@@ -294,7 +311,8 @@ class _Builder:
         if (widths != widths[0]).any():
             self.warnings.append(
                 f"scene {take.id} changes its VIEW WIDTH; a glTF camera's field of view cannot change, so "
-                f"the camera keeps the first width, {widths[0]:g}.")
+                f"the camera keeps the first width, {widths[0]:g}."
+            )
         axes = {}
         for p in {tuple(p) for p in points}:
             cam = Camera(p, widths[0])
@@ -304,12 +322,21 @@ class _Builder:
         q = continuous_quaternions(quaternion_from_matrix(R))
         dist = np.linalg.norm(points[0])
         yfov = 2.0 * np.arctan(widths[0] / self.aspect / 2.0 / dist)
-        self.doc.cameras.append(G.Camera(
-            name=f"scene {take.id} VIEW", type="perspective",
-            perspective=G.Perspective(aspectRatio=self.aspect, yfov=float(yfov),
-                                      znear=float(1e-4 * np.linalg.norm(points, axis=1).min()))))
-        node = self._node(name=f"scene {take.id} camera", camera=len(self.doc.cameras) - 1,
-                          translation=[float(v) for v in points[0]], rotation=[float(v) for v in q[0]])
+        self.doc.cameras.append(
+            G.Camera(
+                name=f"scene {take.id} VIEW",
+                type="perspective",
+                perspective=G.Perspective(
+                    aspectRatio=self.aspect, yfov=float(yfov), znear=float(1e-4 * np.linalg.norm(points, axis=1).min())
+                ),
+            )
+        )
+        node = self._node(
+            name=f"scene {take.id} camera",
+            camera=len(self.doc.cameras) - 1,
+            translation=[float(v) for v in points[0]],
+            rotation=[float(v) for v in q[0]],
+        )
         ticks = np.arange(len(points), dtype=np.int64)
         if (points != points[0]).any():
             self._channel(anim, node, "translation", ticks, points, interp)

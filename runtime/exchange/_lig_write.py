@@ -144,8 +144,10 @@ def _bone(tip: np.ndarray, width: float) -> str:
     alpha = -math.degrees(math.acos(max(-1.0, min(1.0, float(d[1])))))
     h = math.hypot(float(d[0]), float(d[2]))
     beta = math.degrees(math.atan2(-float(d[2]), float(d[0]))) if h > 1e-12 else 0.0
-    return (f"(BOX AT (0.0, {_num(length / 2)}, 0.0), WIDTH {_num(width)}, HEIGHT {_num(length)}, "
-            f"DEPTH {_num(width)}) <ROT Z {_num(alpha)}, ROT Y {_num(beta)}>")
+    return (
+        f"(BOX AT (0.0, {_num(length / 2)}, 0.0), WIDTH {_num(width)}, HEIGHT {_num(length)}, "
+        f"DEPTH {_num(width)}) <ROT Z {_num(alpha)}, ROT Y {_num(beta)}>"
+    )
 
 
 def _comment_text(text: str) -> str:
@@ -153,8 +155,9 @@ def _comment_text(text: str) -> str:
     return re.sub(r"[{}\x00-\x1f\x7f]", "?", text)
 
 
-def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_name: str | None = None,
-                tolerance: float = 0.0) -> bytes:
+def lig_library(
+    clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_name: str | None = None, tolerance: float = 0.0
+) -> bytes:
     """The text of a LIG library holding a BVH clip's skeleton as a MODEL and its frames as a MOTION.
 
     Parameters
@@ -198,7 +201,9 @@ def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_n
         "C   joint  segment            BVH joint (channels)",
     ]
     for j in range(J):
-        out.append(f"C   {j + 1:<5}  {links[j]:<18} {_comment_text(clip.names[j])} ({' '.join(clip.channels[j]) or 'none'})")
+        out.append(
+            f"C   {j + 1:<5}  {links[j]:<18} {_comment_text(clip.names[j])} ({' '.join(clip.channels[j]) or 'none'})"
+        )
     out.append("")
     out.append(f"{{@ {model}: the skeleton of {src}, {J} joints, every axis free }}")
     kept = "one keyframe per frame" if tolerance <= 0 else f"keyframes within {tolerance:g} degrees"
@@ -206,7 +211,7 @@ def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_n
     out.append("")
     out.append("      GRAPHICAL ORIGIN")
     for k in range(0, J, 6):
-        out.append("      GRAPHICAL " + ", ".join(links[k:k + 6]))
+        out.append("      GRAPHICAL " + ", ".join(links[k : k + 6]))
     out.append(f"      MODEL {model}")
     out.append(f"      MOTION {motion}")
     out.append("")
@@ -228,8 +233,10 @@ def lig_library(clip, model: str = "CAPTURE", motion: str = "CAPTURED", source_n
     for j in range(J):
         parent = "ORIGIN" if j == 0 else links[int(clip.parents[j])]
         o = (0.0, 0.0, 0.0) if j == 0 else offsets[j]
-        out.append(f"        JOINT {j + 1}, {parent}, ({_num(o[0])}, {_num(o[1])}, {_num(o[2])}), "
-                   f"{links[j]}, (0.0, 0.0, 0.0), {free}")
+        out.append(
+            f"        JOINT {j + 1}, {parent}, ({_num(o[0])}, {_num(o[1])}, {_num(o[2])}), "
+            f"{links[j]}, (0.0, 0.0, 0.0), {free}"
+        )
     out.append("      ENDMODEL")
     out.append("")
     head = ("\n".join(out) + "\n").encode("utf-8")
@@ -253,8 +260,14 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None)
         if moving[j]:
             rows = np.arange(1, F) if keep is None else keep[j][keep[j] > 0]
             table = np.column_stack([frames[rows - 1], angles[rows, j]])
-            parts.append(format_rows(table, [0, DECIMALS, DECIMALS, DECIMALS],
-                                     columns_prefix=["          FRAME", " POSITION", ",", ","], suffix="\n"))
+            parts.append(
+                format_rows(
+                    table,
+                    [0, DECIMALS, DECIMALS, DECIMALS],
+                    columns_prefix=["          FRAME", " POSITION", ",", ","],
+                    suffix="\n",
+                )
+            )
     parts.append(b"      ENDMOTION\n")
     return b"".join(parts)
 
@@ -262,8 +275,10 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None)
 def _path_table(path: np.ndarray) -> bytes:
     """The ROOT's path as a comment: a header line, then ``frame x y z`` per frame."""
     F = len(path)
-    head = (f"\n{{ {ROOT_PATH_MARK}: the BVH ROOT's position at each frame (frame, x, y, z). ANIMATE does not\n"
-            "  move a figure along it yet; liganimate.runtime.exchange.read_root_path reads it.\n")
+    head = (
+        f"\n{{ {ROOT_PATH_MARK}: the BVH ROOT's position at each frame (frame, x, y, z). ANIMATE does not\n"
+        "  move a figure along it yet; liganimate.runtime.exchange.read_root_path reads it.\n"
+    )
     table = np.column_stack([np.arange(F, dtype=np.float64), path])
     return head.encode("ascii") + format_rows(table, [0, DECIMALS, DECIMALS, DECIMALS], prefix=" ") + b"}\n"
 
@@ -291,7 +306,7 @@ def read_root_path(path: str) -> np.ndarray:
     at = text.find("{ " + ROOT_PATH_MARK + ":")
     if at < 0:
         raise ValueError(f"{path} has no {ROOT_PATH_MARK} table")
-    body = text[at:text.index("}", at)]
+    body = text[at : text.index("}", at)]
     rows = body.split("\n")[2:]
     table = np.array([[float(v) for v in r.split()] for r in rows if r.strip()], dtype=np.float64).reshape(-1, 4)
     return table[np.argsort(table[:, 0], kind="stable"), 1:]
@@ -330,10 +345,11 @@ def reduce_keyframes(angles: np.ndarray, tolerance: float, rounds: int = 64) -> 
     values = np.round(angles, DECIMALS)
     keep = [_linear_keep(values[:, j], tolerance / 2.0) for j in range(J)]
     frames = np.arange(F, dtype=np.float64)
-    budget = tolerance - 10.0 ** -DECIMALS
+    budget = tolerance - 10.0**-DECIMALS
     for _ in range(rounds):
-        spec = {j + 1: (values[0, j], [(float(f), values[f, j], "LINEAR") for f in keep[j][1:].tolist()])
-                for j in range(J)}
+        spec = {
+            j + 1: (values[0, j], [(float(f), values[f, j], "LINEAR") for f in keep[j][1:].tolist()]) for j in range(J)
+        }
         motion = Motion.from_tracks(spec).unwrapped({j + 1: (True, True, True) for j in range(J)})
         played = motion.evaluate(frames)
         miss = np.abs(_wrapped(played - values)).max(axis=2) > budget  # (F, J)

@@ -16,8 +16,7 @@ __all__ = ["format_rows"]
 _EXACT = 2.0**52
 
 
-def format_rows(values, decimals, sep: str = " ", prefix: str = "", suffix: str = "\n",
-                columns_prefix=None) -> bytes:
+def format_rows(values, decimals, sep: str = " ", prefix: str = "", suffix: str = "\n", columns_prefix=None) -> bytes:
     """Format a table of finite numbers in fixed-point notation, one line per row.
 
     Parameters
@@ -92,10 +91,10 @@ def _column(x: np.ndarray, dec: int) -> np.ndarray:
     idx = np.arange(n_int)
     int_chars = (digits[:, :n_int] + ord("0")).astype(np.uint8)
     int_chars[idx[None, :] < lead[:, None]] = ord(" ")
-    chars[:, 1:1 + n_int] = int_chars
+    chars[:, 1 : 1 + n_int] = int_chars
     if dec:
         chars[:, 1 + n_int] = ord(".")
-        chars[:, 2 + n_int:] = (digits[:, n_int:] + ord("0")).astype(np.uint8)
+        chars[:, 2 + n_int :] = (digits[:, n_int:] + ord("0")).astype(np.uint8)
     rows = np.flatnonzero(neg)
     chars[rows, lead[rows]] = ord("-")
     return chars

@@ -182,7 +182,11 @@ def static_triangles(fig: F.Figure):
     angles = K.clamp(fig, np.zeros((1, J, 3)))
     X = world_transforms(fig, angles, np.asarray(fig.placement)[None])
     table = mesh_table(fig)
-    return world_triangles(table, X)[0], table.grey, table.closed & (np.linalg.det(np.asarray(fig.placement)[:3, :3]) > 0)
+    return (
+        world_triangles(table, X)[0],
+        table.grey,
+        table.closed & (np.linalg.det(np.asarray(fig.placement)[:3, :3]) > 0),
+    )
 
 
 def posed_graphical(fig: F.Figure, motion: Motion | None, frame: float) -> Graphical:

@@ -155,8 +155,10 @@ def normalize_extremes(extremes) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise FigureError("joint extremes must be finite numbers of degrees.")
     if not np.all(np.abs(arr) <= MAX_ANGLE):
-        raise FigureError(f"joint extremes must lie within ±{magnitude(MAX_ANGLE)} degrees.",
-                          hint="a range of 360 degrees or more already lets the joint turn freely")
+        raise FigureError(
+            f"joint extremes must lie within ±{magnitude(MAX_ANGLE)} degrees.",
+            hint="a range of 360 degrees or more already lets the joint turn freely",
+        )
     out = np.zeros((3, 2))
     out[: arr.shape[0]] = arr
     for axis in range(3):
@@ -492,7 +494,9 @@ class Figure:
             if not rows:
                 break
             k, parents, children, rev = (np.array(c) for c in zip(*rows))
-            levels.append(TraversalLevel(k.astype(np.intp), parents.astype(np.intp), children.astype(np.intp), rev.astype(bool)))
+            levels.append(
+                TraversalLevel(k.astype(np.intp), parents.astype(np.intp), children.astype(np.intp), rev.astype(bool))
+            )
             frontier = [r[2] for r in rows]
         return tuple(levels)
 
@@ -625,7 +629,9 @@ class Figure:
             close = difflib.get_close_matches(name.upper(), names, n=3, cutoff=0.5)
             raise FigureError(
                 f"the model has no link named {name}.",
-                hint=f"did you mean {' or '.join(close)}?" if close else f"its links are named {', '.join(names) or 'nothing'}",
+                hint=f"did you mean {' or '.join(close)}?"
+                if close
+                else f"its links are named {', '.join(names) or 'nothing'}",
             )
         chosen = found[0]
         warning = None
@@ -656,9 +662,11 @@ class Figure:
         """
         head = f"MODEL {name}: " if name else "MODEL: "
         lines = [
-            (f"{head}{self.n_links} links, {self.n_joints} joints; "
-            f"original main link {self.links[self.root].label} (node {self.root}); "
-            f"current main link {self.links[self.main].label} (node {self.main})")
+            (
+                f"{head}{self.n_links} links, {self.n_joints} joints; "
+                f"original main link {self.links[self.root].label} (node {self.root}); "
+                f"current main link {self.links[self.main].label} (node {self.main})"
+            )
         ]
         for i in self.preorder:
             link = self.links[i]
@@ -699,8 +707,21 @@ class Figure:
             velocity and acceleration.
         """
         shape = (self.n_joints, 3)
-        cols = [np.broadcast_to(np.asarray(0.0 if a is None else a, dtype=float), shape) for a in (angles, velocity, acceleration)]
-        rows = [("Joint #", "Current orientation", "X extremes", "Y extremes", "Z extremes", "Current velocity", "Current acceleration")]
+        cols = [
+            np.broadcast_to(np.asarray(0.0 if a is None else a, dtype=float), shape)
+            for a in (angles, velocity, acceleration)
+        ]
+        rows = [
+            (
+                "Joint #",
+                "Current orientation",
+                "X extremes",
+                "Y extremes",
+                "Z extremes",
+                "Current velocity",
+                "Current acceleration",
+            )
+        ]
         for k, j in enumerate(self.joints):
             rows.append(
                 (
@@ -926,8 +947,10 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
         warnings.append(
             (
                 s.statement_index,
-                (f"JOINT {s.joint_id}: {len(cands)} segments are named {s.primary_name}, so the reference is "
-                f"ambiguous; using {made_by}, the latest made before this statement."),
+                (
+                    f"JOINT {s.joint_id}: {len(cands)} segments are named {s.primary_name}, so the reference is "
+                    f"ambiguous; using {made_by}, the latest made before this statement."
+                ),
             )
         )
 
@@ -938,7 +961,7 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
         cur = attach[pos][0]
         while cur >= 0:
             if cur in chain:
-                loop = chain[chain.index(cur):]
+                loop = chain[chain.index(cur) :]
                 ids = ", ".join(f"JOINT {specs[c].joint_id}" for c in loop)
                 raise FigureError(
                     f"the model has a cycle: {ids} each hang from a segment made by the next"

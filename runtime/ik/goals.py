@@ -151,7 +151,9 @@ def resolve_link(figure: Figure, ref) -> tuple[int, str | None]:
         found = figure.links_named(ref)
         if not found:
             names = sorted({l.name.upper() for l in figure.links if l.name is not None})
-            raise GoalError(f"the model has no link named {ref}.", hint=f"its links are named {', '.join(names) or 'nothing'}")
+            raise GoalError(
+                f"the model has no link named {ref}.", hint=f"its links are named {', '.join(names) or 'nothing'}"
+            )
         warning = None
         if len(found) > 1:
             others = ", ".join(str(figure.parent_joint_of(i).id) for i in found[1:])
@@ -176,7 +178,9 @@ def _vectors(value, what: str, batch: int | None) -> np.ndarray:
     except (TypeError, ValueError):
         raise GoalError(f"{what} must be a vector of three numbers, not {value!r}.") from None
     if v.shape[-1:] != (3,) or v.ndim > 2:
-        raise GoalError(f"{what} must be a vector of three numbers (or a batch of them), not an array of shape {v.shape}.")
+        raise GoalError(
+            f"{what} must be a vector of three numbers (or a batch of them), not an array of shape {v.shape}."
+        )
     if not np.all(np.isfinite(v)):
         raise GoalError(f"{what} must be finite.")
     return v
@@ -200,7 +204,9 @@ def _weights(value, what: str) -> np.ndarray:
     if w.ndim > 1 or not np.all(np.isfinite(w)):
         raise GoalError(f"{what} must be a finite number (or a batch of them).")
     if np.any(w < 0):
-        raise GoalError(f"{what} must not be negative.", hint="only the ratios of weights matter; 0 switches a goal off")
+        raise GoalError(
+            f"{what} must not be negative.", hint="only the ratios of weights matter; 0 switches a goal off"
+        )
     return w
 
 
@@ -311,7 +317,11 @@ class GoalStack:
                     raise GoalError(f"the axis of {what} is a direction in the link and cannot be batched.")
                 # A mirrored link (negative scale) turns its own directions round.
                 axs["local"].append(_unit(a, f"the axis of {what}") * np.sign(scale[link]))
-                axs["dir"].append(_batched(_unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)))
+                axs["dir"].append(
+                    _batched(
+                        _unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)
+                    )
+                )
                 ell = model.lengths[link]
                 if mean_length is None:
                     positive = model.lengths[model.lengths > 0]
@@ -328,7 +338,12 @@ class GoalStack:
                     d = pts
                 else:
                     pls["origin"].append(_batched(_vectors(g.origin, f"the plane point of {what}", B), (B, 3)))
-                    pls["normal"].append(_batched(_unit(_vectors(g.normal, f"the plane normal of {what}", B), f"the plane normal of {what}"), (B, 3)))
+                    pls["normal"].append(
+                        _batched(
+                            _unit(_vectors(g.normal, f"the plane normal of {what}", B), f"the plane normal of {what}"),
+                            (B, 3),
+                        )
+                    )
                     d = pls
                 d["local"].append(local)
             d["link"].append(link)
@@ -580,6 +595,6 @@ class GoalStack:
         """
         out = np.array(dist, dtype=float)
         if len(self.h_link):
-            cols = self.order[len(self.p_link) + len(self.q_link):]
+            cols = self.order[len(self.p_link) + len(self.q_link) :]
             out[:, cols] = np.rad2deg(out[:, cols] / self.h_ell)
         return out

@@ -73,21 +73,51 @@ def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 # The products of cosines and sines that make up ``Rz Ry Rx`` and the local
 # axes (see IKModel.forward_one): columns of [cx, cy, cz, sx, sy, sz, 1],
 # three per product.
-_TERMS = np.array([
-    (1, 2, 6), (2, 4, 3), (5, 0, 6), (2, 4, 0), (5, 3, 6), (1, 5, 6), (5, 4, 3), (2, 0, 6),
-    (5, 4, 0), (2, 3, 6), (4, 6, 6), (1, 3, 6), (1, 0, 6), (5, 6, 6), (2, 6, 6), (6, 6, 6),
-]).T
+_TERMS = np.array(
+    [
+        (1, 2, 6),
+        (2, 4, 3),
+        (5, 0, 6),
+        (2, 4, 0),
+        (5, 3, 6),
+        (1, 5, 6),
+        (5, 4, 3),
+        (2, 0, 6),
+        (5, 4, 0),
+        (2, 3, 6),
+        (4, 6, 6),
+        (1, 3, 6),
+        (1, 0, 6),
+        (5, 6, 6),
+        (2, 6, 6),
+        (6, 6, 6),
+    ]
+).T
 # Which products, with which signs, add up to each entry: R row-major, then
 # the local X axis Rz Ry e_x, Y axis Rz e_y and Z axis e_z.
 _TERM_SUMS = np.zeros((16, 18))
-for _col, _terms in enumerate([
-    {0: 1}, {1: 1, 2: -1}, {3: 1, 4: 1},
-    {5: 1}, {6: 1, 7: 1}, {8: 1, 9: -1},
-    {10: -1}, {11: 1}, {12: 1},
-    {0: 1}, {5: 1}, {10: -1},
-    {13: -1}, {14: 1}, {},
-    {}, {}, {15: 1},
-]):
+for _col, _terms in enumerate(
+    [
+        {0: 1},
+        {1: 1, 2: -1},
+        {3: 1, 4: 1},
+        {5: 1},
+        {6: 1, 7: 1},
+        {8: 1, 9: -1},
+        {10: -1},
+        {11: 1},
+        {12: 1},
+        {0: 1},
+        {5: 1},
+        {10: -1},
+        {13: -1},
+        {14: 1},
+        {},
+        {},
+        {},
+        {15: 1},
+    ]
+):
     for _k, _sign in _terms.items():
         _TERM_SUMS[_k, _col] = _sign
 del _col, _terms, _k, _sign
@@ -226,7 +256,7 @@ class IKModel:
         order = sorted(range(J), key=lambda k: (-depth[k], k))
         vj, va = [], []
         for k in order:
-            for a in ((2, 1, 0) if rev[k] else (0, 1, 2)):
+            for a in (2, 1, 0) if rev[k] else (0, 1, 2):
                 if is_var[k, a]:
                     vj.append(k)
                     va.append(a)
@@ -252,7 +282,9 @@ class IKModel:
         self._near = np.where(rev[:, None], loc2, loc1)
         self._far = np.where(rev[:, None], loc1, loc2)
         self._levels = [
-            (int(l.joints[0]), int(l.parents[0]), int(l.children[0])) if len(l.joints) == 1 else (l.joints, l.parents, l.children)
+            (int(l.joints[0]), int(l.parents[0]), int(l.children[0]))
+            if len(l.joints) == 1
+            else (l.joints, l.parents, l.children)
             for l in figure.traversal
         ]
         self.link_scale = np.asarray(figure.link_scales, dtype=float)
@@ -261,9 +293,7 @@ class IKModel:
         self.b = P[:3, 3].copy()
         self.placement_is_identity = bool(np.array_equal(P, np.eye(4)))
         # Variables grouped by axis, with their joints, for :meth:`axes_trig`.
-        self._axis_vars = [
-            (np.flatnonzero(self.var_axis == a), self.var_joint[self.var_axis == a]) for a in range(3)
-        ]
+        self._axis_vars = [(np.flatnonzero(self.var_axis == a), self.var_joint[self.var_axis == a]) for a in range(3)]
         self.lengths = link_lengths(figure)
         self.length = figure_length(figure)
         # For :meth:`forward_one`: each joint's 4x4 transform and local axes
@@ -278,12 +308,14 @@ class IKModel:
                     src = 3 * j + i if rev[k] else 3 * i + j
                     SJ[k, :, 4 * i + j] = _TERM_SUMS[:, src]
                 # t_i = near_i - sum_j R_ij far_j; the constant rides on the product "1".
-                SJ[k, :, 4 * i + 3] = -(SJ[k, :, 4 * i: 4 * i + 3] @ far)
+                SJ[k, :, 4 * i + 3] = -(SJ[k, :, 4 * i : 4 * i + 3] @ far)
                 SJ[k, 15, 4 * i + 3] += near[i]
             SJ[k, 15, 15] = 1.0
             SJ[k, :, 16:] = _TERM_SUMS[:, 9:]
         self._term_maps = SJ
-        self._term_index = (np.arange(J)[:, None] * 7 + _TERMS[:, None, :]) if J else np.zeros((3, 0, 16), dtype=np.intp)
+        self._term_index = (
+            (np.arange(J)[:, None] * 7 + _TERMS[:, None, :]) if J else np.zeros((3, 0, 16), dtype=np.intp)
+        )
         # Where the variables' cosines and sines go among [c, s, 1] per joint.
         self._cos_at = self.var_joint * 7 + self.var_axis
         self._sin_at = self._cos_at + 3
@@ -295,8 +327,14 @@ class IKModel:
         for lv in self._levels if chain else ():
             chain = chain and lv[1] == prev
             prev = lv[2]
-        self._chain = (np.array([lv[0] for lv in self._levels], dtype=np.intp),
-                       np.array([lv[2] for lv in self._levels], dtype=np.intp)) if chain and J else None
+        self._chain = (
+            (
+                np.array([lv[0] for lv in self._levels], dtype=np.intp),
+                np.array([lv[2] for lv in self._levels], dtype=np.intp),
+            )
+            if chain and J
+            else None
+        )
         # Each variable's local axis in column 0, its pivot in column 1
         # (homogeneous): one product with the primary's 4x4 gives both.
         M = np.zeros((V, 4, 2))

@@ -328,21 +328,32 @@ def solve_pose(
     batched = B_goals is not None or B_start is not None
     B = B_goals or B_start or 1
     base = np.deg2rad(start_deg).reshape(B_start or 1, figure.n_joints, 3)  # (1 or B, J, 3)
-    start_deg = start_deg[None] if start_deg.ndim == 2 and B == 1 else np.broadcast_to(start_deg, (B, figure.n_joints, 3))
+    start_deg = (
+        start_deg[None] if start_deg.ndim == 2 and B == 1 else np.broadcast_to(start_deg, (B, figure.n_joints, 3))
+    )
 
     model = IKModel.cached(figure, _movable_mask(figure, goals, movable), translate)
     stack = GoalStack(model, goals, B)
     x0 = np.zeros((B, model.n_params))
     x0[:, : model.n_vars] = np.deg2rad(start_deg).reshape(B, -1)[:, model.var_flat]
-    result = solve(model, stack, x0, base, method=solver, tolerance=tol, max_iterations=max_iter,
-                   restarts=int(restarts), trace=trace)
+    result = solve(
+        model,
+        stack,
+        x0,
+        base,
+        method=solver,
+        tolerance=tol,
+        max_iterations=max_iter,
+        restarts=int(restarts),
+        trace=trace,
+    )
 
     q = result.x[:, : model.n_vars]
     angles = start_deg.copy()
     flat = angles.reshape(B, -1)
     flat[:, model.var_flat] = np.rad2deg(q)
     angles = K.clamp(figure, flat.reshape(B, figure.n_joints, 3))
-    t = result.x[:, model.n_vars:] * model.length if translate else np.zeros((B, 3))
+    t = result.x[:, model.n_vars :] * model.length if translate else np.zeros((B, 3))
     # Wrapping free axes changes no link, so the solver's last distances are the pose's.
     residuals = stack.report(result.dist)
     sol = PoseSolution(
@@ -477,8 +488,17 @@ def reach(
     goals = list(goals)
     if batch_size(goals) is not None:
         raise GoalError("reach() takes unbatched goals; use reach_keyframes() for a batch.")
-    sol = solve_pose(figure, goals, start=start, movable=movable, translate=translate, solver=solver,
-                     tolerance=tolerance, max_iterations=max_iterations, restarts=restarts)
+    sol = solve_pose(
+        figure,
+        goals,
+        start=start,
+        movable=movable,
+        translate=translate,
+        solver=solver,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        restarts=restarts,
+    )
     s0 = start_pose(figure, start)
     driven = _driven(figure, goals, movable, start, joints)
     tracks = {}
@@ -533,8 +553,17 @@ def reach_keyframes(
     s0 = start_pose(figure, start)
     if s0.ndim == 3:
         raise GoalError("reach_keyframes() starts every solve from one pose; give an unbatched start.")
-    sol = solve_pose(figure, goals, start=np.broadcast_to(s0, (B,) + s0.shape), movable=movable, translate=translate,
-                     solver=solver, tolerance=tolerance, max_iterations=max_iterations, restarts=restarts)
+    sol = solve_pose(
+        figure,
+        goals,
+        start=np.broadcast_to(s0, (B,) + s0.shape),
+        movable=movable,
+        translate=translate,
+        solver=solver,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        restarts=restarts,
+    )
     driven = _driven(figure, goals, movable, start, joints)
     tracks = {}
     for jid in driven:

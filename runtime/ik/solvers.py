@@ -208,9 +208,19 @@ def _converged(dist: np.ndarray, active: np.ndarray, tol: float) -> np.ndarray:
     return np.all((dist <= tol) | ~active, axis=1)
 
 
-def solve(model: IKModel, stack: GoalStack, x0: np.ndarray, base: np.ndarray, *, method: str = "dls",
-          tolerance: float, max_iterations: int, restarts: int = 0, seed: int = 0,
-          trace: bool = False) -> SolveResult:
+def solve(
+    model: IKModel,
+    stack: GoalStack,
+    x0: np.ndarray,
+    base: np.ndarray,
+    *,
+    method: str = "dls",
+    tolerance: float,
+    max_iterations: int,
+    restarts: int = 0,
+    seed: int = 0,
+    trace: bool = False,
+) -> SolveResult:
     """Minimise the goals' weighted cost for a batch of problems.
 
     Parameters
@@ -257,8 +267,16 @@ def solve(model: IKModel, stack: GoalStack, x0: np.ndarray, base: np.ndarray, *,
         # One problem (the language's STARTREACH): the batch bookkeeping
         # would cost more than the arithmetic; same iterates, scalar control.
         return _dls_one(prob, x[0], float(tolerance), int(max_iterations), int(restarts), seed, trace)
-    st = _State(prob, x, float(tolerance), trace, jac=method != "ccd", max_iter=int(max_iterations),
-                restarts=int(restarts), seed=seed)
+    st = _State(
+        prob,
+        x,
+        float(tolerance),
+        trace,
+        jac=method != "ccd",
+        max_iter=int(max_iterations),
+        restarts=int(restarts),
+        seed=seed,
+    )
     run(prob, st)
     return st.finish()
 
@@ -271,8 +289,9 @@ class _State:
     distances ``dist`` (B, n_goals) of every batch element.
     """
 
-    def __init__(self, prob: _Problem, x: np.ndarray, tol: float, trace: bool, jac: bool,
-                 max_iter: int, restarts: int, seed: int):
+    def __init__(
+        self, prob: _Problem, x: np.ndarray, tol: float, trace: bool, jac: bool, max_iter: int, restarts: int, seed: int
+    ):
         self.prob = prob
         self.x = x
         self.x0 = x.copy()
@@ -356,8 +375,10 @@ class _State:
         self.status[run[k >= self.max_iter]] = LIMIT
         check = run[(k % GIVEUP_EVERY == 0) & (self.attempts_left[run] > 0) & (self.status[run] == RUNNING)]
         if check.size:
-            hopeless = (self.attempt_iter[check] >= GIVEUP_FROM) & (self.f[check] > self.giveup_floor[check]) & (
-                self.f[check] > 0.5 * self.fast_f[check]
+            hopeless = (
+                (self.attempt_iter[check] >= GIVEUP_FROM)
+                & (self.f[check] > self.giveup_floor[check])
+                & (self.f[check] > 0.5 * self.fast_f[check])
             )
             self.status[check[hopeless]] = STALLED
             self.gave_up[check[hopeless]] = True
@@ -522,8 +543,9 @@ def _dls(prob: _Problem, st: _State) -> None:
         st.end_iteration(idx)
 
 
-def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts: int, seed: int,
-             trace: bool) -> SolveResult:
+def _dls_one(
+    prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts: int, seed: int, trace: bool
+) -> SolveResult:
     """:func:`_dls` and :class:`_State` for a batch of one, with plain Python control.
 
     A single solve is a few dozen iterations on arrays of a handful of
@@ -638,7 +660,8 @@ def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts:
         if converged(dist):
             status = CONVERGED
         elif (accept and gain <= FTOL * f_old) or (
-                math.sqrt(float(dx @ dx)) <= XTOL * (XTOL + math.sqrt(float(x @ x)))):
+            math.sqrt(float(dx @ dx)) <= XTOL * (XTOL + math.sqrt(float(x @ x)))
+        ):
             status = STALLED
         if status == RUNNING and mu > MU_MAX * max(curv, 1e-300):
             status = STALLED
@@ -663,8 +686,21 @@ def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts:
         if status in (STALLED, LIMIT):
             if attempts_left > 0:
                 if saved is None:
-                    saved = dict(x=x, r=r, J=J, f=f, dist=dist, status=status, attempt_iter=attempt_iter,
-                                 window_f=window_f, gave_up=gave_up, fast_f=fast_f, curv=curv, mu=mu, nu=nu)
+                    saved = dict(
+                        x=x,
+                        r=r,
+                        J=J,
+                        f=f,
+                        dist=dist,
+                        status=status,
+                        attempt_iter=attempt_iter,
+                        window_f=window_f,
+                        gave_up=gave_up,
+                        fast_f=fast_f,
+                        curv=curv,
+                        mu=mu,
+                        nu=nu,
+                    )
                 if rng is None:
                     rng = np.random.default_rng(seed)
                 lo = np.where(np.isfinite(lower[:V]), lower[:V], -np.pi)
@@ -691,8 +727,7 @@ def _dls_one(prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts:
 
     if saved is not None and status != CONVERGED and not resumed:
         x, f, dist, status = saved["x"], saved["f"], saved["dist"], saved["status"]
-    return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None],
-                       history or [])
+    return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None], history or [])
 
 
 def _transpose(prob: _Problem, st: _State) -> None:
@@ -806,8 +841,8 @@ def _ccd(prob: _Problem, st: _State) -> None:
         yq = stack._link_points(R, p, stack.q_link, stack.q_local)
         vh = np.einsum("bhij,hj->bhi", R[:, stack.h_link], stack.h_local)
         wp = stack.row_weight[:, : 3 * len(stack.p_link)].reshape(idx.size, -1, 3)[..., 0]
-        wq = stack.row_weight[:, 3 * len(stack.p_link): 3 * len(stack.p_link) + len(stack.q_link)]
-        wh = stack.row_weight[:, 3 * len(stack.p_link) + len(stack.q_link):].reshape(idx.size, -1, 3)[..., 0]
+        wq = stack.row_weight[:, 3 * len(stack.p_link) : 3 * len(stack.p_link) + len(stack.q_link)]
+        wh = stack.row_weight[:, 3 * len(stack.p_link) + len(stack.q_link) :].reshape(idx.size, -1, 3)[..., 0]
         nvh = np.linalg.norm(vh @ A.T, axis=-1)  # |A v|, unchanged by turns when A is a similarity
         for v in range(V):
             w = omega[:, v]
@@ -826,7 +861,10 @@ def _ccd(prob: _Problem, st: _State) -> None:
                 n = stack.q_normal[:, mq]
                 d = yq[:, mq] - cv[:, None]
                 wd = cross3(w[:, None], d)
-                a = np.einsum("bqi,bqi->bq", n, yq[:, mq] @ A.T + model.b + tw[:, None] - stack.q_origin[:, mq]) * wq[:, mq]
+                a = (
+                    np.einsum("bqi,bqi->bq", n, yq[:, mq] @ A.T + model.b + tw[:, None] - stack.q_origin[:, mq])
+                    * wq[:, mq]
+                )
                 b = np.einsum("bqi,bqi->bq", n, wd @ A.T) * wq[:, mq]
                 g = np.einsum("bqi,bqi->bq", n, cross3(w[:, None], wd) @ A.T) * wq[:, mq]
                 C += _sums(a, b, g)

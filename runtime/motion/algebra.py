@@ -119,8 +119,13 @@ class Motion:
 
     __slots__ = ("_derived", "_expr", "_length", "_open", "_tail", "_tracks")
 
-    def __init__(self, tracks: Mapping[int, tr.Track], expr: tuple, length: float | None = None,
-                 gaps: tuple[Iterable[int], Iterable[int]] = ((), ())):
+    def __init__(
+        self,
+        tracks: Mapping[int, tr.Track],
+        expr: tuple,
+        length: float | None = None,
+        gaps: tuple[Iterable[int], Iterable[int]] = ((), ()),
+    ):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
 
         Parameters
@@ -138,13 +143,13 @@ class Motion:
         self._tracks = dict(sorted(tracks.items()))
         self._open = frozenset(gaps[0]) & self._tracks.keys()
         self._tail = frozenset(gaps[1]) & self._tracks.keys()
-        self._length = float(
-            length if length is not None else max((t.end for t in self._tracks.values()), default=0.0)
-        )
+        self._length = float(length if length is not None else max((t.end for t in self._tracks.values()), default=0.0))
         if not math.isfinite(self._length):
             # n * m and SCALE FRAMES multiply lengths; LEN must stay a finite REAL.
-            raise MotionError("the motion would be longer than a REAL can count (about 1.8E308 frames)",
-                              hint="repeat or stretch it less")
+            raise MotionError(
+                "the motion would be longer than a REAL can count (about 1.8E308 frames)",
+                hint="repeat or stretch it less",
+            )
         self._expr = expr
         self._derived: dict | None = None
 

@@ -181,8 +181,9 @@ def _knot_velocity(s1, s2, kind_l, kind_r, w_l, w_r, cap_l, cap_r) -> np.ndarray
     """
     kl, kr = kind_l[:, None], kind_r[:, None]
     wants_l, wants_r = kl == _WANTS, kr == _WANTS
-    v = np.where(wants_l & wants_r, _harmonic(w_l, w_r),
-                 np.where(wants_l, w_l, np.where(wants_r, w_r, _harmonic(s1, s2))))
+    v = np.where(
+        wants_l & wants_r, _harmonic(w_l, w_r), np.where(wants_l, w_l, np.where(wants_r, w_r, _harmonic(s1, s2)))
+    )
     # Two flexible ends (DECELERATE into a keyframe, ACCELERATE out) rest, as both names say.
     v = np.where(((kl == _FLEXIBLE) & (kr == _FLEXIBLE)) | (kl == _REST) | (kr == _REST), 0.0, v)
     same = ((s1 > 0) & (s2 > 0)) | ((s1 < 0) & (s2 < 0))
@@ -225,8 +226,16 @@ class Edge(NamedTuple):
 
 def _edge_velocity(left: Edge, right: Edge) -> np.ndarray:
     """The knot velocity, shape (3,), shared across a smooth junction."""
-    return _knot_velocity(left.slope[None], right.slope[None], np.array([left.kind]), np.array([right.kind]),
-                          left.w[None], right.w[None], np.array([left.cap]), np.array([right.cap]))[0]
+    return _knot_velocity(
+        left.slope[None],
+        right.slope[None],
+        np.array([left.kind]),
+        np.array([right.kind]),
+        left.w[None],
+        right.w[None],
+        np.array([left.cap]),
+        np.array([right.cap]),
+    )[0]
 
 
 class _Prepared(NamedTuple):
@@ -271,8 +280,17 @@ class Leaf(Track):
 
     __slots__ = ("_prep", "after", "before", "frames", "methods", "ramps", "right", "start", "values")
 
-    def __init__(self, start, frames, values, methods, ramps, right: bool = True,
-                 before: Edge | None = None, after: Edge | None = None):
+    def __init__(
+        self,
+        start,
+        frames,
+        values,
+        methods,
+        ramps,
+        right: bool = True,
+        before: Edge | None = None,
+        after: Edge | None = None,
+    ):
         self.start = _frozen(start).reshape(3)
         self.frames = _frozen(frames).reshape(-1)
         k = len(self.frames)
@@ -343,8 +361,16 @@ class Leaf(Track):
             kind_r = np.where(side[1:] != 0, side[1:], np.where(e0[1:] > 0, _WANTS, _FLEXIBLE))
             with np.errstate(divide="ignore", invalid="ignore"):
                 cap = np.where(lin, T / np.minimum(self.ramps, T / 2.0), HERMITE_CAP)
-            knot = _knot_velocity(slope[:-1], slope[1:], kind_l, kind_r,
-                                  e1[:-1, None] * slope[:-1], e0[1:, None] * slope[1:], cap[:-1], cap[1:])
+            knot = _knot_velocity(
+                slope[:-1],
+                slope[1:],
+                kind_l,
+                kind_r,
+                e1[:-1, None] * slope[:-1],
+                e0[1:, None] * slope[1:],
+                cap[:-1],
+                cap[1:],
+            )
             Ve[:-1] = np.where(both[:, None], knot, Ve[:-1])
             Vs[1:] = np.where(both[:, None], knot, Vs[1:])
         first = last = None
@@ -412,7 +438,7 @@ class Leaf(Track):
         # Rows b[i] .. b[i+1] lie in segment i (knot i to knot i+1).
         b = np.searchsorted(t, p.F, side="left" if self.right else "right").tolist()
         x[: b[0]] = self.start
-        x[b[K]:] = p.V[K]
+        x[b[K] :] = p.V[K]
         for k in range(K):
             lo, hi = b[k], b[k + 1]
             if hi <= lo:
@@ -454,8 +480,9 @@ class Leaf(Track):
             frames, ramps = self.frames * r, self.ramps * r
         check_frames(frames, f"SCALE FRAMES {r:g}")
         if len(ramps) and not ramps.min() > 0:
-            raise MotionError(f"SCALE FRAMES {r:g} squeezes the motion's speed-up ramps to nothing",
-                              hint="use a larger factor")
+            raise MotionError(
+                f"SCALE FRAMES {r:g} squeezes the motion's speed-up ramps to nothing", hint="use a larger factor"
+            )
         before = None if self.before is None else self.before.time_scaled(r)
         after = None if self.after is None else self.after.time_scaled(r)
         return Leaf(self.start, frames, self.values, self.methods, ramps, self.right, before, after)
@@ -1201,22 +1228,28 @@ def check_frames(frames: np.ndarray, cause: str) -> None:
         return
     last = frames[-1]
     if not last <= MAX_FRAME:
-        raise MotionError(f"{cause} puts a keyframe at frame {magnitude(last)}, beyond the last frame allowed, {magnitude(MAX_FRAME)}",
-                          hint="a keyframe's frame is at most 1E9")
+        raise MotionError(
+            f"{cause} puts a keyframe at frame {magnitude(last)}, beyond the last frame allowed, {magnitude(MAX_FRAME)}",
+            hint="a keyframe's frame is at most 1E9",
+        )
     gaps = np.diff(frames, prepend=0.0)
     close = (gaps > 0) & (gaps < MIN_FRAME_GAP)
     if close.any():
         gap = float(gaps[close][0])
-        raise MotionError(f"{cause} puts two keyframes {gap:g} frames apart, closer than {MIN_FRAME_GAP:g}",
-                          hint="keyframes of a joint share a frame (a step) or lie at least 1E-100 frames apart")
+        raise MotionError(
+            f"{cause} puts two keyframes {gap:g} frames apart, closer than {MIN_FRAME_GAP:g}",
+            hint="keyframes of a joint share a frame (a step) or lie at least 1E-100 frames apart",
+        )
 
 
 def check_angles(values: np.ndarray, cause: str) -> None:
     """Angles within ``±MAX_ANGLE`` degrees, else MotionError naming ``cause``."""
     far = float(np.max(np.abs(values))) if np.size(values) else 0.0
     if not far <= MAX_ANGLE:
-        raise MotionError(f"{cause} makes an angle of {magnitude(far)} degrees, beyond the largest allowed, {magnitude(MAX_ANGLE)}",
-                          hint="angles are in degrees; a joint's extremes clip them anyway")
+        raise MotionError(
+            f"{cause} makes an angle of {magnitude(far)} degrees, beyond the largest allowed, {magnitude(MAX_ANGLE)}",
+            hint="angles are in degrees; a joint's extremes clip them anyway",
+        )
 
 
 def unwrap_angles(start: np.ndarray, values: np.ndarray) -> np.ndarray:

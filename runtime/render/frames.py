@@ -88,8 +88,19 @@ class Renderer:
         or an output another run is writing (see :class:`.outputs.OutputLock`).
     """
 
-    def __init__(self, out_dir, size=(640, 480), gif=None, mp4=None, poses=None, fps=24.0, quiet=False,
-                 workers=None, stdout=None, progress=None):
+    def __init__(
+        self,
+        out_dir,
+        size=(640, 480),
+        gif=None,
+        mp4=None,
+        poses=None,
+        fps=24.0,
+        quiet=False,
+        workers=None,
+        stdout=None,
+        progress=None,
+    ):
         check_outputs(out_dir, gif, mp4, poses, fps, KEYWORD_NAMES, make_poses_folder=True)
         self.out_dir = out_dir
         self.size = (int(size[0]), int(size[1]))
@@ -147,8 +158,12 @@ class Renderer:
         if self.current is None or self.current["image"] != image:
             if self.current is not None:
                 self.pending.append(self.current)
-            self.current = {"scene": state.id, "image": image, "background": self._background(state, camera),
-                            "ticks": []}
+            self.current = {
+                "scene": state.id,
+                "image": image,
+                "background": self._background(state, camera),
+                "ticks": [],
+            }
         self.current["ticks"].append((tick, camera, list(state.drawn)))
         if tick % k == k - 1 or tick == state.length - 1:
             self.pending.append(self.current)
@@ -236,8 +251,13 @@ class Renderer:
         segments = []
         for i, link in enumerate(fig.links):
             parent = fig.parent_joint_of(i)
-            segments.append({"link": link.name, "joint": parent.id if parent is not None else None,
-                             "matrix": [_r(x) for x in X[i].reshape(-1)]})
+            segments.append(
+                {
+                    "link": link.name,
+                    "joint": parent.id if parent is not None else None,
+                    "matrix": [_r(x) for x in X[i].reshape(-1)],
+                }
+            )
         rec = {"scene": scene, "tick": tick, "image": image, "model": name, "joints": joints, "segments": segments}
         self._poses_fh.write((json.dumps(rec, separators=(", ", ": ")) + "\n").encode("utf-8"))
 
@@ -255,8 +275,7 @@ class Renderer:
         if not chunk:
             return
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
-            self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init,
-                                            initargs=(os.getpid(),))
+            self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init, initargs=(os.getpid(),))
             self._worker_procs: list = []
             # The first submit forks the workers.  With SIGINT and SIGTERM blocked
             # meanwhile, a signal cannot reach a worker before it has set itself to
@@ -357,8 +376,10 @@ def _result(future):
     try:
         return future.result()
     except BrokenProcessPool:
-        raise RenderError("a worker process drawing the images stopped unexpectedly (killed, or out of memory); "
-                          "the images written before it are complete") from None
+        raise RenderError(
+            "a worker process drawing the images stopped unexpectedly (killed, or out of memory); "
+            "the images written before it are complete"
+        ) from None
 
 
 def _worker_init(parent: int) -> None:
@@ -466,8 +487,11 @@ def _joined(parts):
     """One (triangles, grey, cull) from several."""
     if len(parts) == 1:
         return parts[0]
-    return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-            np.concatenate([p[2] for p in parts]))
+    return (
+        np.concatenate([p[0] for p in parts]),
+        np.concatenate([p[1] for p in parts]),
+        np.concatenate([p[2] for p in parts]),
+    )
 
 
 _cameras: dict = {}

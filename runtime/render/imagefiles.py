@@ -477,8 +477,9 @@ class AtomicWriter:
         self._tmp = None
         folder = os.path.dirname(os.path.abspath(self.path))
         try:
-            self._fd, self._tmp = tempfile.mkstemp(dir=folder, prefix="." + os.path.basename(self.path) + ".",
-                                                   suffix=".tmp")
+            self._fd, self._tmp = tempfile.mkstemp(
+                dir=folder, prefix="." + os.path.basename(self.path) + ".", suffix=".tmp"
+            )
         except OSError as exc:
             raise write_error(exc, self.path) from None
 

@@ -52,8 +52,10 @@ def check_fps(fps, name: str = "--fps") -> float:
     except (TypeError, ValueError, OverflowError):
         f = math.nan
     if not (MIN_FPS <= f <= MAX_FPS):
-        raise RenderError(f"{name} {fps} is not a usable frame rate; give a number of frames per second "
-                          f"from {MIN_FPS:g} to {MAX_FPS:g}")
+        raise RenderError(
+            f"{name} {fps} is not a usable frame rate; give a number of frames per second "
+            f"from {MIN_FPS:g} to {MAX_FPS:g}"
+        )
     return f
 
 
@@ -205,8 +207,9 @@ def _words(exc: OSError) -> str:
 def _taken(shown: str, is_folder: bool, pid) -> RenderError:
     who = f" (pid {pid})" if pid else ""
     what = (shown.rstrip(os.sep) + os.sep) if is_folder else shown
-    return RenderError(f"{what} is being written by another liganimate run{who}; wait for it to end or choose "
-                       "another output")
+    return RenderError(
+        f"{what} is being written by another liganimate run{who}; wait for it to end or choose another output"
+    )
 
 
 class OutputLock:
@@ -320,5 +323,4 @@ class OutputLock:
             _HELD.discard(key)
 
 
-__all__ = ["CLI_NAMES", "KEYWORD_NAMES", "OutputLock", "check_fps", "check_outputs", "holder_of",
-           "refuse_if_locked"]
+__all__ = ["CLI_NAMES", "KEYWORD_NAMES", "OutputLock", "check_fps", "check_outputs", "holder_of", "refuse_if_locked"]

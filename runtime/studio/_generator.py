@@ -159,8 +159,9 @@ class Generator:
         """Go back one action (take, generation, seed, freeze, stand, keep); False if there is none."""
         if not self._history:
             return False
-        (self.current, self.candidates, self.levels, self.generation, state, self.kept, self.frozen,
-         self.seed) = self._history.pop()
+        (self.current, self.candidates, self.levels, self.generation, state, self.kept, self.frozen, self.seed) = (
+            self._history.pop()
+        )
         self._rng.bit_generator.state = state
         return True
 
@@ -245,8 +246,18 @@ class Generator:
         return np.asarray(chosen, dtype=np.int64)
 
     def _push(self) -> None:
-        self._history.append((self.current, self.candidates, self.levels, self.generation,
-                              copy.deepcopy(self._rng.bit_generator.state), self.kept, self.frozen, self.seed))
+        self._history.append(
+            (
+                self.current,
+                self.candidates,
+                self.levels,
+                self.generation,
+                copy.deepcopy(self._rng.bit_generator.state),
+                self.kept,
+                self.frozen,
+                self.seed,
+            )
+        )
         if len(self._history) > _HISTORY:
             del self._history[0]
 

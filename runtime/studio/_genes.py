@@ -113,8 +113,9 @@ def joint_axes(fig) -> list:
         p, f = _PAIRS[t]
         ext = np.asarray(joint.extremes, dtype=np.float64)
         lo, hi = ext[:, 0].copy(), ext[:, 1].copy()
-        out.append(JointAxes(k, int(joint.id), int(joint.secondary), t, p, f, 1.0 if u[t] >= 0 else -1.0,
-                             lo, hi, lo == hi))
+        out.append(
+            JointAxes(k, int(joint.id), int(joint.secondary), t, p, f, 1.0 if u[t] >= 0 else -1.0, lo, hi, lo == hi)
+        )
     return out
 
 
@@ -211,8 +212,9 @@ def _order(level, plain, distance, values):
     return np.lexsort((*keys, np.round(distance, 6), ~plain, level))
 
 
-def alternatives(ax: JointAxes, seed: np.ndarray, mode: str, first: bool, max_distance: float,
-                 need: int = 9) -> Alternatives:
+def alternatives(
+    ax: JointAxes, seed: np.ndarray, mode: str, first: bool, max_distance: float, need: int = 9
+) -> Alternatives:
     """The configurations this gene may take, from the coarsest levels, sorted for presentation.
 
     Parameters
@@ -262,8 +264,7 @@ def _coarsest(ok: np.ndarray, level: np.ndarray, need: int) -> np.ndarray:
     return np.flatnonzero(ok[:end])
 
 
-def _on_circle(ax: JointAxes, axis: int, seed: np.ndarray, first: bool, max_distance: float,
-               need: int) -> Alternatives:
+def _on_circle(ax: JointAxes, axis: int, seed: np.ndarray, first: bool, max_distance: float, need: int) -> Alternatives:
     angles, level = _spheres.circle()
     s = float(seed[axis])
     distance = np.abs(wrap(angles - s))

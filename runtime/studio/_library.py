@@ -134,8 +134,11 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
     taken = {model, motion}
     segs = _segment_names(fig, taken)
     ext = widened_extremes(fig, kept)
-    grown = [fig.joints[k].id for k in range(fig.n_joints)
-             if not np.array_equal(ext[k], np.asarray(fig.extremes[k]).reshape(3, 2))]
+    grown = [
+        fig.joints[k].id
+        for k in range(fig.n_joints)
+        if not np.array_equal(ext[k], np.asarray(fig.extremes[k]).reshape(3, 2))
+    ]
     out = [
         f"C {model}, {motion}: posed with liganimate studio, the Generator of the thesis on",
         "C posing figures with interactive genetic algorithms.",
@@ -149,10 +152,17 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
         f"C {model} is the model as drawn: each segment's triangles, its joints and extremes.",
     ]
     if grown:
-        out.append("C The extremes of joint(s) " + ", ".join(str(j) for j in grown)
-                   + " are widened to hold poses the Generator took beyond them.")
-    out += ["", f"{{@ {model}: the posed model, {fig.n_links} segments and {fig.n_joints} joints }}",
-            f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}", ""]
+        out.append(
+            "C The extremes of joint(s) "
+            + ", ".join(str(j) for j in grown)
+            + " are widened to hold poses the Generator took beyond them."
+        )
+    out += [
+        "",
+        f"{{@ {model}: the posed model, {fig.n_links} segments and {fig.n_joints} joints }}",
+        f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}",
+        "",
+    ]
     shapes: dict = {}  # (id(shape), scale) -> primitive name
     assign = []
     for i, link in enumerate(fig.links):
@@ -170,7 +180,7 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
             out += _primitive(prim, tris * link.scale, link.shape.lightness)
         assign.append(f"      {segs[i]} :- ({prim})")
     for k in range(0, len(segs), 6):
-        out.append("      GRAPHICAL " + ", ".join(segs[k:k + 6]))
+        out.append("      GRAPHICAL " + ", ".join(segs[k : k + 6]))
     out += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + ["", f"      STARTMODEL {model}"]
     for k, j in enumerate(fig.joints):
         pairs = ", ".join(f"({_num(a)}, {_num(b)})" for a, b in ext[k])

@@ -71,9 +71,10 @@ def studio_model(path: str | None, name: str | None):
         if lib is None:
             from liganimate.compiler import library as L
 
-            raise LigError(f"no standard library offers a model called {wanted}",
-                           "the standard libraries are " + ", ".join(L.stdlib_names())
-                           + "; `liganimate lib` lists their models")
+            raise LigError(
+                f"no standard library offers a model called {wanted}",
+                "the standard libraries are " + ", ".join(L.stdlib_names()) + "; `liganimate lib` lists their models",
+            )
         variables = _run(_compiled_text(f"LOAD {wanted} FROM '{lib}'\n", f"<studio {lib}>"))
         source = f"the standard library '{lib}'"
     else:
@@ -85,15 +86,19 @@ def studio_model(path: str | None, name: str | None):
     models = sorted(k for k, v in variables.items() if isinstance(v, Figure))
     if wanted is None:
         if len(models) != 1:
-            raise LigError(f"{path} has {'no models' if not models else 'several models: ' + ', '.join(models)}, "
-                           "so say which one to pose",
-                           "pass --model NAME" if models else "define a MODEL with STARTMODEL or JOINT")
+            raise LigError(
+                f"{path} has {'no models' if not models else 'several models: ' + ', '.join(models)}, "
+                "so say which one to pose",
+                "pass --model NAME" if models else "define a MODEL with STARTMODEL or JOINT",
+            )
         wanted = models[0]
     fig = variables.get(wanted)
     if not isinstance(fig, Figure):
         hint = did_you_mean(wanted, models) or ("its models are " + ", ".join(models) if models else None)
         raise LigError(f"{source} has no model called {wanted}", hint)
     if fig.n_joints == 0:
-        raise LigError(f"the model {wanted} has no joints, so there is nothing to pose",
-                       "pose a model made with JOINT or STARTMODEL")
+        raise LigError(
+            f"the model {wanted} has no joints, so there is nothing to pose",
+            "pose a model made with JOINT or STARTMODEL",
+        )
     return fig, wanted, source

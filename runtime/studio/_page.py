@@ -53,28 +53,40 @@ def studio_page(generator, title: str) -> str:
     eye = centre + _EYE_DIRECTION / np.linalg.norm(_EYE_DIRECTION) * 3.2 * radius
     joints = []
     for ax in generator.axes:
-        joints.append({"id": ax.id, "ext": np.stack([ax.lo, ax.hi], axis=-1).round(9).tolist(),
-                       "twist": "XYZ"[ax.twist], "pivot": "XYZ"[ax.pivot], "flexion": "XYZ"[ax.flexion]})
+        joints.append(
+            {
+                "id": ax.id,
+                "ext": np.stack([ax.lo, ax.hi], axis=-1).round(9).tolist(),
+                "twist": "XYZ"[ax.twist],
+                "pivot": "XYZ"[ax.pivot],
+                "flexion": "XYZ"[ax.flexion],
+            }
+        )
     manifest = {
         "model": title,
         "population": POPULATION,
         "links": [link.label for link in fig.links],
         "jointOfLink": [-1 if j is None else j for j in (generator.joint_of_link(i) for i in range(fig.n_links))],
         "joints": joints,
-        "mesh": {"pos": blob.add(table.triangles.reshape(-1), np.float32),
-                 "link": blob.add(table.link, np.uint16 if fig.n_links < 65536 else np.uint32),
-                 "grey": blob.add(table.grey, np.uint8)},
+        "mesh": {
+            "pos": blob.add(table.triangles.reshape(-1), np.float32),
+            "link": blob.add(table.link, np.uint16 if fig.n_links < 65536 else np.uint32),
+            "grey": blob.add(table.grey, np.uint8),
+        },
         # Candidates reach further than the standing figure: room for them.
         "bounds": [float(c) for c in centre] + [radius * 2.0],
         # A view width of 3.4 radii: room for limbs swung out to their full length.
         "camera": {"eye": [float(c) for c in eye], "target": [float(c) for c in centre], "k": 3.4 / 3.2},
     }
-    return fill(_own("studio.html"), {
-        "VERSION": html.escape(__version__),
-        "TITLE": html.escape(title),
-        "CSS": inline_code(_own("studio.css")),
-        "MANIFEST": json_for_script(manifest),
-        "BLOB": base64.b64encode(blob.tobytes()).decode("ascii"),
-        "GLJS": inline_code(asset("gl.js")),
-        "STUDIOJS": inline_code(_own("studio.js")),
-    })
+    return fill(
+        _own("studio.html"),
+        {
+            "VERSION": html.escape(__version__),
+            "TITLE": html.escape(title),
+            "CSS": inline_code(_own("studio.css")),
+            "MANIFEST": json_for_script(manifest),
+            "BLOB": base64.b64encode(blob.tobytes()).decode("ascii"),
+            "GLJS": inline_code(asset("gl.js")),
+            "STUDIOJS": inline_code(_own("studio.js")),
+        },
+    )

@@ -188,10 +188,11 @@ class _Handler(BaseHTTPRequestHandler):
             return self._error(403, "the studio answers only its own page on 127.0.0.1")
         path = urlsplit(self.path).path
         if path in ("/", "/index.html"):
-            csp = ("default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; "
-                   "connect-src 'self'; img-src data:; base-uri 'none'; form-action 'none'")
-            return self._send(200, self.server.page, "text/html; charset=utf-8",
-                              {"Content-Security-Policy": csp})
+            csp = (
+                "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; "
+                "connect-src 'self'; img-src data:; base-uri 'none'; form-action 'none'"
+            )
+            return self._send(200, self.server.page, "text/html; charset=utf-8", {"Content-Security-Policy": csp})
         if path == "/api/state":
             s = self.server.session
             with s.lock:
@@ -205,8 +206,9 @@ class _Handler(BaseHTTPRequestHandler):
                     data = fh.read()
             except OSError:
                 return self._error(404, "the saved library is gone")
-            return self._send(200, data, "text/plain; charset=utf-8",
-                              {"Content-Disposition": 'attachment; filename="library.lig"'})
+            return self._send(
+                200, data, "text/plain; charset=utf-8", {"Content-Disposition": 'attachment; filename="library.lig"'}
+            )
         self._error(404, "no such page")
 
     def _post(self) -> None:
@@ -244,8 +246,9 @@ class _Handler(BaseHTTPRequestHandler):
         except RequestError as exc:
             return self._error(400, str(exc))
         except LigDiagnostics as exc:
-            return self._error(500, "the library to save does not compile: "
-                               + "; ".join(format_diagnostic(d) for d in exc.diagnostics))
+            return self._error(
+                500, "the library to save does not compile: " + "; ".join(format_diagnostic(d) for d in exc.diagnostics)
+            )
         except OSError as exc:
             return self._error(500, f"cannot write the library: {exc.strerror or exc}")
         self._json(200, state)

@@ -67,9 +67,16 @@ class Session:
         poses = np.concatenate([g.current[None], g.candidates])
         X = g.transforms(poses)[:, :, :3, :]  # (10, L, 3, 4)
         return {
-            "seed": g.seed, "generation": g.generation, "intensity": g.intensity, "mode": g.mode,
-            "kept": len(g.kept), "canUndo": g.can_undo, "frozen": g.frozen.tolist(),
-            "saved": self.saved, "savePath": self.save_path, "message": message,
+            "seed": g.seed,
+            "generation": g.generation,
+            "intensity": g.intensity,
+            "mode": g.mode,
+            "kept": len(g.kept),
+            "canUndo": g.can_undo,
+            "frozen": g.frozen.tolist(),
+            "saved": self.saved,
+            "savePath": self.save_path,
+            "message": message,
             "matrices": _b64(X),
             "angles": np.round(poses, 4).tolist(),
             "levels": g.levels.tolist(),
@@ -97,8 +104,9 @@ class Session:
 
     def _settings(self, g, body) -> None:
         intensity, mode = body.get("intensity"), body.get("mode")
-        if intensity is not None and (isinstance(intensity, bool) or not isinstance(intensity, (int, float))
-                                      or not 0 <= intensity <= 1):
+        if intensity is not None and (
+            isinstance(intensity, bool) or not isinstance(intensity, (int, float)) or not 0 <= intensity <= 1
+        ):
             raise RequestError("'intensity' must be a number from 0 to 1")
         if mode is not None and mode not in MODES:
             raise RequestError("'mode' must be 'flexion' or 'twist'")
@@ -156,8 +164,9 @@ class Session:
     def _do_save(self, g, body):
         if not g.kept:
             raise RequestError("keep a pose first: the saved motion is made of the kept poses")
-        text = library_text(g.figure, self.model, self.motion, g.kept, self.spacing,
-                            note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept.")
+        text = library_text(
+            g.figure, self.model, self.motion, g.kept, self.spacing, note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept."
+        )
         write_library(self.save_path, text)
         self.saved = True
         return f"saved {len(g.kept)} pose(s) to {self.save_path}"

@@ -46,8 +46,7 @@ def sphere(levels: int = LEVELS):
         The level at which each point first appears, read-only.  Points are
         listed level by level in the order the subdivision makes them.
     """
-    pts = [np.array(p, dtype=np.float64) for p in
-           ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))]
+    pts = [np.array(p, dtype=np.float64) for p in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))]
     lev = [0] * 6
     # The octahedron's faces, wound outward.
     faces = [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]

@@ -75,15 +75,18 @@ def viewer_html(scenes, title: str) -> str:
     """
     blob = Blob()
     manifest = {"version": 1, "title": title, "scenes": scene_manifest(scenes, blob)}
-    return fill(asset("viewer.html"), {
-        "VERSION": html.escape(__version__),
-        "TITLE": html.escape(title),
-        "CSS": inline_code(asset("viewer.css")),
-        "MANIFEST": json_for_script(manifest),
-        "BLOB": base64.b64encode(blob.tobytes()).decode("ascii"),
-        "GLJS": inline_code(asset("gl.js")),
-        "VIEWERJS": inline_code(asset("viewer.js")),
-    })
+    return fill(
+        asset("viewer.html"),
+        {
+            "VERSION": html.escape(__version__),
+            "TITLE": html.escape(title),
+            "CSS": inline_code(asset("viewer.css")),
+            "MANIFEST": json_for_script(manifest),
+            "BLOB": base64.b64encode(blob.tobytes()).decode("ascii"),
+            "GLJS": inline_code(asset("gl.js")),
+            "VIEWERJS": inline_code(asset("viewer.js")),
+        },
+    )
 
 
 def iframe(page: str, height: int = 560) -> str:
@@ -92,6 +95,8 @@ def iframe(page: str, height: int = 560) -> str:
     The frame keeps the viewer's script and style away from the notebook's
     own, and several viewers on one notebook page apart from each other.
     """
-    return (f'<iframe srcdoc="{html.escape(page, quote=True)}" sandbox="allow-scripts" '
-            f'style="width:100%;height:{int(height)}px;border:1px solid #ccc" '
-            'title="liganimate viewer"></iframe>')
+    return (
+        f'<iframe srcdoc="{html.escape(page, quote=True)}" sandbox="allow-scripts" '
+        f'style="width:100%;height:{int(height)}px;border:1px solid #ccc" '
+        'title="liganimate viewer"></iframe>'
+    )

@@ -23,8 +23,13 @@ from liganimate.runtime.values import Graphical, grey_levels
 
 __all__ = ["Blob", "scene_manifest"]
 
-_TYPES = {np.dtype(np.float32): "f32", np.dtype(np.uint8): "u8", np.dtype(np.uint16): "u16",
-          np.dtype(np.int32): "i32", np.dtype(np.uint32): "u32"}
+_TYPES = {
+    np.dtype(np.float32): "f32",
+    np.dtype(np.uint8): "u8",
+    np.dtype(np.uint16): "u16",
+    np.dtype(np.int32): "i32",
+    np.dtype(np.uint32): "u32",
+}
 
 
 class Blob:
@@ -127,8 +132,11 @@ def _background_entry(obj, ticks, blob: Blob, extent: list):
         if len(tris) == 0:
             return None
     extent.append(np.asarray(tris).reshape(-1, 3))
-    return {"pos": blob.add(np.asarray(tris).reshape(-1), np.float32), "grey": blob.add(grey, np.uint8),
-            "ticks": blob.add(ticks, np.int32)}
+    return {
+        "pos": blob.add(np.asarray(tris).reshape(-1), np.float32),
+        "grey": blob.add(grey, np.uint8),
+        "ticks": blob.add(ticks, np.int32),
+    }
 
 
 def scene_manifest(scenes, blob: Blob) -> list:
@@ -159,13 +167,15 @@ def scene_manifest(scenes, blob: Blob) -> list:
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         centre = (lo + hi) / 2
         radius = float(np.linalg.norm(hi - lo) / 2) or 1.0
-        out.append({
-            "id": int(take.id),
-            "length": int(take.length),
-            "sameframe": int(take.sameframe),
-            "cameras": blob.add(cams, np.float32),
-            "bounds": [float(c) for c in centre] + [radius],
-            "models": models,
-            "backgrounds": backgrounds,
-        })
+        out.append(
+            {
+                "id": int(take.id),
+                "length": int(take.length),
+                "sameframe": int(take.sameframe),
+                "cameras": blob.add(cams, np.float32),
+                "bounds": [float(c) for c in centre] + [radius],
+                "models": models,
+                "backgrounds": backgrounds,
+            }
+        )
     return out

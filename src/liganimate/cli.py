@@ -122,8 +122,9 @@ def _render(program, warnings, args, out: str) -> int:
     _print_diagnostics(warnings)
     warnings_run = _checked(program, args.quiet)
     _print_diagnostics(warnings_run)
-    program.render(out, checked=True, size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps,
-                   quiet=args.quiet)
+    program.render(
+        out, checked=True, size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps, quiet=args.quiet
+    )
     if not args.quiet:
         sys.stderr.write(f"frames written to {out}\n")
     return 0
@@ -166,8 +167,10 @@ def _guarded(fn):
         sys.stderr.write("liganimate: error: the program is nested too deeply to compile\n")
         return EXIT_USER_ERROR
     except Exception as exc:  # noqa: BLE001 - the user must never see a traceback
-        sys.stderr.write(f"liganimate: internal error: {type(exc).__name__}: {exc}\n"
-                         "  please report this with the program that caused it\n")
+        sys.stderr.write(
+            f"liganimate: internal error: {type(exc).__name__}: {exc}\n"
+            "  please report this with the program that caused it\n"
+        )
         if os.environ.get("LIGANIMATE_DEBUG"):
             raise
         return EXIT_INTERNAL
@@ -300,7 +303,9 @@ def cmd_plot(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``liganimate`` command."""
-    parser = argparse.ArgumentParser(prog="liganimate", description="LIG ANIMATE: model and animate articulated figures.")
+    parser = argparse.ArgumentParser(
+        prog="liganimate", description="LIG ANIMATE: model and animate articulated figures."
+    )
     parser.add_argument("--version", action="version", version=f"liganimate {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="compile a program and render its scenes")
@@ -336,6 +341,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Entry point of the ``liganimate`` command."""
+
     def go():
         args = build_parser().parse_args(argv)
         return args.func(args)
@@ -347,6 +353,7 @@ def run_program_cli(program, argv=None) -> int:
     """``python compiled.py [-o DIR] ...``: render a compiled module."""
     parser = argparse.ArgumentParser(prog=os.path.basename(sys.argv[0]), description=f"Render {program.name}.")
     _add_render_options(parser)
+
     def go():
         args = parser.parse_args(argv)
         stem = os.path.splitext(os.path.basename(program.name))[0]

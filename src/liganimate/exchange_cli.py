@@ -39,8 +39,9 @@ def _lig_name(text: str) -> str:
     from liganimate.compiler.names import definable
 
     if not definable(text):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a LIG name a library can define "
-                                         "(a letter, then letters, digits and _; not a keyword)")
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a LIG name a library can define (a letter, then letters, digits and _; not a keyword)"
+        )
     return text.upper()
 
 
@@ -48,26 +49,47 @@ def add_commands(subparsers) -> None:
     """Add ``export`` and ``import`` to the ``liganimate`` command's subparsers."""
     from liganimate.cli import _size
 
-    p = subparsers.add_parser("export", help="write a program's scenes as glTF 2.0 (.glb, .gltf) or BVH (.bvh)",
-                              description="Write every model the program's scenes draw, with their motion, "
-                                          "to glTF 2.0 or BVH (see docs/exchange.md).")
+    p = subparsers.add_parser(
+        "export",
+        help="write a program's scenes as glTF 2.0 (.glb, .gltf) or BVH (.bvh)",
+        description="Write every model the program's scenes draw, with their motion, "
+        "to glTF 2.0 or BVH (see docs/exchange.md).",
+    )
     p.add_argument("file")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.glb|OUT.gltf|OUT.bvh",
-                   help="the file to write; its extension chooses the format")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="OUT.glb|OUT.gltf|OUT.bvh",
+        help="the file to write; its extension chooses the format",
+    )
     p.add_argument("--fps", type=_fps, default=24.0, help="ticks per second of the time axis (default 24)")
-    p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH",
-                   help="image size whose aspect ratio the glTF cameras take (default 640x480)")
+    p.add_argument(
+        "--size",
+        type=_size,
+        default=(640, 480),
+        metavar="WxH",
+        help="image size whose aspect ratio the glTF cameras take (default 640x480)",
+    )
     p.add_argument("--quiet", action="store_true", help="do not list the files written")
     p.set_defaults(func=cmd_export)
-    p = subparsers.add_parser("import", help="turn a BVH capture into a LIG library (a MODEL and a MOTION)",
-                              description="Write a library file that LOAD takes, with the capture's skeleton as "
-                                          "a MODEL and its frames as a MOTION (see docs/exchange.md).")
+    p = subparsers.add_parser(
+        "import",
+        help="turn a BVH capture into a LIG library (a MODEL and a MOTION)",
+        description="Write a library file that LOAD takes, with the capture's skeleton as "
+        "a MODEL and its frames as a MOTION (see docs/exchange.md).",
+    )
     p.add_argument("file", metavar="FILE.bvh")
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
     p.add_argument("--model", type=_lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
     p.add_argument("--motion", type=_lig_name, help="the MOTION's name (default: <STEM>)")
-    p.add_argument("--tolerance", type=_degrees, default=0.0, metavar="DEG",
-                   help="drop keyframes while every angle stays within DEG degrees (default 0: every frame)")
+    p.add_argument(
+        "--tolerance",
+        type=_degrees,
+        default=0.0,
+        metavar="DEG",
+        help="drop keyframes while every angle stays within DEG degrees (default 0: every frame)",
+    )
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_import)
 
@@ -82,16 +104,20 @@ def cmd_export(args) -> int:
 
         kind = _EXPORT_KINDS.get(os.path.splitext(args.output)[1].lower())
         if kind is None:
-            raise LigError(f"cannot tell the format of {args.output} from its extension.",
-                           "write to a file ending in .glb, .gltf or .bvh")
+            raise LigError(
+                f"cannot tell the format of {args.output} from its extension.",
+                "write to a file ending in .glb, .gltf or .bvh",
+            )
         program, warnings = load_program(args.file)
         _print_diagnostics(warnings)
         run_warnings: list = []
         scenes = X.collect(program, run_warnings)
         _print_diagnostics(run_warnings)
         if not scenes:
-            raise LigError("the program shoots no scene, so there is nothing to export.",
-                           "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES")
+            raise LigError(
+                "the program shoots no scene, so there is nothing to export.",
+                "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES",
+            )
         if kind == "bvh":
             files = X.bvh_files(scenes, args.output, args.fps)
         else:
@@ -124,17 +150,21 @@ def cmd_import(args) -> int:
         if model == motion:
             from liganimate.runtime.errors import LigError
 
-            raise LigError(f"the model and the motion cannot both be called {model}.",
-                           "give them different names with --model and --motion")
+            raise LigError(
+                f"the model and the motion cannot both be called {model}.",
+                "give them different names with --model and --motion",
+            )
         out = args.output or f"{stem}.lig"
         clip = X.read_bvh(args.file)
-        text = X.lig_library(clip, model=model, motion=motion, source_name=os.path.basename(args.file),
-                             tolerance=args.tolerance)
+        text = X.lig_library(
+            clip, model=model, motion=motion, source_name=os.path.basename(args.file), tolerance=args.tolerance
+        )
         X.write_files([(out, text)])
         if not args.quiet:
-            sys.stderr.write(f"wrote {out}: MODEL {model} and MOTION {motion} "
-                             f"({len(clip.names)} joints, {clip.data.shape[0]} frames)\n")
+            sys.stderr.write(
+                f"wrote {out}: MODEL {model} and MOTION {motion} "
+                f"({len(clip.names)} joints, {clip.data.shape[0]} frames)\n"
+            )
         return 0
 
     return _guarded(go)
-

@@ -17,8 +17,9 @@ def _lig_name(text: str) -> str:
     from liganimate.runtime.studio import lig_name
 
     if not lig_name(text):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a LIG name a library can define "
-                                         "(a letter, then letters, digits and _; not a keyword)")
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a LIG name a library can define (a letter, then letters, digits and _; not a keyword)"
+        )
     return text.upper()
 
 
@@ -54,22 +55,33 @@ def _frames(text: str) -> int:
 
 def add_commands(subparsers) -> None:
     """Add ``view`` and ``studio`` to the ``liganimate`` command's subparsers."""
-    p = subparsers.add_parser("view", help="write a program's scenes as one HTML page with a 3D viewer",
-                              description="Run the program once without drawing and write a self-contained "
-                                          "HTML page that shows its scenes in 3D (see docs/viewer.md).")
+    p = subparsers.add_parser(
+        "view",
+        help="write a program's scenes as one HTML page with a 3D viewer",
+        description="Run the program once without drawing and write a self-contained "
+        "HTML page that shows its scenes in 3D (see docs/viewer.md).",
+    )
     p.add_argument("file")
     p.add_argument("-o", "--output", metavar="OUT.html", help="default: <stem>.html in the current folder")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_view)
-    p = subparsers.add_parser("studio", help="pose a model by eye with the posing thesis' Generator, in the browser",
-                              description="Start a local server (127.0.0.1 only) with the Generator of the thesis on "
-                                          "posing figures with interactive genetic algorithms (see docs/viewer.md).")
+    p = subparsers.add_parser(
+        "studio",
+        help="pose a model by eye with the posing thesis' Generator, in the browser",
+        description="Start a local server (127.0.0.1 only) with the Generator of the thesis on "
+        "posing figures with interactive genetic algorithms (see docs/viewer.md).",
+    )
     p.add_argument("file", nargs="?", help="a program whose model to pose (default: the standard library)")
     p.add_argument("--model", type=_lig_name, help="the MODEL to pose (default HUMANOID, or the file's only model)")
     p.add_argument("--save", metavar="LIB.lig", help="the library Save writes (default: <model>_poses.lig)")
     p.add_argument("--motion", type=_lig_name, default="POSES", help="the saved MOTION's name (default POSES)")
-    p.add_argument("--frames", type=_frames, default=24, metavar="N",
-                   help="frames between kept poses in the saved motion (default 24)")
+    p.add_argument(
+        "--frames",
+        type=_frames,
+        default=24,
+        metavar="N",
+        help="frames between kept poses in the saved motion (default 24)",
+    )
     p.add_argument("--seed", type=_seed, help="the Generator's seed (default: a random one, shown)")
     p.add_argument("--port", type=_port, default=0, help="the port (default: a free one, printed)")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser; just print the address")
@@ -93,8 +105,10 @@ def cmd_view(args) -> int:
         scenes = X.collect(program, run_warnings)
         _print_diagnostics(run_warnings)
         if not scenes:
-            raise LigError("the program shoots no scene, so there is nothing to view.",
-                           "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES")
+            raise LigError(
+                "the program shoots no scene, so there is nothing to view.",
+                "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES",
+            )
         page = viewer_html(scenes, os.path.basename(args.file)).encode("utf-8")
         X.write_files([(out, page)])
         if not args.quiet:
@@ -124,12 +138,14 @@ def cmd_studio(args) -> int:
 
         fig, model, source = studio_model(args.file, args.model)
         if args.motion == model:
-            raise LigError(f"the model and the motion cannot both be called {model}.",
-                           "give the motion another name with --motion")
+            raise LigError(
+                f"the model and the motion cannot both be called {model}.", "give the motion another name with --motion"
+            )
         save = os.path.abspath(args.save or f"{model.lower()}_poses.lig")
         if not save.lower().endswith(".lig"):
-            raise LigError(f"{args.save} does not end in .lig, so LOAD would not take it.",
-                           "name the library file something.lig")
+            raise LigError(
+                f"{args.save} does not end in .lig, so LOAD would not take it.", "name the library file something.lig"
+            )
         if not os.path.isdir(os.path.dirname(save)):
             raise LigError(f"there is no folder {os.path.dirname(save)} to save {os.path.basename(save)} in.")
         seed = args.seed if args.seed is not None else secrets.randbelow(2**32)
@@ -147,4 +163,3 @@ def cmd_studio(args) -> int:
         return 0
 
     return _guarded(go)
-

@@ -1,0 +1,258 @@
+"""glTF export, checked by Khronos's glTF-Validator and by an independent reader against --poses."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from exchange_support import (
+    load_gltf,
+    pose_records,
+    sample_channels,
+    segment_nodes,
+    validate,
+    world_transforms,
+)
+from paths import ROOT_DIR
+
+from liganimate.cli import load_program
+from liganimate.runtime import exchange as X
+
+ROOT = ROOT_DIR
+FPS = 24.0
+
+# Two scenes: a figure scaled unevenly, turned and moved every tick, with a
+# clamped joint and a free axis; a mirrored copy re-rooted at its forearm
+# that is drawn only from tick 3 to 8; a camera that follows; a second scene
+# with SAMEFRAME 2 (STEP sampling).
+EDGES = """\
+      GRAPHICAL A, B, C, FLOOR
+      MODEL ARM, MIRROR
+      MOTION SWING
+      VECTOR P
+      A :- BOX WIDTH 0.2, HEIGHT 1.0, DEPTH 0.2, LIGHTNESS 30.0
+      B :- BOX WIDTH 0.15, HEIGHT 0.8, DEPTH 0.15, LIGHTNESS 60.0
+      C :- BOX WIDTH 0.3, HEIGHT 0.1, DEPTH 0.3
+      ARM :- JOINT 1, A, (0.0, 0.5, 0.0), B, (0.0, -0.4, 0.0), (-90.0, 90.0), (-180.0, 180.0), (-120.0, 120.0)
+      ARM :- JOINT 2, ARM, (0.0, -0.5, 0.0), C, (0.0, 0.05, 0.0), (-30.0, 30.0), (-30.0, 30.0), (-30.0, 30.0)
+      MIRROR :- ARM <SCALE MODEL -0.5>
+      FIGURE MIRROR MAIN JOINT 1
+      STARTMOTION SWING
+        JOINT 1 POSITION 10.0, 20.0, 30.0
+          FRAME 10 POSITION -50.0, 170.0, 100.0 INTERPOLATE ACCDCC
+        JOINT 2 POSITION 0.0, 0.0, 0.0
+          FRAME 10 POSITION 40.0, -40.0, 20.0
+      ENDMOTION
+      FLOOR :- BOX AT (0.0, -1.0, 0.0), WIDTH 4.0, HEIGHT 0.1, DEPTH 4.0
+      INITIALIZE SCENE 1
+        P = (0.0, 0.0, 0.0)
+        BACKGROUND FLOOR
+      STARTSCENE LENGTH 12
+        ANIMATE ARM FROM 0 TO 11 USING SWING
+        ARM :- ARM <SCALE (1.0, 2.0, 1.0)> <ROT Y 30.0> <TRANS (P)>
+        ANIMATE MIRROR FROM 3 TO 8 USING SWING
+        MIRROR :- MIRROR <ROT Z 20.0> <TRANS (1.0, 0.0, 0.0)>
+        P = P + (0.1, 0.05, 0.0)
+        VIEW POINT = (1.0, 2.0, 6.0) + P
+      ENDSCENE
+      INITIALIZE SCENE 2
+      STARTSCENE LENGTH 4 SAMEFRAME 2
+        ANIMATE ARM FROM 0 TO 3 USING SWING <SCALE FRAMES 0.5>
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+WALKING_HUMANOID = """\
+      LOAD HUMANOID, WALK FROM 'humanoid'
+      VECTOR P
+      INITIALIZE SCENE 1
+        VIEW POINT = (0.0, 1.0, 5.0)
+        P = (-1.0, 0.972, 0.0)
+      STARTSCENE LENGTH 30
+        ANIMATE HUMANOID FROM 0 TO 29 USING WALK REPEAT
+        HUMANOID :- HUMANOID <TRANS (P)>
+        P = P + (0.05, 0.0, 0.0)
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+
+def _program(tmp_path, name):
+    if name == "edges":
+        path = tmp_path / "edges.lig"
+        path.write_text(EDGES)
+    elif name == "walking_humanoid":
+        path = tmp_path / "walk.lig"
+        path.write_text(WALKING_HUMANOID)
+    else:
+        path = os.path.join(ROOT, "examples", name + ".lig")
+    program, _ = load_program(str(path))
+    return program
+
+
+PROGRAMS = ["edges", "walking_humanoid", "appendix_a", "rerooting", "big_and_small_robot", "there_and_back"]
+
+
+def _export(program, path):
+    scenes = X.collect(program)
+    data, warnings = X.gltf_bytes(scenes, path.endswith(".glb"), fps=FPS)
+    with open(path, "wb") as fh:
+        fh.write(data)
+    return scenes, warnings
+
+
+@pytest.mark.parametrize("name", PROGRAMS)
+def test_validator_reports_no_errors(tmp_path, name):
+    program = _program(tmp_path, name)
+    paths = [str(tmp_path / f"{name}.glb"), str(tmp_path / f"{name}.gltf")]
+    for p in paths:
+        _export(program, p)
+    reports = validate(paths)
+    for p in paths:
+        issues = reports[p]
+        errors = [m for m in issues["messages"] if m["severity"] == 0]
+        assert issues["numErrors"] == 0, errors[:5]
+        assert issues["numWarnings"] == 0, issues["messages"][:5]
+
+
+def test_validator_catches_a_broken_file(tmp_path):
+    """The check can fail: the same export with a POSITION accessor's bounds spoiled is reported."""
+    program = _program(tmp_path, "appendix_a")
+    doc, blob, _ = X.gltf_document(X.collect(program))
+    acc = doc.meshes[0].primitives[0].attributes.POSITION
+    doc.accessors[acc].max = [v - 1.0 for v in doc.accessors[acc].max]
+    doc.set_binary_blob(blob)
+    path = str(tmp_path / "broken.glb")
+    with open(path, "wb") as fh:
+        fh.write(b"".join(doc.save_to_bytes()))
+    assert validate([path])[path]["numErrors"] > 0
+
+
+@pytest.mark.parametrize("name", PROGRAMS)
+@pytest.mark.parametrize("ext", [".glb", ".gltf"])
+def test_node_world_transforms_equal_the_pose_record(tmp_path, name, ext):
+    program = _program(tmp_path, name)
+    path = str(tmp_path / f"out{ext}")
+    _export(program, path)
+    doc, blob = load_gltf(path)
+    records = pose_records(program, tmp_path)
+    assert records
+    scene_index = {s.name: i for i, s in enumerate(doc.scenes)}
+    animations = {a.name: a for a in doc.animations}
+    segments = segment_nodes(doc)
+    checked = 0
+    cache: dict = {}
+    for rec in records:
+        key = (rec["scene"], rec["tick"])
+        if key not in cache:
+            anim = animations.get(f"scene {rec['scene']}")
+            override = sample_channels(doc, blob, anim, rec["tick"] / FPS) if anim is not None else {}
+            cache[key] = world_transforms(doc, scene_index[f"scene {rec['scene']}"], override)
+        worlds = cache[key]
+        for i, seg in enumerate(rec["segments"]):
+            node = segments[(rec["scene"], rec["model"], i)]
+            expected = np.array(seg["matrix"]).reshape(4, 4)
+            np.testing.assert_allclose(
+                worlds[node],
+                expected,
+                rtol=0,
+                atol=1e-5,
+                err_msg=f"scene {rec['scene']} tick {rec['tick']} {rec['model']} segment {i}",
+            )
+            checked += 1
+    assert checked == sum(len(r["segments"]) for r in records)
+
+
+def test_sampling_is_linear_but_steps_at_sameframe_holds(tmp_path):
+    doc, _ = _export_and_load(tmp_path, "edges")
+    by_name = {a.name: a for a in doc.animations}
+    assert {s.interpolation for s in by_name["scene 1"].samplers if s.interpolation != "STEP"} == {"LINEAR"}
+    assert {s.interpolation for s in by_name["scene 2"].samplers} == {"STEP"}
+
+
+def _export_and_load(tmp_path, name, ext=".glb"):
+    program = _program(tmp_path, name)
+    path = str(tmp_path / f"x{ext}")
+    _export(program, path)
+    return load_gltf(path)
+
+
+def test_a_model_not_drawn_at_a_tick_is_shrunk_to_nothing_there(tmp_path):
+    doc, blob = _export_and_load(tmp_path, "edges")
+    anim = next(a for a in doc.animations if a.name == "scene 1")
+    mirror = next(n for n, node in enumerate(doc.nodes) if node.name == "MIRROR")
+    for tick, shown in [(0, False), (2, False), (3, True), (8, True), (9, False), (11, False)]:
+        scale = sample_channels(doc, blob, anim, tick / FPS)[mirror]["scale"]
+        assert (np.abs(scale) > 0).all() == shown, (tick, scale)
+
+
+def test_the_camera_is_the_view(tmp_path):
+    doc, blob = _export_and_load(tmp_path, "edges")
+    anim = next(a for a in doc.animations if a.name == "scene 1")
+    cam_node = next(
+        n for n, node in enumerate(doc.nodes) if node.camera is not None and node.name.startswith("scene 1")
+    )
+    cam = doc.cameras[doc.nodes[cam_node].camera].perspective
+    for tick in (0, 5, 11):
+        worlds = world_transforms(doc, 0, sample_channels(doc, blob, anim, tick / FPS))
+        M = worlds[cam_node]
+        point = np.array([1.0, 2.0, 6.0]) + 0.1 * (tick + 1) * np.array([1.0, 0.5, 0.0])
+        np.testing.assert_allclose(M[:3, 3], point, atol=1e-5)
+        looking = -M[:3, 2]  # a glTF camera looks down its -Z
+        np.testing.assert_allclose(looking, -point / np.linalg.norm(point), atol=1e-6)
+        assert M[1, 1] > 0  # +Y up
+    # VIEW WIDTH 10 (the default) across a 4:3 image, at the eye's distance at tick 0.
+    d = np.linalg.norm([1.1, 2.05, 6.0])
+    assert cam.yfov == pytest.approx(2 * np.arctan(10.0 * 0.75 / 2 / d))
+    assert cam.aspectRatio == pytest.approx(4 / 3)
+
+
+def test_segments_carry_meshes_with_lightness_materials(tmp_path):
+    doc, _ = _export_and_load(tmp_path, "edges")
+    greys = set()
+    for mesh in doc.meshes:
+        for prim in mesh.primitives:
+            greys.add(doc.materials[prim.material].name.split()[1])
+    # LIGHTNESS 30, 60 and 40 (default), and 1.5 times each for a BOX's side faces.
+    assert {"77", "153", "102", "115", "229"} <= greys  # 90 * 2.55 rounds to 229
+    factors = {m.name: m.pbrMetallicRoughness.baseColorFactor[0] for m in doc.materials}
+    assert factors["grey 77"] < factors["grey 153"]
+
+
+def test_a_sheared_placement_is_refused_and_nothing_written(tmp_path):
+    text = EDGES.replace("<SCALE (1.0, 2.0, 1.0)> <ROT Y 30.0>", "<ROT Z 30.0> <SCALE (1.0, 2.0, 1.0)>")
+    src = tmp_path / "shear.lig"
+    src.write_text(text)
+    out = tmp_path / "shear.glb"
+    r = subprocess.run(
+        [sys.executable, "-m", "liganimate", "export", str(src), "-o", str(out)],
+        check=False,
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 1
+    assert "shear" in r.stderr and "Traceback" not in r.stderr
+    assert not out.exists()
+    assert os.listdir(tmp_path) == ["shear.lig"]
+
+
+def test_cli_export_writes_a_valid_glb(tmp_path):
+    src = tmp_path / "walk.lig"
+    src.write_text(WALKING_HUMANOID)
+    out = tmp_path / "film.glb"
+    r = subprocess.run(
+        [sys.executable, "-m", "liganimate", "export", str(src), "-o", str(out), "--fps", "30"],
+        check=False,
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 0, r.stderr
+    doc, blob = load_gltf(str(out))
+    times = [sampler.input for a in doc.animations for sampler in a.samplers]
+    from exchange_support import accessor
+
+    assert accessor(doc, blob, times[0])[-1, 0] == pytest.approx(29 / 30)
+    assert validate([str(out)])[str(out)]["numErrors"] == 0

@@ -1,0 +1,157 @@
+"""The studio in headless Chromium: nine candidates, a click takes a limb, Keep pose and Save write a library `liganimate run` accepts."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from browser import Browser, require_chromium
+
+from liganimate.runtime.studio import (
+    Session,
+    StudioServer,
+    start_in_thread,
+    studio_model,
+    studio_page,
+)
+
+
+@pytest.fixture(scope="module")
+def studio(tmp_path_factory):
+    require_chromium()
+    fig, model, _ = studio_model(None, None)
+    save = tmp_path_factory.mktemp("studio") / "posed.lig"
+    session = Session(fig, model, "POSES", str(save), seed=2024)
+    server = StudioServer(session, studio_page(session.generator, model))
+    start_in_thread(server)
+    with Browser(1300, 950, log_network=True) as b:
+        b.driver.get(server.url)
+        _settle(b)
+        yield b, server, session, save
+    server.shutdown()
+    server.server_close()
+
+
+def _settle(b, timeout=30):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        if b.driver.execute_script("return !!(window.ligStudio && ligStudio.state() && !ligStudio.busy())"):
+            return b.driver.execute_script("return ligStudio.state()")
+        time.sleep(0.05)
+    pytest.fail("the studio page did not settle: " + b.driver.find_element("id", "status").text)
+
+
+def _click_limb(b, view: int, link: int) -> None:
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    point = b.driver.execute_script(f"return ligStudio.linkPoint({view}, {link})")
+    assert point is not None, f"link {link} is not visible in view {view}"
+    canvas = b.driver.find_element("id", "current" if view == 0 else f"cand{view - 1}")
+    ActionChains(b.driver).move_to_element_with_offset(canvas, round(point[0]), round(point[1])).click().perform()
+
+
+def test_the_page_shows_nine_candidates(studio):
+    b = studio[0]
+    images = [b.canvas(f"#cand{i}") for i in range(9)]
+    assert len(b.driver.find_elements("css selector", "#grid canvas")) == 9
+    for img in images:
+        assert (img < 250).sum() > 300  # a figure is drawn in each
+    # ...and they are nine different poses.
+    for i in range(9):
+        for j in range(i + 1, 9):
+            assert (images[i] != images[j]).sum() > 100, (i, j)
+    assert b.driver.find_element("id", "generation").text == "generation 1"
+    assert b.driver.find_element("id", "seed").get_attribute("value") == "2024"
+
+
+def test_a_click_takes_a_limb_then_keep_and_save(studio, tmp_path):
+    b, _, session, save = studio
+    g = session.generator
+    thigh = g.figure.links_named("R_THIGH")[0]
+    joint = g.joint_of_link(thigh)
+    before = g.current.copy()
+    _click_limb(b, 4, thigh)  # candidate 4
+    state = _settle(b)
+    assert "took R_THIGH (joint 31) from candidate 4" in b.driver.find_element("id", "status").text
+    assert np.array_equal(g.current[joint], g.candidates[3, joint])
+    assert not np.array_equal(g.current[joint], before[joint])
+    assert np.allclose(state["angles"][0][joint], g.candidates[3, joint], atol=1e-4)
+    current = b.canvas("#current")
+    b.driver.find_element("id", "keep").click()
+    _settle(b)
+    b.driver.find_element("id", "next").click()
+    _settle(b)
+    assert b.driver.find_element("id", "generation").text == "generation 2"
+    arm = g.figure.links_named("L_UPPERARM")[0]
+    _click_limb(b, 7, arm)
+    _settle(b)
+    assert (b.canvas("#current") != current).sum() > 50
+    b.driver.find_element("id", "keep").click()
+    _settle(b)
+    b.driver.find_element("id", "save").click()
+    state = _settle(b)
+    assert state["saved"] and state["kept"] == 2
+    assert "saved 2 pose(s)" in b.driver.find_element("id", "status").text
+    assert save.is_file()
+    r = subprocess.run(
+        [sys.executable, "-m", "liganimate", "run", str(save), "-o", str(tmp_path / "f"), "--quiet"],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    play = tmp_path / "play.lig"
+    play.write_text(
+        f"      LOAD HUMANOID, POSES FROM '{save}'\n      INITIALIZE SCENE 1\n"
+        "      STARTSCENE LENGTH 25\n        ANIMATE HUMANOID FROM 0 TO 24 USING POSES\n"
+        "      ENDSCENE\n      SHOOTSCENES\n",
+        encoding="utf-8",
+    )
+    r = subprocess.run(
+        [sys.executable, "-m", "liganimate", "run", str(play), "-o", str(tmp_path / "g"), "--quiet"],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+
+
+def test_undo_seed_and_twist_from_the_page(studio):
+    b, _, session, _ = studio
+    g = session.generator
+    gen = g.generation
+    b.driver.find_element("css selector", "input[name=mode][value=twist]").click()
+    _settle(b)
+    assert g.mode == "twist"
+    b.driver.find_element("id", "next").click()
+    _settle(b)
+    assert g.generation == gen + 1
+    b.driver.find_element("id", "undo").click()
+    _settle(b)
+    assert g.generation == gen
+    seed = b.driver.find_element("id", "seed")
+    seed.clear()
+    seed.send_keys("31337")
+    b.driver.find_element("id", "setSeed").click()
+    _settle(b)
+    assert g.seed == 31337 and g.generation == 1
+    assert b.driver.find_element("id", "generation").text == "generation 1"
+    # A limb clicked in the current pose is frozen (tinted) and no longer mutates.
+    spine = g.figure.links_named("SPINE")[0]
+    plain = b.canvas("#current")
+    _click_limb(b, 0, spine)
+    _settle(b)
+    assert g.frozen[g.joint_of_link(spine)]
+    assert (b.canvas("#current") != plain).sum() > 50
+
+
+def test_the_page_talks_only_to_its_server(studio):
+    b, server, _, _ = studio
+    requests = [url for url, _ in b.requests() if not url.startswith(("chrome:", "data:", "about:"))]
+    assert requests
+    assert all(url.startswith(server.url) for url in requests), requests

@@ -1,0 +1,130 @@
+"""The studio's Save: a library LOAD takes, that `liganimate run` accepts, replaying the kept poses exactly."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from liganimate.cli import load_program
+from liganimate.lang.diagnostics import LigDiagnostics
+from liganimate.runtime import exchange as X
+from liganimate.runtime.figure.pose import mesh_table, world_transforms, world_triangles
+from liganimate.runtime.studio import (
+    Generator,
+    library_text,
+    studio_model,
+    widened_extremes,
+    write_library,
+)
+
+
+@pytest.fixture(scope="module")
+def humanoid():
+    return studio_model(None, None)[0]
+
+
+@pytest.fixture(scope="module")
+def human():
+    return studio_model(None, "HUMAN")[0]
+
+
+def _posed(fig, seed=31):
+    g = Generator(fig, seed=seed, intensity=0.9)
+    g.take(0, 1)
+    g.take(4, fig.n_joints - 1)
+    g.keep()
+    for k in range(3):
+        g.next_generation()
+        for j in range(0, fig.n_joints, 2):
+            g.take((k + j) % 9, j)
+        if k == 1:
+            g.set_mode("twist")
+        g.keep()
+    return g
+
+
+def _play(tmp_path, lib, model, motion, frames):
+    prog = tmp_path / "play.lig"
+    prog.write_text(
+        f"      LOAD {model}, {motion} FROM '{lib.name}'\n"
+        "      INITIALIZE SCENE 1\n"
+        "        VIEW POINT = (0.0, 1.0, 8.0)\n"
+        "        VIEW WIDTH = 4.0\n"
+        f"      STARTSCENE LENGTH {frames}\n"
+        f"        ANIMATE {model} FROM 0 TO {frames - 1} USING {motion}\n"
+        "      ENDSCENE\n"
+        "      SHOOTSCENES\n",
+        encoding="utf-8",
+    )
+    program, _ = load_program(str(prog))
+    return prog, X.collect(program)[0].models[0]
+
+
+@pytest.mark.parametrize("which", ["humanoid", "human"])
+def test_saved_library_replays_the_kept_poses_exactly(tmp_path, request, which):
+    fig = request.getfixturevalue(which)
+    g = _posed(fig)
+    kept = np.array(g.kept)
+    assert not ((kept >= np.asarray(fig.extremes)[..., 0]) & (kept <= np.asarray(fig.extremes)[..., 1])).all(), (
+        "the run should have gone beyond an extreme, so that widening is exercised"
+    )
+    lib = tmp_path / "posed.lig"
+    write_library(str(lib), library_text(fig, "POSED", "POSES", g.kept, spacing=10))
+    _, take = _play(tmp_path, lib, "POSED", "POSES", 10 * (len(kept) - 1) + 1)
+    at = np.arange(len(kept)) * 10
+    # The angles drawn at the keyframes are the kept ones, to the bit.
+    assert np.array_equal(take.angles[at], kept)
+    # And so is the figure: the same triangles in the world (the library bakes SCALE MODEL into them).
+    mine = world_triangles(mesh_table(fig), g.transforms(kept))
+    theirs = world_triangles(
+        mesh_table(take.figure), world_transforms(take.figure, take.angles[at], take.placements[at])
+    )
+    assert mine.shape == theirs.shape
+    assert np.allclose(mine, theirs, atol=1e-7)
+    # Extremes: widened exactly to what the poses need, locked axes still locked.
+    ext = np.asarray(take.figure.extremes)
+    assert np.array_equal(ext, widened_extremes(fig, kept))
+    old = np.asarray(fig.extremes)
+    locked = old[..., 0] == old[..., 1]
+    assert np.array_equal(ext[locked], old[locked])
+
+
+def test_liganimate_run_accepts_the_library_and_plays_it(tmp_path, humanoid):
+    g = _posed(humanoid, seed=5)
+    lib = tmp_path / "poses.lig"
+    write_library(str(lib), library_text(humanoid, "HUMANOID", "POSES", g.kept))
+    env = dict(os.environ)
+    cmd = [sys.executable, "-m", "liganimate", "run", str(lib), "-o", str(tmp_path / "lib_frames"), "--quiet"]
+    r = subprocess.run(cmd, check=False, capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "error" not in r.stderr
+    prog, _ = _play(tmp_path, lib, "HUMANOID", "POSES", 25)
+    cmd = [sys.executable, "-m", "liganimate", "run", str(prog), "-o", str(tmp_path / "frames"), "--quiet"]
+    r = subprocess.run(cmd, check=False, capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert len(os.listdir(tmp_path / "frames" / "scene1")) == 25
+
+
+def test_library_names_segments_uniquely(human):
+    """The Appendix A human has two FOOT, two BARM...: STARTMODEL needs one name per segment."""
+    g = Generator(human, seed=1)
+    g.keep()
+    text = library_text(human, "HUMAN", "POSES", g.kept)
+    assert "FOOT_2" in text and "BARM_2" in text
+    assert text.count("PRIMITIVE ") < human.n_links  # shared shapes are drawn by one primitive
+
+
+def test_a_library_that_would_not_compile_is_not_written(tmp_path, humanoid):
+    lib = tmp_path / "poses.lig"
+    lib.write_text("C the old library\n", encoding="utf-8")
+    g = Generator(humanoid, seed=2)
+    g.keep()
+    text = library_text(humanoid, "HUMANOID", "POSES", g.kept).replace("ENDMODEL", "ENDMODLE")
+    with pytest.raises(LigDiagnostics):
+        write_library(str(lib), text)
+    assert lib.read_text(encoding="utf-8") == "C the old library\n"
+    assert os.listdir(tmp_path) == ["poses.lig"]  # no temporary file left behind
