@@ -16,8 +16,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from liganimate.lang import ast as A
-from liganimate.lang import numbers
+from liganimate.lang import messages, numbers
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+from liganimate.lang.vocabulary import DRAW_WITH, MODIFIERS
 from liganimate.runtime.motion import interpolation
 
 from . import types as T
@@ -581,10 +582,7 @@ class Checker:
                 self._keyframe(k)
                 c = _const(k.frame)
                 if c is not None and last is not None and c < last:
-                    self.err(
-                        k.frame,
-                        f"keyframes must be in ascending frame order: frame {_fmt(c)} comes after frame {_fmt(last)}",
-                    )
+                    self.err(k.frame, messages.keyframes_out_of_order(c, last))
                 last = c if c is not None else last
         if self.scene is not None:
             self.scene.assigned.add(s.name.name)
@@ -744,8 +742,8 @@ class Checker:
         if self.primitive is None:
             self.err(s, "DRAW belongs in a PRIMITIVE")
         for m in s.modifiers:
-            if m.kind != "lightness":
-                self.err(m, "DRAW WITH takes <LIGHTNESS l>")
+            if m.kind != DRAW_WITH.kind:
+                self.err(m, f"DRAW WITH takes <{DRAW_WITH.label} l>")
             self._want_number(m.arg, "a lightness")
 
     def _s_DrawPoly(self, s, context):
@@ -907,7 +905,7 @@ class Checker:
             hint = did_you_mean(e.name, T.BUILTINS)
             self.err(e, f"{e.name} is not a function", hint or "the functions are " + ", ".join(sorted(T.BUILTINS)))
             return None
-        params, result = spec
+        params, result = spec.params, spec.result
         if len(params) != len(e.args):
             self.err(e, f"{e.name} takes {len(params)} argument{'s' if len(params) != 1 else ''}, not {len(e.args)}")
             return None
@@ -930,40 +928,18 @@ class Checker:
             for m in e.modifiers:
                 self.expr(m.arg)
             return None
-        allowed = {
-            T.GRAPHICAL: {"trans", "rot", "scale", "lightness"},
-            T.MODEL: {"trans", "rot", "scale", "trans_joints", "scale_model", "scale_extremes"},
-            T.MOTION: {"scale_frames", "scale_extremes"},
-        }.get(t, set())
         for m in e.modifiers:
             at = self.expr(m.arg)
-            label = _MOD_LABEL[m.kind]
-            if m.kind not in allowed:
-                target = {
-                    "trans_joints": "models",
-                    "scale_model": "models",
-                    "scale_frames": "motions",
-                    "scale_extremes": "models and motions",
-                    "lightness": "graphical objects",
-                }.get(m.kind, "graphical objects and models")
-                self.err(m, f"{label} applies to {target}; this is {T.NOUN[t]}")
+            spec = MODIFIERS[m.kind]
+            if t not in spec.targets:
+                self.err(m, f"{spec.label} applies to {spec.targets_noun}; this is {T.NOUN[t]}")
                 continue
             if at is None:
                 continue
-            if m.kind == "trans":
-                if at != T.VECTOR:
-                    self.err(m.arg, f"TRANS needs a vector (x, y, z), not {T.NOUN[at]}")
-            elif m.kind == "trans_joints":
-                if at != T.INTEGER:
-                    self.err(m.arg, f"TRANS JOINTS needs an INTEGER, not {T.NOUN[at]}")
-            elif m.kind == "scale":
-                if at != T.VECTOR and not T.is_numeric(at):
-                    self.err(m.arg, f"SCALE needs a number or a vector, not {T.NOUN[at]}")
-            elif not T.is_numeric(at):
-                self.err(m.arg, f"{label} needs a number, not {T.NOUN[at]}")
-            c = _const(m.arg)
-            if c == 0 and m.kind in ("scale_frames", "scale_model", "scale"):
-                self.err(m.arg, f"{label} 0 would collapse it to nothing")
+            if at not in spec.accepts:
+                self.err(m.arg, f"{spec.label} needs {spec.accepts_noun}, not {T.NOUN[at]}")
+            if spec.nonzero and _const(m.arg) == 0:
+                self.err(m.arg, f"{spec.label} 0 would collapse it to nothing")
         return t
 
     def _e_PrimCall(self, e):
@@ -1028,18 +1004,6 @@ class Checker:
                     f"cannot compare {T.NOUN[lt]} with {T.NOUN[rt]}",
                     "comparisons work on numbers (and = or <> on vectors)",
                 )
-
-
-_MOD_LABEL = {
-    "trans_joints": "TRANS JOINTS",
-    "trans": "TRANS",
-    "rot": "ROT",
-    "scale_model": "SCALE MODEL",
-    "scale_extremes": "SCALE EXTREMES",
-    "scale_frames": "SCALE FRAMES",
-    "scale": "SCALE",
-    "lightness": "LIGHTNESS",
-}
 
 
 def _plain_name(e):

@@ -17,6 +17,7 @@ import re
 from liganimate import __version__
 from liganimate.lang import ast as A
 from liganimate.lang import numbers as N
+from liganimate.lang.vocabulary import MODIFIERS
 
 from . import types as T
 from .check import _SOLVERS, Checked, expr_type
@@ -571,14 +572,12 @@ class Lowerer:
 
     def e_Modified(self, e):
         t = self.type_of(e.target)
-        mods = []
+        code, at = self.expr(e.target), self.at(e)
         for m in e.modifiers:
-            if m.kind == "rot":
-                mods.append(f"('rot', {self.expr(m.arg)}, {m.axis!r})")
-            else:
-                mods.append(f"({m.kind!r}, {self.expr(m.arg)}, None)")
-        fn = {T.GRAPHICAL: "modify_graphical", T.MODEL: "modify_model", T.MOTION: "modify_motion"}[t]
-        return f"rt.{fn}({self.expr(e.target)}, ({''.join(x + ', ' for x in mods)}), {self.at(e)})"
+            spec = MODIFIERS[m.kind]
+            axis = f", {m.axis!r}" if spec.axis else ""
+            code = f"rt.{spec.runtime_name(t)}({code}, {self.expr(m.arg)}{axis}, {at})"
+        return code
 
     def e_PrimCall(self, e):
         _, sig, _ = self.c.primitives[e.name]

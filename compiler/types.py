@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
-INTEGER = "INTEGER"
-REAL = "REAL"
-VECTOR = "VECTOR"
-PAIR = "PAIR"  # a (min, max) pair: only joint extremes use it
-GRAPHICAL = "GRAPHICAL"
-MODEL = "MODEL"
-MOTION = "MOTION"
-BOOL = "BOOL"
+from liganimate.lang.vocabulary import (  # noqa: F401  (the type names are the language's)
+    BOOL,
+    FUNCTIONS,
+    GRAPHICAL,
+    INTEGER,
+    MODEL,
+    MOTION,
+    PAIR,
+    REAL,
+    VECTOR,
+)
 
 DECLARABLE = (INTEGER, REAL, VECTOR, GRAPHICAL, MODEL, MOTION)
 NUMERIC = (INTEGER, REAL)
@@ -44,32 +47,5 @@ def fits(declared: str, value: str) -> bool:
     return declared == REAL and value == INTEGER
 
 
-# name -> (argument types, result type); "N" means INTEGER or REAL.
-# Trigonometry is in degrees, like every angle in the language.
-BUILTINS = {
-    "SIN": (("N",), REAL),
-    "COS": (("N",), REAL),
-    "TAN": (("N",), REAL),
-    "ASIN": (("N",), REAL),
-    "ACOS": (("N",), REAL),
-    "ATAN": (("N",), REAL),
-    "ATAN2": (("N", "N"), REAL),
-    "SQRT": (("N",), REAL),
-    "EXP": (("N",), REAL),
-    "LOG": (("N",), REAL),
-    "ABS": (("N",), None),  # same type as the argument
-    "INT": (("N",), INTEGER),
-    "NINT": (("N",), INTEGER),
-    "REAL": (("N",), REAL),
-    "FLOAT": (("N",), REAL),
-    "MIN": (("N", "N"), None),
-    "MAX": (("N", "N"), None),
-    "MOD": (("N", "N"), None),
-    "DOT": ((VECTOR, VECTOR), REAL),
-    "CROSS": ((VECTOR, VECTOR), VECTOR),
-    "NORM": ((VECTOR,), REAL),
-    "X": ((VECTOR,), REAL),
-    "Y": ((VECTOR,), REAL),
-    "Z": ((VECTOR,), REAL),
-    "LEN": ((MOTION,), REAL),
-}
+#: The built-in functions (lang/vocabulary.py), by name.
+BUILTINS = FUNCTIONS

@@ -25,6 +25,7 @@ from .lexer import LigLexer
 from .source import Source, prepare
 from .structure import group_blocks
 from .transform import ToAst
+from .vocabulary import BLOCKS
 
 #: Primitives every program knows without defining them.
 BUILTIN_PRIMITIVES = frozenset({"BOX"})
@@ -189,33 +190,23 @@ def _describe_token(tok: Token) -> str:
 
 
 _BLOCK_WORDS = re.compile(
-    r"\b(STARTMODEL|ENDMODEL|STARTMOTION|ENDMOTION|STARTREACH|ENDREACH|INITIALIZE|ENDSCENE|PRIMITIVE|BEGIN|END"
-    r"|JOINT|ENDJOINT)\b",
-    re.IGNORECASE,
+    r"\b(" + "|".join(sorted({w for b in BLOCKS for w in (b.opener, b.closer)})) + r")\b", re.IGNORECASE
 )
-_CLOSER = {
-    "STARTMODEL": "ENDMODEL",
-    "STARTMOTION": "ENDMOTION",
-    "STARTREACH": "ENDREACH",
-    "INITIALIZE": "ENDSCENE",
-    "PRIMITIVE": "END",
-    "BEGIN": "END",
-    "JOINT": "ENDJOINT",
-}
+_CLOSER = {b.opener: b.closer for b in BLOCKS}
 # Each closing word, what opens it (as the user would write it), and the opening words.
 _STRAY = {
-    "ENDMOTION": ("STARTMOTION", ("STARTMOTION",)),
-    "ENDMODEL": ("STARTMODEL", ("STARTMODEL",)),
-    "ENDREACH": ("STARTREACH", ("STARTREACH",)),
-    "ENDSCENE": ("INITIALIZE SCENE", ("INITIALIZE",)),
-    "ENDJOINT": ("JOINT", ("JOINT",)),
-    "END": ("BEGIN or PRIMITIVE", ("BEGIN", "PRIMITIVE")),
+    closer: (
+        " or ".join(b.shown for b in BLOCKS if b.closer == closer),
+        tuple(b.opener for b in BLOCKS if b.closer == closer),
+    )
+    for closer in dict.fromkeys(b.closer for b in BLOCKS)
 }
+_SHOWN = {b.opener: b.shown for b in BLOCKS}
 
 
 def _shown(word: str) -> str:
     """An opening word as the user wrote it (a scene opens with INITIALIZE SCENE)."""
-    return "INITIALIZE SCENE" if word == "INITIALIZE" else word
+    return _SHOWN.get(word, word)
 
 
 _BLANKED = re.compile(r"\{[^}]*\}|'[^'\n]*'")
@@ -423,7 +414,7 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
 
 
 # When the file ends inside a block the scan did not see, the closer to suggest.
-_CLOSING_ORDER = ("ENDMOTION", "ENDMODEL", "ENDREACH", "ENDSCENE", "END", "ENDJOINT")
+_CLOSING_ORDER = tuple(_STRAY)
 
 
 def _end_of_file(tok: Token, expected: set, text: str, source: Source) -> Diagnostic:

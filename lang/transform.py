@@ -12,6 +12,7 @@ from lark import Token, Transformer
 from . import ast as A
 from .lexer import Tok
 from .numbers import literal
+from .vocabulary import MODIFIERS
 
 #: What a terminal is in the children: our parser's Tok, or a Token from Lark's own loop.
 TOKENS = (Token, Tok)
@@ -446,30 +447,6 @@ class ToAst(Transformer):
     def modlist(self, children):
         return list(children)
 
-    def mod_trans_joints(self, children):
-        return A.Modifier(span(children), "trans_joints", children[-1])
-
-    def mod_trans(self, children):
-        return A.Modifier(span(children), "trans", children[1])
-
-    def mod_rot(self, children):
-        return A.Modifier(span(children), "rot", children[2], upper_name(children[1].value))
-
-    def mod_scale_model(self, children):
-        return A.Modifier(span(children), "scale_model", children[2])
-
-    def mod_scale_extremes(self, children):
-        return A.Modifier(span(children), "scale_extremes", children[2])
-
-    def mod_scale_frames(self, children):
-        return A.Modifier(span(children), "scale_frames", children[2])
-
-    def mod_scale(self, children):
-        return A.Modifier(span(children), "scale", children[1])
-
-    def mod_lightness(self, children):
-        return A.Modifier(span(children), "lightness", children[1])
-
     # --------------------------------------------------------- conditions
     def cond_or(self, children):
         return A.BoolOp(span(children), "OR", children[0], children[2])
@@ -486,3 +463,18 @@ class ToAst(Transformer):
 
     def cond_group(self, children):
         return children[0]
+
+
+def _modifier_rule(kind: str, axis: bool):
+    """The transformer method of the grammar alternative ``-> mod_<kind>``: its argument is its last child."""
+
+    def rule(self, children):
+        return A.Modifier(span(children), kind, children[-1], upper_name(children[1].value) if axis else None)
+
+    rule.__name__ = "mod_" + kind
+    return rule
+
+
+# One method per modifier of lang/vocabulary.py: a new modifier needs no code here.
+for _spec in MODIFIERS.values():
+    setattr(ToAst, "mod_" + _spec.kind, _modifier_rule(_spec.kind, _spec.axis))

@@ -11,7 +11,6 @@ written unless the whole program is sound; then in *render* mode.
 from __future__ import annotations
 
 import io
-import math
 import re
 import sys
 
@@ -23,6 +22,7 @@ from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 from liganimate.runtime import limits
 from liganimate.runtime.arithmetic import Arithmetic
 from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import pose as P
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.library import Library  # noqa: F401  (generated modules name it _host.Library)
@@ -276,32 +276,73 @@ class Runtime(Arithmetic):
             return self._guard(at, P.posed_graphical, value, None, 0.0)
         return value
 
-    def modify_graphical(self, g: Graphical, mods, at) -> Graphical:
-        for kind, arg, axis in mods:
-            if kind == "lightness":
-                g = g.with_lightness(arg)
-            else:
-                g = self._guard(at, g.transformed, self._host_matrix(kind, arg, axis, at))
-                self._guard(at, limits.check_graphical, g, "the transformed object")
+    # ----------------------------------------------------------- modifiers
+    # One method per modifier of lang/vocabulary.py and type it applies to,
+    # named by Modifier.runtime_name; a compiled <...> list calls them in order.
+    def graphical_trans(self, g: Graphical, v, at) -> Graphical:
+        """``g <TRANS v>``."""
+        return self._transform(g, K.translation(v), at)
+
+    def graphical_rot(self, g: Graphical, degrees, axis, at) -> Graphical:
+        """``g <ROT axis degrees>``."""
+        return self._transform(g, K.rotation(axis, degrees), at)
+
+    def graphical_scale(self, g: Graphical, k, at) -> Graphical:
+        """``g <SCALE k>`` (a number or a vector of factors)."""
+        return self._transform(g, self._scaling(k, at), at)
+
+    def graphical_lightness(self, g: Graphical, lightness, at) -> Graphical:
+        """``g <LIGHTNESS l>``."""
+        return g.with_lightness(lightness)
+
+    def _transform(self, g: Graphical, matrix, at) -> Graphical:
+        g = self._guard(at, g.transformed, matrix)
+        self._guard(at, limits.check_graphical, g, "the transformed object")
         return g
 
-    def _host_matrix(self, kind, arg, axis, at) -> np.ndarray:
-        m = np.eye(4)
-        if kind == "trans":
-            m[:3, 3] = arg
-        elif kind == "rot":
-            c, s = math.cos(math.radians(arg)), math.sin(math.radians(arg))
-            i, j = {"X": (1, 2), "Y": (2, 0), "Z": (0, 1)}[axis]
-            m[i, i] = c
-            m[i, j] = -s
-            m[j, i] = s
-            m[j, j] = c
-        elif kind == "scale":
-            k = np.asarray(arg, dtype=np.float64) * np.ones(3)
-            if np.any(k == 0):
-                self.fail(at, "SCALE by 0 would collapse the object to nothing")
-            m[:3, :3] = np.diag(k)
-        return m
+    def _scaling(self, k, at) -> np.ndarray:
+        if np.any(np.asarray(k, dtype=np.float64) == 0):
+            self.fail(at, "SCALE by 0 would collapse the object to nothing")
+        return K.scaling(k)
+
+    def model_trans(self, m, v, at):
+        """``m <TRANS v>``: the model placed further by ``v``."""
+        return self._refigure(m, at, F.Figure.placed, K.translation(v))
+
+    def model_rot(self, m, degrees, axis, at):
+        """``m <ROT axis degrees>``."""
+        return self._refigure(m, at, F.Figure.placed, K.rotation(axis, degrees))
+
+    def model_scale(self, m, k, at):
+        """``m <SCALE k>``: the whole model, placement and all."""
+        return self._refigure(m, at, F.Figure.placed, self._scaling(k, at))
+
+    def model_trans_joints(self, m, n, at):
+        """``m <TRANS JOINTS n>``: every joint identifier plus ``n``."""
+        return self._refigure(m, at, F.Figure.trans_joints, n)
+
+    def model_scale_model(self, m, k, at):
+        """``m <SCALE MODEL k>``: the segments and locations scaled."""
+        return self._refigure(m, at, F.Figure.scale_model, k)
+
+    def model_scale_extremes(self, m, r, at):
+        """``m <SCALE EXTREMES r>``: every joint's range of motion scaled."""
+        return self._refigure(m, at, F.Figure.scale_extremes, r, checked=False)
+
+    def _refigure(self, m, at, change, arg, checked: bool = True):
+        """``change(figure, arg)`` of a model, or of an ANIMATEd model's figure (it stays in its pose)."""
+        fig = self._guard(at, change, self._model(m, at), arg)
+        if checked:  # extremes change no geometry
+            self._guard(at, limits.check_figure, fig, "the transformed model")
+        return m.with_figure(fig) if isinstance(m, Posed) else fig
+
+    def motion_scale_frames(self, m, r, at) -> M.Motion:
+        """``m <SCALE FRAMES r>``: the motion ``r`` times as long."""
+        return self._guard(at, M.scale_frames, self._motion(m, at), r)
+
+    def motion_scale_extremes(self, m, r, at) -> M.Motion:
+        """``m <SCALE EXTREMES r>``: every angle ``r`` times as large."""
+        return self._guard(at, M.scale_extremes, self._motion(m, at), r)
 
     # -------------------------------------------------------------- models
     def _model(self, m, at, what="a model"):
@@ -343,22 +384,6 @@ class Runtime(Arithmetic):
         for index, sentence in warnings:
             self.warn(specs[index][-1], _sentence(sentence))
         return self._guard(at, limits.check_figure, figure, f"the model {name}")
-
-    def modify_model(self, m, mods, at):
-        posed = m if isinstance(m, Posed) else None
-        fig = self._model(m, at)
-        for kind, arg, axis in mods:
-            if kind == "trans_joints":
-                fig = self._guard(at, fig.trans_joints, arg)
-            elif kind == "scale_model":
-                fig = self._guard(at, fig.scale_model, arg)
-            elif kind == "scale_extremes":
-                fig = self._guard(at, fig.scale_extremes, arg)
-            else:
-                fig = self._guard(at, fig.placed, self._host_matrix(kind, arg, axis, at))
-            if kind != "scale_extremes":
-                self._guard(at, limits.check_figure, fig, "the transformed model")
-        return posed.with_figure(fig) if posed is not None else fig
 
     def figure(self, m, kind, arg, at):
         posed = m if isinstance(m, Posed) else None
@@ -589,15 +614,6 @@ class Runtime(Arithmetic):
 
     def synchronize(self, motions, at):
         return self._guard(at, M.synchronize, *[self._motion(m, at) for m in motions])
-
-    def modify_motion(self, m, mods, at):
-        m = self._motion(m, at)
-        for kind, arg, _ in mods:
-            if kind == "scale_frames":
-                m = self._guard(at, M.scale_frames, m, arg)
-            else:
-                m = self._guard(at, M.scale_extremes, m, arg)
-        return m
 
     # -------------------------------------------------------------- scenes
     def view(self, what, value, at):

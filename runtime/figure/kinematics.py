@@ -18,6 +18,8 @@ walk kept to cross-check it.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from liganimate.runtime.figure.tree import Figure
@@ -323,25 +325,48 @@ def _cos_sin(a: np.ndarray):
 # -- the reference implementation: plain loops, one frame at a time ----------
 
 
-def _rx(deg: float) -> np.ndarray:
-    c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
-    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
+def rotation(axis: str, degrees: float) -> np.ndarray:
+    """The (4, 4) rotation by ``degrees`` about ``axis`` ("X", "Y" or "Z"), right-handed."""
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    i, j = _PLANES[axis]
+    m = np.eye(4)
+    m[i, i] = c
+    m[i, j] = -s
+    m[j, i] = s
+    m[j, j] = c
+    return m
 
 
-def _ry(deg: float) -> np.ndarray:
-    c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
-    return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1.0]])
+_PLANES = {"X": (1, 2), "Y": (2, 0), "Z": (0, 1)}  # the axes each rotation turns, first towards second
 
 
-def _rz(deg: float) -> np.ndarray:
-    c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def _translation(v) -> np.ndarray:
+def translation(v) -> np.ndarray:
+    """The (4, 4) translation by ``v`` (3,)."""
     T = np.eye(4)
     T[:3, 3] = v
     return T
+
+
+def scaling(k) -> np.ndarray:
+    """The (4, 4) scaling by ``k``: a number, or (3,) factors along x, y and z."""
+    m = np.eye(4)
+    m[:3, :3] = np.diag(np.asarray(k, dtype=np.float64) * np.ones(3))
+    return m
+
+
+def _rx(deg: float) -> np.ndarray:
+    return rotation("X", deg)
+
+
+def _ry(deg: float) -> np.ndarray:
+    return rotation("Y", deg)
+
+
+def _rz(deg: float) -> np.ndarray:
+    return rotation("Z", deg)
+
+
+_translation = translation
 
 
 def pose_transforms_reference(figure: Figure, angles) -> np.ndarray:

@@ -1,0 +1,34 @@
+"""Sentences that more than one stage says: each rule worded once.
+
+The checker reports what it can see in the text (literal frames); the
+runtime reports the same rule for computed values. Both call these, so the
+program's author reads one sentence for one rule, whichever stage found it.
+"""
+
+from __future__ import annotations
+
+from .numbers import MIN_FRAME_GAP
+
+
+def _num(x) -> str:
+    return str(x) if isinstance(x, int) else f"{x:g}"
+
+
+def keyframes_out_of_order(frame, previous, where: str | None = None) -> str:
+    """Keyframes must ascend: ``frame`` comes after a keyframe at ``previous``.
+
+    ``where`` names the keyframe when the statement alone does not
+    (``"keyframe 3 of joint 2"``).
+    """
+    lead = f"{where}: " if where else ""
+    return f"{lead}keyframes must be in ascending frame order: frame {_num(frame)} comes after frame {_num(previous)}"
+
+
+def keyframes_too_close(frame, previous, where: str | None = None) -> str:
+    """Two keyframes closer than :data:`~.numbers.MIN_FRAME_GAP` frames apart (and not a step)."""
+    lead = f"{where}: " if where else ""
+    return f"{lead}frame {_num(frame)} is too close after frame {_num(previous)}"
+
+
+#: The hint under :func:`keyframes_too_close`.
+GAP_HINT = f"two keyframes of a joint share a frame (a step) or lie at least {MIN_FRAME_GAP:g} frames apart"
