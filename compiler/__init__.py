@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from liganimate.lang import collector
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 from liganimate.lang.parser import parse_source
 from liganimate.lang.source import Source, load, prepare
@@ -54,13 +55,15 @@ def compile_source(
         Any other error.
     """
     path = path if path is not None else source.filename
-    names, failed = _scan_loads(source, path, stack)
-    try:
-        program = parse_source(source, names)
-    except LigDiagnostics as exc:
-        raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
-    checked = check(program, path=path, stack=stack)
-    python = lower(checked, module_name or source.filename, consume)
+    # The stages build trees and tables, not cycles: see lang/collector.py.
+    with collector.paused():
+        names, failed = _scan_loads(source, path, stack)
+        try:
+            program = parse_source(source, names)
+        except LigDiagnostics as exc:
+            raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
+        checked = check(program, path=path, stack=stack)
+        python = lower(checked, module_name or source.filename, consume)
     return Compiled(python, list(source.warnings) + checked.warnings, checked)
 
 

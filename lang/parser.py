@@ -11,14 +11,13 @@ from __future__ import annotations
 
 import contextvars
 import functools
-import gc
 import re
 
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from . import ast as A
-from . import tables
+from . import collector, tables
 from .diagnostics import Diagnostic, LigDiagnostics
 from .lalr import Driver
 from .lexer import LigLexer
@@ -79,17 +78,12 @@ def parse_source(source: Source, primitives: frozenset | set = frozenset()) -> A
     # The parse makes trees, never cycles: the cyclic collector would walk
     # the growing tree again and again for nothing (on a million-line
     # program, a third of the time).
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
+    with collector.paused():
         try:
             body = _driver().parse(source.lexed, names)
         except UnexpectedInput as exc:
             raise LigDiagnostics([_syntax_diagnostic(exc, source)]) from None
         body = group_blocks(body, source)
-    finally:
-        if collecting:
-            gc.enable()
     prims = [s for s in body if isinstance(s, A.PrimitiveDef)]
     return A.Program(A.Pos(1, 1, 1, 1), source.filename, source.text, body, prims)
 

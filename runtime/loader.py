@@ -10,6 +10,8 @@ instead. The result is the namespace that importing the module would give.
 
 from __future__ import annotations
 
+from liganimate.lang import collector
+
 # Every line the lowerer writes is one physical line (program text reaches the
 # module only through repr(), which never writes a raw line break), so a line
 # that begins with this text is a top-level function of the main program.
@@ -24,10 +26,11 @@ def exec_module(text: str, filename: str, namespace: dict) -> dict:
     (the last piece holds ``_main`` and the module's tail).
     """
     start = 0
-    while True:
-        end = text.find(PIECE_MARK, start + 1)
-        piece = text[start:] if end < 0 else text[start : end + 1]
-        exec(compile(piece, filename, "exec"), namespace)  # noqa: S102 - the module the lowerer wrote
-        if end < 0:
-            return namespace
-        start = end + 1
+    with collector.paused():  # code objects and constants, no cycles (lang/collector.py)
+        while True:
+            end = text.find(PIECE_MARK, start + 1)
+            piece = text[start:] if end < 0 else text[start : end + 1]
+            exec(compile(piece, filename, "exec"), namespace)  # noqa: S102 - the module the lowerer wrote
+            if end < 0:
+                return namespace
+            start = end + 1
