@@ -203,12 +203,12 @@ def polygons_to_graphical(polys) -> Graphical:
             tris.append((pts[0], pts[k], pts[k + 1]))
             light.append(l)
             owner.append(i)
-    tris = np.asarray(tris, dtype=np.float64)
+    corners = np.asarray(tris, dtype=np.float64)
     side = np.asarray(_solid_orientation(polys), dtype=np.int8)[owner]
     flip = side < 0
     if flip.any():
-        tris[flip] = tris[flip][:, ::-1, :]
-    return Graphical(tris, light, side != 0)
+        corners[flip] = corners[flip][:, ::-1, :]
+    return Graphical(corners, light, side != 0)
 
 
 def _solid_orientation(polys) -> list:
