@@ -47,6 +47,9 @@ _INDEX_MASK = (1 << _INDEX_BITS) - 1
 _DEPTH_MASK = ~_INDEX_MASK
 _MAX_TRIANGLES = 1 << 31
 
+#: Largest anti-aliasing factor: aa x aa samples per pixel.
+MAX_AA = 8
+
 # Back-facing triangles have their 1/z scaled down by this fraction (about
 # four units of the key's last depth bit).  For a closed solid seen from
 # outside, every back-face pixel is also covered by a front face of the same
@@ -60,7 +63,7 @@ _BACK_BIAS = 4e-6
 _CHUNK = 1 << 18
 
 
-def rasterize(triangles, shade, camera: Camera, background: int = 255, cull=None) -> np.ndarray:
+def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: int = 1) -> np.ndarray:
     """Draw flat-shaded triangles with a z-buffer into a new image.
 
     Parameters
@@ -68,35 +71,79 @@ def rasterize(triangles, shade, camera: Camera, background: int = 255, cull=None
     triangles : array_like, shape (N, 3, 3)
         World-space vertices, ``triangles[i, k]`` is vertex ``k`` of
         triangle ``i``.
-    shade : array_like, shape (N,)
-        Grey level (0 black .. 255 white) of each triangle.
+    shade : array_like, shape (N,) or (N, 3)
+        Grey level (0 black .. 255 white) of each triangle, or its
+        ``(r, g, b)`` colour (each 0..255).
     camera : Camera
         The view; its ``size`` is the image size.
-    background : int, optional
-        Grey level where no triangle is drawn; default 255 (white).
+    background : int or tuple of 3 int, optional
+        Grey level, or ``(r, g, b)`` colour, where no triangle is drawn;
+        default 255 (white).
     cull : array_like of bool, shape (N,), optional
         True where the triangle is part of a closed solid whose faces are
         wound counter-clockwise seen from outside (outward right-hand
         normals); such triangles are dropped when they face away from the
         eye.  This is only a speed-up: for closed solids seen from outside
         the image is the same with or without it.
+    aa : int, optional
+        Anti-aliasing: each pixel is the rounded mean of ``aa x aa``
+        samples on a regular grid (1, the default, is one sample at the
+        pixel centre).  See :func:`downsample`.
 
     Returns
     -------
-    ndarray, shape (H, W), uint8
-        The image, row 0 at the top.
+    ndarray, shape (H, W) or (H, W, 3), uint8
+        The image, row 0 at the top; (H, W, 3) RGB when ``shade`` or
+        ``background`` is a colour, else (H, W) grey.
 
     Raises
     ------
     RenderError
-        If the arrays have the wrong shape, coordinates are not finite, or a
-        grey level is outside 0..255.
+        If the arrays have the wrong shape, coordinates are not finite, a
+        grey level or colour component is outside 0..255, or ``aa`` is not
+        a whole number from 1 to ``MAX_AA``.
     """
-    W, H = camera.size
-    img = np.full((H, W), _grey(background, "background"), dtype=np.uint8)
+    aa = _aa(aa)
+    tris, shade = _check(triangles, shade, cull)
+    bg = _background(background)
+    shade, bg = _same_kind(shade, bg)
+    cam = camera.supersampled(aa)
+    W, H = cam.size
+    img = np.empty((H, W) + np.shape(bg), dtype=np.uint8)
+    img[...] = bg
     # Nothing drawn yet: the depth buffer need only span the pixels touched.
-    _draw(None, img, triangles, shade, camera, cull, 0)
-    return img
+    _draw(None, img, tris, shade, cam, cull, 0)
+    return downsample(img, aa)
+
+
+def downsample(img, aa: int) -> np.ndarray:
+    """Box-filter an image supersampled ``aa`` times in each direction.
+
+    Each output pixel is the mean of its ``aa x aa`` block, rounded to the
+    nearest integer with halves rounded up, in exact integer arithmetic
+    (so the bytes never depend on floating point).
+
+    Parameters
+    ----------
+    img : ndarray, shape (aa H, aa W) or (aa H, aa W, 3), uint8
+        The supersampled image.
+    aa : int
+        The supersampling factor.
+
+    Returns
+    -------
+    ndarray, shape (H, W) or (H, W, 3), uint8
+        ``img`` itself when ``aa`` is 1.
+    """
+    if aa == 1:
+        return img
+    H, W = img.shape[0] // aa, img.shape[1] // aa
+    blocks = img.reshape((H, aa, W, aa) + img.shape[2:])
+    total = blocks.sum(axis=(1, 3), dtype=np.uint32)
+    n = aa * aa
+    total += n // 2
+    total //= n
+    return total.astype(np.uint8)
 
 
 class Framebuffer:
@@ -104,26 +151,32 @@ class Framebuffer:
 
     Draws share the depth test, so e.g. several ticks drawn into one image
     hide each other correctly; a later draw counts as "later" for the tie
-    rule.
+    rule.  The buffers hold ``aa x aa`` samples per pixel; :attr:`image` is
+    their box-filtered mean.  The image turns RGB at the first draw in
+    colour (grey levels ``g`` are then the colour ``(g, g, g)``).
 
     Parameters
     ----------
     size : tuple of int
         ``(W, H)`` in pixels.
-    background : int, optional
-        Initial grey level; default 255.
+    background : int or tuple of 3 int, optional
+        Initial grey level or ``(r, g, b)`` colour; default 255.
+    aa : int, optional
+        Samples per pixel in each direction (see :func:`rasterize`); default 1.
 
     Attributes
     ----------
-    image : ndarray, shape (H, W), uint8
-        The image so far (updated in place by :meth:`draw`).
-    zbuf : ndarray, shape (H, W), int64
+    samples : ndarray, shape (aa H, aa W) or (aa H, aa W, 3), uint8
+        The supersampled image so far (updated in place by :meth:`draw`).
+    zbuf : ndarray, shape (aa H, aa W), int64
         Depth keys (see :func:`rasterize_into`); ``EMPTY`` where nothing is drawn.
     count : int
         Triangles drawn so far; the next draw's triangles are numbered from here.
+    aa : int
+        The supersampling factor.
     """
 
-    def __init__(self, size, background: int = 255):
+    def __init__(self, size, background=255, aa: int = 1):
         try:
             W, H = (int(s) for s in size)
             ok = W > 0 and H > 0 and (W, H) == tuple(size)
@@ -131,10 +184,22 @@ class Framebuffer:
             ok = False
         if not ok:
             raise RenderError(f"The image size must be two positive whole numbers, not {size!r}.")
+        self.aa = _aa(aa)
         self.size = (W, H)
-        self.image = np.full((H, W), _grey(background, "background"), dtype=np.uint8)
-        self.zbuf = np.zeros((H, W), dtype=np.int64)  # all EMPTY
+        bg = _background(background)
+        self.samples = np.empty((H * self.aa, W * self.aa) + np.shape(bg), dtype=np.uint8)
+        self.samples[...] = bg
+        self.zbuf = np.zeros((H * self.aa, W * self.aa), dtype=np.int64)  # all EMPTY
         self.count = 0
+
+    @property
+    def image(self) -> np.ndarray:
+        """The image so far, shape (H, W) or (H, W, 3), uint8.
+
+        With ``aa`` 1 this is :attr:`samples` itself, updated in place by
+        later draws; otherwise a new downsampled array.
+        """
+        return downsample(self.samples, self.aa)
 
     def draw(self, triangles, shade, camera: Camera, cull=None) -> None:
         """Draw triangles over what is already there, depth-tested.
@@ -143,21 +208,33 @@ class Framebuffer:
         ----------
         triangles : array_like, shape (N, 3, 3)
             World-space vertices.
-        shade : array_like, shape (N,)
-            Grey levels 0..255.
+        shade : array_like, shape (N,) or (N, 3)
+            Grey levels or ``(r, g, b)`` colours, 0..255.
         camera : Camera
             The view; ``camera.size`` must equal the framebuffer's size.
         cull : array_like of bool, shape (N,), optional
             See :func:`rasterize`.
         """
-        self.count = rasterize_into(self.zbuf, self.image, triangles, shade, camera, cull, self.count)
+        tris, shade = _check(triangles, shade, cull)
+        if shade.ndim == 2 and self.samples.ndim == 2:
+            self.samples = np.repeat(self.samples[:, :, None], 3, axis=2)
+        elif shade.ndim == 1 and self.samples.ndim == 3:
+            shade = np.repeat(shade[:, None], 3, axis=1)
+        W, H = camera.size
+        if (W, H) != self.size:
+            raise RenderError(
+                f"The camera's image size {W}x{H} does not match the {self.size[0]}x{self.size[1]} image being drawn into."
+            )
+        self.count = rasterize_into(
+            self.zbuf, self.samples, tris, shade, camera.supersampled(self.aa), cull, self.count
+        )
 
     def depth(self) -> np.ndarray:
-        """The depth of the visible surface at each pixel centre.
+        """The depth of the visible surface at each sample.
 
         Returns
         -------
-        ndarray, shape (H, W), float64
+        ndarray, shape (aa H, aa W), float64
             Camera-space depth to about 1e-6 relative (a back face that won
             reads about 4e-6 too far, see ``_BACK_BIAS``); ``inf`` where
             nothing was drawn.
@@ -179,12 +256,12 @@ def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first
         ``first_index + i``: the larger key is the nearer surface, or at
         equal depth the later triangle.  All draws into one buffer must
         use the same camera.
-    img : ndarray, shape (H, W), uint8, C-contiguous
+    img : ndarray, shape (H, W) or (H, W, 3), uint8, C-contiguous
         The image, updated in place where a triangle wins the depth test.
     triangles : array_like, shape (N, 3, 3)
         World-space vertices.
-    shade : array_like, shape (N,)
-        Grey levels 0..255.
+    shade : array_like, shape (N,) or (N, 3)
+        Grey levels, or colours when ``img`` is RGB, 0..255.
     camera : Camera
         The view; ``camera.size`` must be ``(W, H)``.
     cull : array_like of bool, shape (N,), optional
@@ -199,17 +276,19 @@ def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first
         ``first_index + N``: the number to give the next draw.
     """
     W, H = camera.size
-    if img.shape != (H, W) or zbuf.shape != (H, W):
+    if img.shape[:2] != (H, W) or zbuf.shape != (H, W):
         raise RenderError(
             f"The camera's image size {W}x{H} does not match the {img.shape[1]}x{img.shape[0]} image being drawn into."
         )
     if not (img.flags.c_contiguous and zbuf.flags.c_contiguous and zbuf.dtype == np.int64 and img.dtype == np.uint8):
         raise RenderError("The image and depth buffer must be C-contiguous uint8 and int64 arrays.")
-    return _draw(zbuf, img, triangles, shade, camera, cull, first_index)
-
-
-def _draw(zbuf, img, triangles, shade, camera, cull, first_index):
     tris, shade = _check(triangles, shade, cull)
+    if (shade.ndim == 2) != (img.ndim == 3) or img.ndim not in (2, 3) or img.shape[2:] not in ((), (3,)):
+        raise RenderError("Colours need an RGB image, and grey levels a grey one.")
+    return _draw(zbuf, img, tris, shade, camera, cull, first_index)
+
+
+def _draw(zbuf, img, tris, shade, camera, cull, first_index):
     n = len(tris)
     if first_index + n >= _MAX_TRIANGLES:
         raise RenderError(f"Too many triangles in one image (more than {_MAX_TRIANGLES - 1}).")
@@ -217,7 +296,7 @@ def _draw(zbuf, img, triangles, shade, camera, cull, first_index):
     if spans is None:
         return first_index + n
     offset, wstart, step, tag, count = spans
-    flat_img = img.reshape(-1)
+    flat_img = img.reshape((-1,) + img.shape[2:])
     if zbuf is None:
         # A fresh buffer: allocate depth keys for the touched range only.
         drawn = count > 0
@@ -285,14 +364,45 @@ def _expand(offset, wstart, step, tag, count, ends):
     return pix, key
 
 
-def _grey(value, what: str) -> int:
+def _aa(aa) -> int:
     try:
-        v = int(value)
-    except (TypeError, ValueError):
-        v = -1
-    if v != value or not 0 <= v <= 255:
-        raise RenderError(f"The {what} grey level must be a whole number from 0 to 255, not {value!r}.")
+        v = int(aa)
+    except (TypeError, ValueError, OverflowError):
+        v = 0
+    if isinstance(aa, bool) or v != aa or not 1 <= v <= MAX_AA:
+        raise RenderError(
+            f"Anti-aliasing must be a whole number of samples from 1 to {MAX_AA} per pixel side, not {aa!r}."
+        )
     return v
+
+
+def _background(value):
+    """A grey level (int) or a colour (uint8 array, shape (3,))."""
+    if np.ndim(value) == 0:
+        try:
+            v = int(value)
+        except (TypeError, ValueError, OverflowError):
+            v = -1
+        if isinstance(value, bool) or v != value or not 0 <= v <= 255:
+            raise RenderError(f"The background grey level must be a whole number from 0 to 255, not {value!r}.")
+        return v
+    try:
+        c = np.asarray(value, dtype=np.float64)
+        ok = c.shape == (3,) and bool(np.all(c == np.round(c))) and bool(np.all((c >= 0) & (c <= 255)))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise RenderError(f"The background colour must be three whole numbers from 0 to 255, not {value!r}.")
+    return c.astype(np.uint8)
+
+
+def _same_kind(shade, bg):
+    """Grey shades and background stay grey; if either is a colour, both become colours."""
+    if shade.ndim == 2 and np.ndim(bg) == 0:
+        bg = np.full(3, bg, dtype=np.uint8)
+    elif shade.ndim == 1 and np.ndim(bg) == 1:
+        shade = np.repeat(shade[:, None], 3, axis=1)
+    return shade, bg
 
 
 def _check(triangles, shade, cull):
@@ -302,11 +412,18 @@ def _check(triangles, shade, cull):
     if not np.isfinite(tris).all():
         raise RenderError("A triangle has a coordinate that is not a finite number.")
     s = np.asarray(shade)
-    if s.shape != (len(tris),):
-        raise RenderError(f"Expected {len(tris)} grey levels, one per triangle, got shape {s.shape}.")
+    if s.shape not in ((len(tris),), (len(tris), 3)):
+        raise RenderError(
+            f"Expected {len(tris)} grey levels or {len(tris)} (r, g, b) colours, one per triangle, got shape {s.shape}."
+        )
     if s.dtype != np.uint8:
-        if s.size and (not np.all(np.isfinite(s)) or s.min() < 0 or s.max() > 255 or np.any(s != np.round(s))):
-            raise RenderError("Grey levels must be whole numbers from 0 to 255.")
+        try:
+            bad = s.size and (not np.all(np.isfinite(s)) or s.min() < 0 or s.max() > 255 or np.any(s != np.round(s)))
+        except TypeError:
+            bad = True
+        if bad:
+            what = "Colour components" if s.ndim == 2 else "Grey levels"
+            raise RenderError(f"{what} must be whole numbers from 0 to 255.")
         s = s.astype(np.uint8)
     if cull is not None and np.shape(cull) != (len(tris),):
         raise RenderError(f"Expected {len(tris)} cull flags, one per triangle, got shape {np.shape(cull)}.")
