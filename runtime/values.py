@@ -159,13 +159,13 @@ def grey_levels(lightness) -> np.ndarray:
 def colour_levels(lightness, colour) -> np.ndarray:
     """LIGHTNESS (N,) lighting COLOUR (N, 3), both 0..100 and clipped, to 8-bit RGB levels (N, 3).
 
-    Channel ``c`` is ``LIGHTNESS * c / 100`` on LIGHTNESS's scale, rounded
-    half up; white (100) gives exactly :func:`grey_levels`.
+    Channel ``c`` is the grey level (:func:`grey_levels`) of
+    ``LIGHTNESS * c / 100``, so white (100) gives exactly the grey levels.
     """
     l = np.clip(np.asarray(lightness, dtype=np.float64), 0.0, 100.0)[:, None]
     c = np.clip(np.asarray(colour, dtype=np.float64), 0.0, 100.0)
-    # Multiplying by c / 100 last keeps white exact: l * 1.0 == l.
-    return np.floor(l * (c / 100.0) * 2.55 + 0.5).astype(np.uint8)
+    # l * 100 / 100 is l exactly in binary, which keeps white exact.
+    return grey_levels(l * c / 100.0)
 
 
 def joined_shades(shades) -> np.ndarray:

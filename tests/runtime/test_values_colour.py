@@ -28,9 +28,9 @@ def test_white_is_the_thesis_grey_exactly():
 
 def test_lightness_lights_the_colour():
     rgb = colour_levels(np.array([50.0, 100.0, 0.0]), np.array([[100, 0, 50]] * 3, dtype=float))
-    # 50 lights white to grey_levels(50) (127: 50 * 2.55 is just under 127.5 in binary).
-    assert grey_levels(50.0) == 127
-    assert rgb.tolist() == [[127, 0, 64], [255, 0, 128], [0, 0, 0]]
+    # Each channel is the grey level of LIGHTNESS * c / 100.
+    assert rgb.tolist() == [grey_levels([50.0, 0.0, 25.0]).tolist(), [255, 0, grey_levels(50.0)], [0, 0, 0]]
+    assert rgb[0].tolist() == [127, 0, 64]
 
 
 def test_an_object_without_colour_shades_grey():
