@@ -39,7 +39,6 @@ import threading
 import distributed
 
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.render.imagefiles import AtomicWriter, os_error_words
 
 # Times a task that raised is run again (a worker that died is Dask's allowed-failures).
 RETRIES = 2
@@ -227,11 +226,10 @@ class DaskExecutor:
             name = f"{MARKER}.{self._token}"
             _remove_stale_marks(folder)
             try:
-                with AtomicWriter(os.path.join(folder, name), fsync=False) as f:
-                    f.write(self._token.encode("ascii"))
-            except RenderError as exc:
+                _write_whole(os.path.join(folder, name), self._token.encode("ascii"))
+            except OSError as exc:
                 raise RenderError(
-                    f"cannot prepare the output folder {folder} for the Dask workers: {exc.message}"
+                    f"cannot prepare the output folder {folder} for the Dask workers: {_why(exc)}"
                 ) from None
             self._marks.append((folder, name))
         return tuple((folder, name, self._token) for folder, name in self._marks)
@@ -241,6 +239,22 @@ class DaskExecutor:
             with contextlib.suppress(OSError):
                 os.unlink(os.path.join(folder, name))
         self._marks = []
+
+
+def _write_whole(path: str, data: bytes) -> None:
+    """Write ``path`` under a temporary name and rename it, so a worker never reads it half-written."""
+    tmp = f"{path}.{os.getpid()}.tmp"
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o644)
+        try:
+            os.write(fd, data)
+        finally:
+            os.close(fd)
+        os.replace(tmp, path)
+    except OSError:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
 
 
 def _remove_stale_marks(folder: str) -> None:
@@ -299,7 +313,7 @@ def _why(exc: BaseException) -> str:
     if isinstance(exc, (TimeoutError, socket.timeout)) or "Timed out" in str(exc):
         return "no answer (timed out)"
     if isinstance(exc, OSError) and exc.strerror:
-        return os_error_words(exc)
+        return exc.strerror[:1].lower() + exc.strerror[1:]
     if isinstance(exc, (OSError, ValueError)) and str(exc):
         return str(exc)
     return "it does not answer as a Dask scheduler"

@@ -35,7 +35,7 @@ SIZE = (96, 72)
 @pytest.fixture(scope="module")
 def cluster():
     with distributed.LocalCluster(
-        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None, silence_logs=40
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=":0", silence_logs=40
     ) as c:
         yield c
 
@@ -225,7 +225,7 @@ def test_a_bad_scheduler_address_is_a_render_error(address):
 
 
 def test_a_scheduler_without_workers_is_a_render_error():
-    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None) as empty:
+    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=":0") as empty:
         started = time.monotonic()
         with pytest.raises(RenderError, match="has no workers"):
             DaskExecutor(empty, worker_wait=0.5)
