@@ -364,8 +364,14 @@ def _worded(exc: BaseException) -> BaseException:
 _SEEN: set = set()  # markers this worker process has found
 
 
+_TUNED: list = []  # the worker process whose allocator is set up (a forked child sets up its own)
+
+
 def _call(fn, marks, *args):
     """A task on a worker: check once that it sees the output folders, then run ``fn(*args)``."""
+    if _TUNED != [os.getpid()]:
+        _TUNED[:] = [os.getpid()]
+        _keep_freed_memory()
     for mark in marks:
         if mark not in _SEEN:
             _check_folder(*mark)
@@ -373,6 +379,25 @@ def _call(fn, marks, *args):
                 _SEEN.clear()
             _SEEN.add(mark)
     return fn(*args)
+
+
+def _keep_freed_memory() -> None:
+    """Keep the large blocks freed after each image in the heap, as the local pool's workers do.
+
+    Each image allocates and frees the same few large arrays; by default
+    glibc returns them to the kernel and gets them back as fresh zeroed
+    pages every image, which on a Dask worker doubled the CPU time of
+    drawing (measured: 4.0 s against 2.0 s for 600 frames at 640x480).
+    """
+    try:
+        import ctypes
+
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return  # not glibc
+    M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
+    mallopt(M_MMAP_THRESHOLD, 32 << 20)
+    mallopt(M_TRIM_THRESHOLD, 256 << 20)
 
 
 def _check_folder(folder: str, name: str, token: str) -> None:

@@ -271,3 +271,12 @@ def test_a_task_error_reaches_the_caller_after_its_retries(cluster, tmp_path):
     finally:
         ex.shutdown()
     assert count.read_text() == "xxx"
+
+
+def test_a_worker_process_sets_up_its_allocator_once_before_its_first_task(monkeypatch):
+    calls = []
+    monkeypatch.setattr(dask_render, "_keep_freed_memory", lambda: calls.append(os.getpid()))
+    monkeypatch.setattr(dask_render, "_TUNED", [])
+    assert dask_render._call(abs, (), -2) == 2
+    assert dask_render._call(abs, (), -3) == 3
+    assert calls == [os.getpid()]
