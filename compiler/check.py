@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from liganimate.lang import ast as A
-from liganimate.lang import messages, numbers
+from liganimate.lang import bindings, messages, numbers
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
 from liganimate.lang.vocabulary import DRAW_WITH, MODIFIERS
 from liganimate.runtime.motion import interpolation
@@ -196,7 +196,7 @@ class Checker:
         self.top_loads = {id(s) for s in self.program.body if isinstance(s, A.Load)}
         for stmt in self.program.body:
             if not isinstance(stmt, A.Load):
-                for name in _defined_names(stmt):
+                for name in bindings.defined(stmt):
                     defined.setdefault(name.name, name.pos)
                 continue
             try:
@@ -413,13 +413,11 @@ class Checker:
             self._check_self_cycle(s.target.name, s.value)
         t = self.expr(s.value)
         self._assign_type(s.target, t, s.value)
-        if self.scene is not None:
-            self.scene.assigned.add(s.target.name)
 
     def _check_self_cycle(self, target: str, joint: A.JointExpr) -> None:
         args = joint.args
         if len(args) >= 4:
-            p, sec = _plain_name(args[1]), _plain_name(args[3])
+            p, sec = bindings.plain_name(args[1]), bindings.plain_name(args[3])
             if p == target and sec == target:
                 self.err(
                     args[3],
@@ -441,8 +439,6 @@ class Checker:
         self._want(s.joint, T.INTEGER, "a joint identifier")
         self._want(s.index, T.INTEGER, "a keyframe number")
         self._keyframe(s.keyframe)
-        if self.scene is not None:
-            self.scene.assigned.add(s.target.name)
 
     def _keyframe(self, k: A.Keyframe) -> None:
         self._want_number(k.frame, "a frame number")
@@ -485,8 +481,6 @@ class Checker:
                 self.err(e, f"a DO loop bound must be a number, not {T.NOUN[t]}")
         loop_type = T.INTEGER if all(t == T.INTEGER for t in types) else T.REAL
         self._assign_type(s.var, loop_type, s.start)
-        if self.scene is not None:
-            self.scene.assigned.add(s.var.name)
         self._stmts(s.body, context)
 
     def _s_If(self, s, context):
@@ -510,8 +504,6 @@ class Checker:
                     )
                 else:
                     ids[args[0].value] = args[0].pos
-        if self.scene is not None:
-            self.scene.assigned.add(s.name.name)
 
     def _model_target(self, name: A.Name) -> None:
         self._define_as(name, T.MODEL, "{name} is {noun}, not a MODEL")
@@ -584,8 +576,6 @@ class Checker:
                 if c is not None and last is not None and c < last:
                     self.err(k.frame, messages.keyframes_out_of_order(c, last))
                 last = c if c is not None else last
-        if self.scene is not None:
-            self.scene.assigned.add(s.name.name)
 
     def _s_ReachBlock(self, s, context):
         if self.primitive is not None:
@@ -638,8 +628,6 @@ class Checker:
             self._want(s.chain, T.INTEGER, "a chain length")
         if s.translate is not None:
             self._define_as(s.translate, T.VECTOR, "{name} is {noun}; TRANSLATE INTO needs a VECTOR")
-            if self.scene is not None:
-                self.scene.assigned.add(s.translate.name)
         if s.solver is not None and s.solver.name not in _SOLVERS:
             hint = did_you_mean(s.solver.name, list(_SOLVERS))
             self.err(s.solver, f"{s.solver.name} is not a solver", hint or "the solvers are " + ", ".join(_SOLVERS))
@@ -647,15 +635,11 @@ class Checker:
             self._want_number(s.tolerance, "the tolerance")
         if s.iterations is not None:
             self._want(s.iterations, T.INTEGER, "the iteration limit")
-        if self.scene is not None:
-            self.scene.assigned.add(s.name.name)
 
     def _s_FigureStmt(self, s, context):
         self._want_var(s.model, T.MODEL)
         if s.kind == "JOINT":
             self._want(s.joint, T.INTEGER, "a joint identifier")
-        if self.scene is not None:
-            self.scene.assigned.add(s.model.name)
 
     def _s_Scene(self, s, context):
         if self.primitive is not None or context != "top":
@@ -676,6 +660,7 @@ class Checker:
             self._want(s.sameframe, T.INTEGER, "a number of ticks per image")
         self._stmts(s.body, "scene-body")
         self.scene = outer
+        info.assigned = {n.name for n in bindings.assigned(s)}
         info.models = sorted(n for n in _names_used(s) if self.scope.types.get(n) == T.MODEL)
 
     def _s_Animate(self, s, context):
@@ -1006,12 +991,6 @@ class Checker:
                 )
 
 
-def _plain_name(e):
-    while isinstance(e, A.Modified):
-        e = e.target
-    return e.name if isinstance(e, A.Var) else None
-
-
 def _const(e):
     """The value of a literal (or a negated one), or None; a literal out of range is reported elsewhere."""
     if isinstance(e, A.Neg):
@@ -1027,28 +1006,11 @@ def _fmt(x) -> str:
 
 
 def _names_used(node) -> set:
-    from liganimate.lang.structure import children
-
-    out = set()
-    stack = [node]
-    while stack:
-        n = stack.pop()
-        if isinstance(n, (A.Var, A.Name)):
-            out.add(n.name)
-        stack.extend(children(n))
-    return out
+    return {n.name for n in bindings.walk(node) if isinstance(n, (A.Var, A.Name))}
 
 
 def _prim_call_nodes(node) -> list:
-    from liganimate.lang.structure import children
-
-    out, stack = [], [node]
-    while stack:
-        n = stack.pop()
-        if isinstance(n, A.PrimCall):
-            out.append(n)
-        stack.extend(children(n))
-    return out
+    return [n for n in bindings.walk(node) if isinstance(n, A.PrimCall)]
 
 
 def _prim_calls(node) -> set:
@@ -1069,26 +1031,3 @@ def _here(path: str | None) -> tuple:
     import os
 
     return (os.path.abspath(path),) if path and not path.startswith("<") else ()
-
-
-def _defined_names(stmt) -> list:
-    """The names a statement (and the statements inside it) declares or assigns."""
-    out = []
-    if isinstance(stmt, A.Decl):
-        out.extend(stmt.names)
-    elif isinstance(stmt, (A.Assign, A.KeyframeAssign)):
-        out.append(stmt.target)
-    elif isinstance(stmt, (A.ModelBlock, A.MotionBlock)):
-        out.append(stmt.name)
-    elif isinstance(stmt, A.ReachBlock):
-        out.append(stmt.name)
-        if stmt.translate is not None:
-            out.append(stmt.translate)
-    elif isinstance(stmt, A.Do):
-        out.append(stmt.var)
-    for attr in ("body", "then", "orelse"):
-        inner = getattr(stmt, attr, None)
-        if isinstance(inner, list) and not isinstance(stmt, A.PrimitiveDef):
-            for s in inner:
-                out.extend(_defined_names(s))
-    return out

@@ -16,6 +16,7 @@ import re
 
 from liganimate import __version__
 from liganimate.lang import ast as A
+from liganimate.lang import bindings
 from liganimate.lang import numbers as N
 from liganimate.lang.vocabulary import MODIFIERS
 
@@ -163,7 +164,9 @@ class Lowerer:
             f"program = _host.Program(_SOURCE_NAME, _AT, _main, {self.source_literal()})",
             "",
             'if __name__ == "__main__":',
-            "    raise SystemExit(_host.main(program))",
+            "    from liganimate.cli import run_program_cli",
+            "",
+            "    raise SystemExit(run_program_cli(program))",
             "",
         ]
         return "\n".join(head + positions + body + tail)
@@ -330,7 +333,7 @@ class Lowerer:
         for j in s.joints:
             a = j.args
             pname = a[1].name if isinstance(a[1], A.Var) else None
-            sname = _plain_name(a[3])
+            sname = bindings.plain_name(a[3])
             exts = ", ".join(self.expr(e) for e in a[5:])
             specs.append(
                 f"({self.expr(a[0])}, {pname!r}, {self.expr(a[1])}, {self.expr(a[2])}, "
@@ -394,8 +397,7 @@ class Lowerer:
         fn = f"_scene_{self.tmp}"
         self.tmp += 1
         snap = info.models
-        assigned = set(info.assigned) | set(snap) | set(info.animated)
-        assigned |= _assigned_in(s)
+        assigned = info.assigned | set(snap) | set(info.animated)
         self.emit(f"def {fn}(_snap):")
         self.indent += 1
         if assigned:
@@ -602,7 +604,7 @@ class Lowerer:
         exts = "".join(self.expr(x) + ", " for x in a[5:])
         return (
             f"rt.joint({self.expr(a[0])}, {self.expr(a[1])}, {self.expr(a[2])}, {self.expr(a[3])}, "
-            f"{self.expr(a[4])}, ({exts}), ({_plain_name(a[1])!r}, {_plain_name(a[3])!r}), {self.at(e)})"
+            f"{self.expr(a[4])}, ({exts}), ({bindings.plain_name(a[1])!r}, {bindings.plain_name(a[3])!r}), {self.at(e)})"
         )
 
     def e_Strip(self, e):
@@ -637,41 +639,12 @@ def _in_chain(e, t, lowerer) -> bool:
     return isinstance(e, A.BinOp) and e.op in _ARITH
 
 
-def _plain_name(e):
-    while isinstance(e, A.Modified):
-        e = e.target
-    return e.name if isinstance(e, A.Var) else None
-
-
 def _tuple_target(names) -> str:
     return "(" + "".join(n + ", " for n in names) + ")"
 
 
 def _tuple_value(names) -> str:
     return "(" + "".join(n + ", " for n in names) + ")"
-
-
-def _assigned_in(scene: A.Scene) -> set:
-    from liganimate.lang.structure import children
-
-    out = set()
-    stack = list(scene.init) + list(scene.body)
-    while stack:
-        n = stack.pop()
-        if isinstance(n, (A.Assign, A.KeyframeAssign)):
-            out.add(n.target.name)
-        elif isinstance(n, (A.ModelBlock, A.MotionBlock)):
-            out.add(n.name.name)
-        elif isinstance(n, A.FigureStmt):
-            out.add(n.model.name)
-        elif isinstance(n, A.ReachBlock):
-            out.add(n.name.name)
-            if n.translate is not None:
-                out.add(n.translate.name)
-        elif isinstance(n, A.Do):
-            out.add(n.var.name)
-        stack.extend(children(n))
-    return out
 
 
 def _source_text(source: str, pos: A.Pos) -> str:

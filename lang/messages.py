@@ -14,20 +14,22 @@ def _num(x) -> str:
     return str(x) if isinstance(x, int) else f"{x:g}"
 
 
+def _frame(frame, where: str | None) -> str:
+    return f"frame {_num(frame)} ({where})" if where else f"frame {_num(frame)}"
+
+
 def keyframes_out_of_order(frame, previous, where: str | None = None) -> str:
     """Keyframes must ascend: ``frame`` comes after a keyframe at ``previous``.
 
     ``where`` names the keyframe when the statement alone does not
     (``"keyframe 3 of joint 2"``).
     """
-    lead = f"{where}: " if where else ""
-    return f"{lead}keyframes must be in ascending frame order: frame {_num(frame)} comes after frame {_num(previous)}"
+    return f"keyframes must be in ascending frame order: {_frame(frame, where)} comes after frame {_num(previous)}"
 
 
 def keyframes_too_close(frame, previous, where: str | None = None) -> str:
     """Two keyframes closer than :data:`~.numbers.MIN_FRAME_GAP` frames apart (and not a step)."""
-    lead = f"{where}: " if where else ""
-    return f"{lead}frame {_num(frame)} is too close after frame {_num(previous)}"
+    return f"{_frame(frame, where)} is too close after frame {_num(previous)}"
 
 
 #: The hint under :func:`keyframes_too_close`.

@@ -16,10 +16,11 @@ import sys
 
 import numpy as np
 
+from liganimate.lang import messages
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
-from liganimate.runtime import limits
+from liganimate.runtime import limits, printing
 from liganimate.runtime.arithmetic import Arithmetic
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
@@ -27,6 +28,7 @@ from liganimate.runtime.figure import pose as P
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.library import Library  # noqa: F401  (generated modules name it _host.Library)
 from liganimate.runtime.motion import algebra as M
+from liganimate.runtime.motion import edits as E
 from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
 #: How often a long scene reports its progress while it is checked, in ticks.
@@ -49,22 +51,6 @@ class Posed:
     def with_figure(self, figure: F.Figure) -> Posed:
         """The same pose on a changed figure (placement, main link...)."""
         return Posed(figure, self.motion, self.frame, self.statement)
-
-
-class KeyframeEdits:
-    """A motion being written keyframe by keyframe (``m[j, k] := FRAME ...``).
-
-    Edits are chained in O(1) and applied once, when the motion is first used,
-    so a DO loop writing n keyframes costs O(n), not O(n^2).
-    """
-
-    __slots__ = ("_cache", "base", "edit", "parent")
-
-    def __init__(self, base, edit, parent):
-        self.base = base
-        self.edit = edit
-        self.parent = parent
-        self._cache = None
 
 
 class Program:
@@ -173,13 +159,6 @@ def overflow(program: Program, value, kind, at):
     raise LigDiagnostics(
         [Diagnostic(program.name, Pos(*program.positions[at]), exc.message, exc.hint, source=program.source)]
     )
-
-
-def main(program: Program, argv=None) -> int:
-    """``python compiled.py -o DIR``: render a compiled module (same options as ``liganimate run``)."""
-    from liganimate.cli import run_program_cli
-
-    return run_program_cli(program, argv)
 
 
 class Runtime(Arithmetic):
@@ -404,8 +383,8 @@ class Runtime(Arithmetic):
     # ------------------------------------------------------------- motions
     def finished(self, value):
         """A variable's value as Python code or another program sees it: keyframe edits become a Motion."""
-        if isinstance(value, KeyframeEdits):
-            return self._apply_edits(value, value.edit[5])
+        if isinstance(value, E.KeyframeEdits):
+            return self._apply_edits(value, value.at)
         return value
 
     def for_program(self, program: Program) -> Runtime:
@@ -419,77 +398,22 @@ class Runtime(Arithmetic):
         return view
 
     def _motion(self, m, at) -> M.Motion:
-        if isinstance(m, KeyframeEdits):
+        if isinstance(m, E.KeyframeEdits):
             return self._apply_edits(m, at)
         return m
 
     def set_keyframe(self, m, joint, k, frame, position, method, at):
-        if k < 0:
-            self.fail(at, f"keyframe numbers start at 0 (the starting position), not {k}")
-        if k > N.MAX_KEYFRAME:
-            self.fail(
-                at,
-                f"keyframe {k} is beyond the last keyframe number allowed, {N.MAX_KEYFRAME:,}",
-                "number the keyframes of each joint 1, 2, 3, ...",
-            )
-        self._keyframe_values(frame, position, at)
-        base = m.base if isinstance(m, KeyframeEdits) else m
-        return KeyframeEdits(
-            base, (joint, k, frame, tuple(position), method, at), m if isinstance(m, KeyframeEdits) else None
-        )
+        """``m[joint, k] := FRAME ...``: the motion with one more keyframe edit (runtime/motion/edits.py)."""
+        return self._guard(at, E.set_keyframe, m, joint, k, frame, position, method, at)
 
-    def _apply_edits(self, m: KeyframeEdits, at) -> M.Motion:
-        if m._cache is not None:
-            return m._cache
-        edits = []
-        node = m
-        while node is not None:
-            edits.append(node.edit)
-            node = node.parent
-        edits.reverse()
-        base = m.base
-        tracks: dict = {}
-        for j in base.joints:
-            # Keep each keyframe's ramp so a stretched motion stays stretched.
-            start, kfs = self._guard(at, lambda joint: base.keyframes(joint, with_ramps=True), j)
-            tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None, kf[3]) for i, kf in enumerate(kfs)}]
-        for joint, k, frame, position, method, eat in edits:
-            entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
-            if k == 0:
-                entry[0] = position
-            else:
-                entry[1][k] = (frame, position, method or "LINEAR", eat, None)
-        spec = {}
-        for joint, (start, kfs) in tracks.items():
-            numbers = sorted(kfs)
-            n = numbers[-1] if numbers else 0
-            if len(numbers) != n:
-                # The keys are 1..n exactly when there are n of them; else find the first gap (O(set), not O(n)).
-                first = next(i for i, k in enumerate(numbers, start=1) if k != i)
-                eat = kfs[n][3] if kfs[n][3] is not None else at
-                self.fail(
-                    eat,
-                    f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
-                    "number the keyframes of each joint 1, 2, 3, ... without gaps",
-                )
-            seq = [kfs[i] for i in numbers]
-            previous = 0.0  # keyframe 0, the starting position, is at frame 0
-            for i in range(len(seq)):
-                gap = seq[i][0] - previous
-                if gap < 0 or 0 < gap < N.MIN_FRAME_GAP:
-                    eat = seq[i][3] if seq[i][3] is not None else at
-                    self.fail(
-                        eat,
-                        f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
-                        + ("before" if gap < 0 else "too close after")
-                        + f" keyframe {i} at frame {previous:g}",
-                        None if gap < 0 else _GAP_HINT,
-                    )
-                previous = seq[i][0]
-            spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
-        motion = self._guard(at, M.Motion.from_tracks, spec)
-        m._cache = motion
-        return motion
+    def _apply_edits(self, m: E.KeyframeEdits, at) -> M.Motion:
+        try:
+            with np.errstate(all="ignore"):
+                return E.apply(m)
+        except E.EditError as exc:
+            self.fail(at if exc.at is None else exc.at, _sentence(exc.message), exc.hint)
+        except (LigError, N.NumberError) as exc:
+            self.fail(at, _sentence(exc.message), exc.hint)
 
     # ------------------------------------------------------------- REACH
     def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
@@ -565,41 +489,20 @@ class Runtime(Arithmetic):
                 self.fail(jat, f"joint {joint} appears twice in this motion")
             last = 0
             for frame, pos, _method, kat in kfs:
-                self._keyframe_values(frame, pos, kat)
+                self._guard(kat, E.check_frame, frame)
+                self._guard(kat, E.check_angles, pos)
                 if frame < last:
-                    self.fail(
-                        kat, f"keyframes must be in ascending frame order: frame {frame:g} comes after frame {last:g}"
-                    )
+                    self.fail(kat, messages.keyframes_out_of_order(frame, last))
                 if 0 < frame - last < N.MIN_FRAME_GAP:
-                    self.fail(kat, f"frame {frame:g} is too close after frame {last:g}", _GAP_HINT)
+                    self.fail(kat, messages.keyframes_too_close(frame, last), messages.GAP_HINT)
                 last = frame
             if start is not None:
-                self._angles(start, jat)
+                self._guard(jat, E.check_angles, start)
             spec[joint] = (
                 tuple(start) if start is not None else (0.0, 0.0, 0.0),
                 [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
         return self._guard(at, M.Motion.from_tracks, spec)
-
-    def _keyframe_values(self, frame, position, at) -> None:
-        """A keyframe's frame and angles within the limits of lang/numbers.py."""
-        if frame < 0:
-            self.fail(at, f"frame {frame:g} is before the motion starts")
-        if frame > N.MAX_FRAME:
-            self.fail(
-                at,
-                f"frame {N.magnitude(frame)} is beyond the last frame a keyframe may have, {N.magnitude(N.MAX_FRAME)}",
-            )
-        self._angles(position, at)
-
-    def _angles(self, position, at) -> None:
-        if not max(abs(a) for a in position) <= N.MAX_ANGLE:
-            far = max(abs(a) for a in position)
-            self.fail(
-                at,
-                f"an angle of {N.magnitude(far)} degrees is beyond the largest a keyframe may hold, {N.magnitude(N.MAX_ANGLE)}",
-                "angles are in degrees; a joint's extremes clip them anyway",
-            )
 
     def concat(self, a, b, at):
         return self._guard(at, M.concat, self._motion(a, at), self._motion(b, at))
@@ -748,34 +651,15 @@ class Runtime(Arithmetic):
         if kind == "text":
             return value
         if kind == "MODEL":
-            return self._model(value, at, label).describe_tree(label)
+            return printing.model_tree(self._model(value, at, label), label)
         if kind == "table":
             fig = self._model(value, at, label)
             if isinstance(value, Posed):
-                from liganimate.runtime.figure.pose import joint_angles
-
-                angles, vel, acc = joint_angles(fig, value.motion, np.array([value.frame]), full=True)
-                return f"MODEL {label} at frame {value.frame:g}\n" + fig.describe_table(angles[0], vel[0], acc[0])
-            return f"MODEL {label}\n" + fig.describe_table()
+                return printing.model_table(fig, label, value.motion, value.frame)
+            return printing.model_table(fig, label)
         if kind == "MOTION":
-            motion = self._motion(value, at)
-            lines = [
-                f"MOTION {label}: length {motion.length:g} frames, joints {', '.join(map(str, motion.joints)) or 'none'}"
-            ]
-            try:
-                for j in motion.joints:
-                    start, kfs = motion.keyframes(j, limit=1000)
-                    lines.append(f"  JOINT {j} POSITION {_fmt_vec(start)}")
-                    for frame, val, method in kfs:
-                        lines.append(f"    FRAME {frame:g} POSITION {_fmt_vec(val)} INTERPOLATE {method}")
-            except LigError:
-                lines.append("  " + motion.describe())
-            return "\n".join(lines)
-        if kind == "GRAPHICAL":
-            return f"{label} = GRAPHICAL object of {len(value)} triangles"
-        if isinstance(value, float):
-            return f"{label} = {value:.6g}"
-        return f"{label} = {value!r}"
+            return printing.motion_listing(self._motion(value, at), label)
+        return printing.value_line(kind, value, label)
 
 
 class SceneState:
@@ -791,13 +675,6 @@ class SceneState:
         self.length = 0
         self.sameframe = 1
         self.at = at
-
-
-_GAP_HINT = f"two keyframes of a joint share a frame (a step) or lie at least {N.MIN_FRAME_GAP:g} frames apart"
-
-
-def _fmt_vec(v) -> str:
-    return ", ".join(f"{float(x):g}" for x in v)
 
 
 def _sentence(message: str) -> str:

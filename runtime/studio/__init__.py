@@ -20,8 +20,8 @@ The posing logic is pure Python and numpy, tested without a browser; the
 page only shows poses and sends choices.  It may import the runtime
 (figure, kinematics, pose, errors), ``liganimate.runtime.view`` (the page
 helpers and ``gl.js``), ``liganimate.runtime.exchange`` (atomic writes),
-the compiler and ``liganimate.lang`` (to load a model and to check the
-library it saves) and ``liganimate.cli`` (loading a program file).
+the compiler (to load a program file) and ``liganimate.lang`` (to check the
+library it saves); never ``liganimate.cli``, the layer above it.
 Nothing imports it but ``liganimate.view_cli``.  See ``docs/viewer.md``.
 """
 

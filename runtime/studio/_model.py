@@ -78,7 +78,7 @@ def studio_model(path: str | None, name: str | None):
         variables = _run(_compiled_text(f"LOAD {wanted} FROM '{lib}'\n", f"<studio {lib}>"))
         source = f"the standard library '{lib}'"
     else:
-        from liganimate.cli import load_program
+        from liganimate.compiler import load_program
 
         program, _ = load_program(path)
         variables = _run(program)

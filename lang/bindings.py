@@ -1,0 +1,77 @@
+"""Which names a statement binds, computed once for the checker and the lowering.
+
+Like Jinja2's ``idtracking``: the checker needs the names a program defines
+before a LOAD (to refuse a LOAD that would overwrite one) and the names a
+scene assigns; the lowering needs the latter to declare them ``nonlocal``
+(or ``global``) in the scene's function. Both ask here.
+"""
+
+from __future__ import annotations
+
+from . import ast as A
+from .structure import children
+
+#: Statements that hold statements, and the fields that hold them (PRIMITIVE bodies are scopes of their own).
+_INNER = {A.If: ("then", "orelse"), A.Do: ("body",), A.Scene: ("init", "body")}
+
+
+def walk(node):
+    """Every node under ``node`` (itself first), depth first; iterative, so deep trees cannot overflow."""
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        yield n
+        stack.extend(reversed(children(n)))
+
+
+def plain_name(e) -> str | None:
+    """The variable an expression names, through modifiers (``HEAD <TRANS v>`` names HEAD), or None."""
+    while isinstance(e, A.Modified):
+        e = e.target
+    return e.name if isinstance(e, A.Var) else None
+
+
+def assigned(stmt, figure: bool = True) -> list:
+    """The names (``A.Name`` nodes) ``stmt`` and the statements inside it assign, in source order.
+
+    An assignment, a keyframe assignment, a STARTMODEL, STARTMOTION or
+    STARTREACH block (and its TRANSLATE INTO vector), a DO variable; and a
+    FIGURE statement, which gives its model a new value, unless ``figure``
+    is false. Declarations are not assignments (see :func:`defined`).
+    """
+    return [n for s in walk_statements(stmt) for n in _binds(s, figure, False)]
+
+
+def defined(stmt) -> list:
+    """The names ``stmt`` (and the statements inside it) declares or assigns a value to, FIGURE aside, in source order."""
+    return [n for s in walk_statements(stmt) for n in _binds(s, False, True)]
+
+
+def walk_statements(stmt):
+    """``stmt`` and the statements inside it (not inside a PRIMITIVE's body), in source order."""
+    stack = [stmt]
+    while stack:
+        s = stack.pop()
+        yield s
+        inner = _INNER.get(type(s))
+        if inner:
+            for name in reversed(inner):
+                stack.extend(reversed(getattr(s, name) or ()))
+
+
+def _binds(s, figure: bool, decl: bool) -> tuple:
+    """The names statement ``s`` itself binds (not those of statements inside it)."""
+    kind = type(s)
+    if kind is A.Assign or kind is A.KeyframeAssign:
+        return (s.target,)
+    if kind is A.ModelBlock or kind is A.MotionBlock:
+        return (s.name,)
+    if kind is A.ReachBlock:
+        return (s.name,) if s.translate is None else (s.name, s.translate)
+    if kind is A.Do:
+        return (s.var,)
+    if kind is A.FigureStmt and figure:
+        return (s.model,)
+    if kind is A.Decl and decl:
+        return tuple(s.names)
+    return ()

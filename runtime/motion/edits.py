@@ -1,0 +1,141 @@
+"""A motion written keyframe by keyframe: ``m[j, k] := FRAME f POSITION a, b, c``.
+
+Each assignment adds one edit to a chain in O(1); the chain becomes a
+:class:`~.algebra.Motion` once, when the motion is first used, so a DO loop
+writing n keyframes costs O(n), not O(n^2).
+
+Errors carry ``at``, the statement that made the offending edit (an opaque
+token the host turns into a source position), or ``None`` for the statement
+that uses the motion.
+"""
+
+from __future__ import annotations
+
+from liganimate.lang import messages
+from liganimate.lang import numbers as N
+from liganimate.runtime.errors import MotionError
+from liganimate.runtime.motion.algebra import Motion
+
+
+class EditError(MotionError):
+    """A keyframe edit that does not fit; ``at`` is the edit's statement (None: the statement using the motion)."""
+
+    def __init__(self, message: str, hint: str | None = None, at=None):
+        super().__init__(message, hint)
+        self.at = at
+
+
+class KeyframeEdits:
+    """A motion being written keyframe by keyframe: a base motion and a chain of edits.
+
+    ``edit`` is ``(joint, k, frame, position (3,), method or None, at)``.
+    """
+
+    __slots__ = ("_cache", "base", "edit", "parent")
+
+    def __init__(self, base: Motion, edit: tuple, parent: KeyframeEdits | None):
+        self.base = base
+        self.edit = edit
+        self.parent = parent
+        self._cache = None
+
+    @property
+    def at(self):
+        """The statement of the last edit."""
+        return self.edit[5]
+
+
+def check_frame(frame) -> None:
+    """A keyframe's frame within the limits of lang/numbers.py, or MotionError."""
+    if frame < 0:
+        raise MotionError(f"frame {frame:g} is before the motion starts")
+    if frame > N.MAX_FRAME:
+        raise MotionError(
+            f"frame {N.magnitude(frame)} is beyond the last frame a keyframe may have, {N.magnitude(N.MAX_FRAME)}"
+        )
+
+
+def check_angles(position) -> None:
+    """A keyframe's angles (3,) within the limits of lang/numbers.py, or MotionError."""
+    if not max(abs(a) for a in position) <= N.MAX_ANGLE:
+        far = max(abs(a) for a in position)
+        raise MotionError(
+            f"an angle of {N.magnitude(far)} degrees is beyond the largest a keyframe may hold, "
+            f"{N.magnitude(N.MAX_ANGLE)}",
+            "angles are in degrees; a joint's extremes clip them anyway",
+        )
+
+
+def set_keyframe(m, joint: int, k: int, frame, position, method: str | None, at) -> KeyframeEdits:
+    """``m[joint, k] := FRAME frame POSITION position INTERPOLATE method``: ``m`` (a Motion or edits) with one more edit."""
+    if k < 0:
+        raise MotionError(f"keyframe numbers start at 0 (the starting position), not {k}")
+    if k > N.MAX_KEYFRAME:
+        raise MotionError(
+            f"keyframe {k} is beyond the last keyframe number allowed, {N.MAX_KEYFRAME:,}",
+            "number the keyframes of each joint 1, 2, 3, ...",
+        )
+    check_frame(frame)
+    check_angles(position)
+    if isinstance(m, KeyframeEdits):
+        return KeyframeEdits(m.base, (joint, k, frame, tuple(position), method, at), m)
+    return KeyframeEdits(m, (joint, k, frame, tuple(position), method, at), None)
+
+
+def apply(m: KeyframeEdits) -> Motion:
+    """The motion the edits describe (computed once, then kept).
+
+    Raises
+    ------
+    EditError
+        A keyframe number is skipped, or the keyframes do not ascend.
+    MotionError
+        The base motion cannot list its keyframes, or the tracks do not make a motion.
+    """
+    if m._cache is not None:
+        return m._cache
+    edits = []
+    node = m
+    while node is not None:
+        edits.append(node.edit)
+        node = node.parent
+    edits.reverse()
+    base = m.base
+    tracks: dict = {}
+    for j in base.joints:
+        # Keep each keyframe's ramp so a stretched motion stays stretched.
+        start, kfs = base.keyframes(j, with_ramps=True)
+        tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None, kf[3]) for i, kf in enumerate(kfs)}]
+    for joint, k, frame, position, method, eat in edits:
+        entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
+        if k == 0:
+            entry[0] = position
+        else:
+            entry[1][k] = (frame, position, method or "LINEAR", eat, None)
+    spec = {}
+    for joint, (start, kfs) in tracks.items():
+        numbers = sorted(kfs)
+        n = numbers[-1] if numbers else 0
+        if len(numbers) != n:
+            # The keys are 1..n exactly when there are n of them; else find the first gap (O(set), not O(n)).
+            first = next(i for i, k in enumerate(numbers, start=1) if k != i)
+            raise EditError(
+                f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
+                "number the keyframes of each joint 1, 2, 3, ... without gaps",
+                kfs[n][3],
+            )
+        seq = [kfs[i] for i in numbers]
+        previous = 0.0  # keyframe 0, the starting position, is at frame 0
+        for i in range(len(seq)):
+            gap = seq[i][0] - previous
+            if gap < 0:
+                where = f"keyframe {i + 1} of joint {joint}"
+                raise EditError(messages.keyframes_out_of_order(seq[i][0], previous, where), None, seq[i][3])
+            if 0 < gap < N.MIN_FRAME_GAP:
+                where = f"keyframe {i + 1} of joint {joint}"
+                raise EditError(messages.keyframes_too_close(seq[i][0], previous, where), messages.GAP_HINT, seq[i][3])
+            previous = seq[i][0]
+        spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
+    motion = Motion.from_tracks(spec)
+    m._cache = motion
+    return motion

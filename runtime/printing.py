@@ -1,0 +1,55 @@
+"""What PRINT writes: one item (a text, a value, a model's tree or table, a motion's keyframes) as text.
+
+The host resolves each item first (a model that has no value, a motion
+whose keyframe edits do not fit, are reported at the PRINT statement);
+these functions only format values that are sound.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from liganimate.runtime.errors import LigError
+
+
+def model_tree(figure, label: str) -> str:
+    """``PRINT model``: the model's tree of links and joints."""
+    return figure.describe_tree(label)
+
+
+def model_table(figure, label: str, motion=None, frame: float | None = None) -> str:
+    """``PRINT $model``: the joint table, with angles, velocities and accelerations when it is ANIMATEd at ``frame``."""
+    if motion is None:
+        return f"MODEL {label}\n" + figure.describe_table()
+    from liganimate.runtime.figure.pose import joint_angles
+
+    angles, vel, acc = joint_angles(figure, motion, np.array([frame]), full=True)
+    return f"MODEL {label} at frame {frame:g}\n" + figure.describe_table(angles[0], vel[0], acc[0])
+
+
+def motion_listing(motion, label: str) -> str:
+    """``PRINT motion``: its length and joints, then each joint's keyframes (at most 1,000 a joint)."""
+    joints = ", ".join(map(str, motion.joints)) or "none"
+    lines = [f"MOTION {label}: length {motion.length:g} frames, joints {joints}"]
+    try:
+        for j in motion.joints:
+            start, kfs = motion.keyframes(j, limit=1000)
+            lines.append(f"  JOINT {j} POSITION {_vector(start)}")
+            for frame, val, method in kfs:
+                lines.append(f"    FRAME {frame:g} POSITION {_vector(val)} INTERPOLATE {method}")
+    except LigError:
+        lines.append("  " + motion.describe())
+    return "\n".join(lines)
+
+
+def value_line(kind: str, value, label: str) -> str:
+    """``PRINT expression`` of a number, a vector or a graphical object (``kind``: its static type)."""
+    if kind == "GRAPHICAL":
+        return f"{label} = GRAPHICAL object of {len(value)} triangles"
+    if isinstance(value, float):
+        return f"{label} = {value:.6g}"
+    return f"{label} = {value!r}"
+
+
+def _vector(v) -> str:
+    return ", ".join(f"{float(x):g}" for x in v)

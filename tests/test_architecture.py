@@ -1,0 +1,125 @@
+"""The import contract of docs/architecture.md: each package imports only the layers below it.
+
+Every module of lang/, compiler/ and runtime/ is parsed (not imported, so
+lazy imports inside functions count too) and each ``liganimate`` import it
+makes is compared with the modules its package may import.
+"""
+
+from __future__ import annotations
+
+import ast
+import pathlib
+
+import pytest
+from paths import ROOT_DIR
+
+ROOT = pathlib.Path(ROOT_DIR)
+FOLDERS = {"lang": "liganimate.lang", "compiler": "liganimate.compiler", "runtime": "liganimate.runtime"}
+
+#: The command line and the tools above the runtime: nothing below imports them.
+ABOVE = ("liganimate.cli", "liganimate.__main__", "liganimate.api", "liganimate.exchange_cli", "liganimate.view_cli")
+
+#: Package -> the modules (and packages, with everything in them) it may import, besides itself
+#: and ``liganimate`` (the version). The most specific package of a module applies.
+CONTRACT = {
+    "liganimate.lang": (),
+    "liganimate.compiler": (
+        "liganimate.lang",
+        # The runtime's vocabularies, by name only: the interpolation methods a program may name.
+        "liganimate.runtime.motion.interpolation",
+        # compiler.load_program executes the module it lowered, piece by piece.
+        "liganimate.runtime.loader",
+    ),
+    "liganimate.runtime.motion": ("liganimate.lang.numbers", "liganimate.lang.messages", "liganimate.runtime.errors"),
+    "liganimate.runtime.figure": (
+        "liganimate.lang.numbers",
+        "liganimate.runtime.errors",
+        "liganimate.runtime.values",
+        "liganimate.runtime.motion",
+    ),
+    "liganimate.runtime.ik": (
+        "liganimate.lang.numbers",
+        "liganimate.runtime.errors",
+        "liganimate.runtime.figure",
+        "liganimate.runtime.motion",
+    ),
+    "liganimate.runtime.render": (
+        "liganimate.lang.numbers",
+        "liganimate.lang.diagnostics",
+        "liganimate.runtime.errors",
+        "liganimate.runtime.values",
+        "liganimate.runtime.limits",
+        "liganimate.runtime.figure",
+        "liganimate.runtime.motion",
+    ),
+    # The host and the other top-level modules, and the tools built on them
+    # (exchange/, view/, studio/): anything of the package but the command line.
+    "liganimate.runtime": ("liganimate.lang", "liganimate.compiler", "liganimate.runtime"),
+}
+
+
+def _modules():
+    for folder, package in FOLDERS.items():
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            parts = list(path.relative_to(ROOT / folder).with_suffix("").parts)
+            is_package = parts[-1] == "__init__"
+            if is_package:
+                parts.pop()
+            yield ".".join([package, *parts]), is_package, path
+
+
+MODULES = {name: (is_package, path) for name, is_package, path in _modules()}
+
+
+def imports_of(name: str) -> set:
+    """The ``liganimate`` modules that module ``name`` imports, anywhere in its text."""
+    is_package, path = MODULES[name]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = name.split(".") if is_package else name.split(".")[:-1]
+                base = base[: len(base) - node.level + 1]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module or ""
+            for alias in node.names:
+                # ``from liganimate.lang import numbers`` imports the module liganimate.lang.numbers.
+                sub = f"{module}.{alias.name}"
+                found.add(sub if sub in MODULES else module)
+    return {m for m in found if m == "liganimate" or m.startswith("liganimate.")}
+
+
+def _rule(name: str) -> str:
+    return max((p for p in CONTRACT if name == p or name.startswith(p + ".")), key=len)
+
+
+def _allowed(name: str, imported: str) -> bool:
+    rule = _rule(name)
+    if imported == "liganimate" or imported == rule or imported.startswith(rule + "."):
+        return True
+    return any(imported == a or imported.startswith(a + ".") for a in CONTRACT[rule])
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_module_imports_only_what_its_package_may(name):
+    wrong = sorted(m for m in imports_of(name) if not _allowed(name, m) or m.startswith(ABOVE))
+    assert not wrong, f"{name} imports {', '.join(wrong)}, which {_rule(name)} may not (docs/architecture.md)"
+
+
+def test_the_contract_catches_a_wrong_import(tmp_path, monkeypatch):
+    # The check itself can fail: a motion module importing the figure code breaks the contract.
+    fake = tmp_path / "bad.py"
+    fake.write_text("from liganimate.runtime.figure import tree\nimport liganimate.cli\n")
+    monkeypatch.setitem(MODULES, "liganimate.runtime.motion.bad", (False, fake))
+    found = imports_of("liganimate.runtime.motion.bad")
+    assert found == {"liganimate.runtime.figure.tree", "liganimate.cli"}
+    assert not _allowed("liganimate.runtime.motion.bad", "liganimate.runtime.figure.tree")
+    assert not _allowed("liganimate.runtime.host", "liganimate.cli")
+
+
+def test_no_module_below_the_command_line_imports_it():
+    for name in MODULES:
+        assert not any(m.startswith(ABOVE) for m in imports_of(name)), name
