@@ -33,7 +33,7 @@ from liganimate.runtime.figure import pose as PO
 from liganimate.runtime.figure.tree import Figure
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
 from liganimate.runtime.ik.model import IKModel
-from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVERS, STALLED, solve
+from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
 
 __all__ = [
@@ -55,8 +55,8 @@ __all__ = [
 
 #: Default tolerance, as a fraction of the figure's length (the sum of its link lengths).
 DEFAULT_TOLERANCE = 1e-5
-#: Default iteration limits per solver (sweeps for CCD).
-DEFAULT_MAX_ITERATIONS = {"dls": 200, "transpose": 5000, "ccd": 500}
+#: Default iteration limits per solver (sweeps for CCD), from the solvers' registry.
+DEFAULT_MAX_ITERATIONS = {name: spec.max_iterations for name, spec in SOLVERS.items()}
 
 _STATUS = {CONVERGED: "converged", STALLED: "stalled", LIMIT: "limit"}
 
@@ -235,7 +235,7 @@ def _movable_mask(figure: Figure, goals: Sequence, movable) -> np.ndarray:
 
 def _options(figure: Figure, solver: str, tolerance, max_iterations) -> tuple[float, int]:
     if solver not in SOLVERS:
-        raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVERS)}")
+        raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVER_NAMES)}")
     from liganimate.runtime.ik.model import figure_length
 
     if tolerance is None:
