@@ -107,9 +107,9 @@ class PoseSolution:
     angles: np.ndarray
     translation: np.ndarray
     residuals: np.ndarray
-    converged: np.ndarray
-    status: np.ndarray
-    iterations: np.ndarray
+    converged: np.ndarray | bool
+    status: np.ndarray | str
+    iterations: np.ndarray | int
     tolerance: float
     weights: np.ndarray
     met: np.ndarray
@@ -208,7 +208,7 @@ def chain_joints(figure: Figure, link: int, length: int) -> list[int]:
     for level in figure.traversal:
         for k, par, ch in zip(level.joints, level.parents, level.children):
             parent[int(ch)] = (int(par), int(k))
-    out = []
+    out: list[int] = []
     cur = link
     while cur != figure.main and len(out) < length:
         cur, k = parent[cur]
@@ -394,33 +394,35 @@ def solve_pose(
     t = result.x[:, model.n_vars :] * model.length if translate else np.zeros((B, 3))
     # Wrapping free axes changes no link, so the solver's last distances are the pose's.
     residuals = stack.report(result.dist)
-    sol = PoseSolution(
-        angles=angles,
-        translation=t,
-        residuals=residuals,
-        converged=result.status == CONVERGED,
-        status=np.array([_STATUS[s] for s in result.status]),
-        iterations=result.iterations,
-        tolerance=tol,
-        weights=stack.weights,
-        met=(result.dist <= tol) | ~stack.active,
-        warnings=stack.warnings,
-        history=result.history,
-    )
+    converged = result.status == CONVERGED
+    status = np.array([_STATUS[s] for s in result.status])
+    met = (result.dist <= tol) | ~stack.active
     if batched:
-        return sol
+        return PoseSolution(
+            angles=angles,
+            translation=t,
+            residuals=residuals,
+            converged=converged,
+            status=status,
+            iterations=result.iterations,
+            tolerance=tol,
+            weights=stack.weights,
+            met=met,
+            warnings=stack.warnings,
+            history=result.history,
+        )
     return PoseSolution(
-        angles=sol.angles[0],
-        translation=sol.translation[0],
-        residuals=sol.residuals[0],
-        converged=bool(sol.converged[0]),
-        status=str(sol.status[0]),
-        iterations=int(sol.iterations[0]),
+        angles=angles[0],
+        translation=t[0],
+        residuals=residuals[0],
+        converged=bool(converged[0]),
+        status=str(status[0]),
+        iterations=int(result.iterations[0]),
         tolerance=tol,
-        weights=sol.weights[0],
-        met=sol.met[0],
-        warnings=sol.warnings,
-        history=[h[0] for h in sol.history],
+        weights=stack.weights[0],
+        met=met[0],
+        warnings=stack.warnings,
+        history=[h[0] for h in result.history],
     )
 
 
