@@ -11,7 +11,6 @@ written unless the whole program is sound; then in *render* mode.
 from __future__ import annotations
 
 import io
-import re
 import sys
 
 import numpy as np
@@ -468,18 +467,16 @@ class Runtime(Arithmetic):
                 "the solved translation is not within the geometry limit",
                 "the goals may be too far away for the model; everything drawn stays within 1E12 units",
             )
-        with np.errstate(all="ignore"):
-            residual = R.residual_warnings(fig, built, result.solution)
-        for w in residual:
-            m = re.match(r"goal (\d+): ", w)
-            if m is None:
-                self.warn(at, _sentence(w))
-                continue
+        for unmet in result.unmet or ():
             self.warn(
-                goals[int(m.group(1)) - 1][-1],
-                _sentence(w[m.end() :]),
+                goals[unmet.index][-1],
+                _sentence(unmet.sentence),
                 "the model cannot get there within its extremes, or other goals pull it away",
             )
+        with np.errstate(all="ignore"):
+            limit = result.limit_warning
+        if limit:
+            self.warn(at, _sentence(limit))
         return result.motion, Vec(float(t[0]), float(t[1]), float(t[2]))
 
     def motion_block(self, joints, at):

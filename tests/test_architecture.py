@@ -49,6 +49,7 @@ CONTRACT = {
         "liganimate.runtime.errors",
         "liganimate.runtime.values",
         "liganimate.runtime.limits",
+        "liganimate.runtime.files",
         "liganimate.runtime.figure",
         "liganimate.runtime.motion",
     ),
