@@ -336,8 +336,9 @@ class Lowerer:
             sname = bindings.plain_name(a[3])
             exts = ", ".join(self.expr(e) for e in a[5:])
             specs.append(
-                f"({self.expr(a[0])}, {pname!r}, {self.expr(a[1])}, {self.expr(a[2])}, "
-                f"{self.expr(a[3])}, {sname!r}, {self.expr(a[4])}, ({exts},), {self.at(j)})"
+                f"_host.JointArgs(jid={self.expr(a[0])}, primary_name={pname!r}, primary={self.expr(a[1])}, "
+                f"primary_location={self.expr(a[2])}, secondary={self.expr(a[3])}, secondary_name={sname!r}, "
+                f"secondary_location={self.expr(a[4])}, extremes=({exts},), at={self.at(j)})"
             )
         self.emit(f"{s.name.name} = rt.model_block({s.name.name!r}, (")
         for sp in specs:
@@ -364,8 +365,8 @@ class Lowerer:
         for g in s.goals:
             link = repr(g.link.name) if g.link is not None else "None"
             goals.append(
-                f"({g.kind!r}, {link}, {opt(g.joint)}, {opt(g.point)}, {opt(g.target)}, "
-                f"{opt(g.normal)}, {opt(g.weight)}, {self.at(g)})"
+                f"_host.GoalArgs(kind={g.kind!r}, link={link}, joint={opt(g.joint)}, point={opt(g.point)}, "
+                f"target={opt(g.target)}, normal={opt(g.normal)}, weight={opt(g.weight)}, at={self.at(g)})"
             )
         if s.joints is not None:
             movable = "('joints', (" + "".join(self.expr(j) + ", " for j in s.joints) + "))"

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import io
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -50,6 +51,46 @@ class Posed:
     def with_figure(self, figure: F.Figure) -> Posed:
         """The same pose on a changed figure (placement, main link...)."""
         return Posed(figure, self.motion, self.frame, self.statement)
+
+
+@dataclass(frozen=True, slots=True)
+class JointArgs:
+    """One JOINT line of a STARTMODEL block, as the compiled module passes it to :meth:`Runtime.model_block`.
+
+    ``primary_name`` and ``secondary_name`` are the variables named there
+    (None for an expression); ``extremes`` holds one to three (min, max)
+    pairs; ``at`` is the line's position index.
+    """
+
+    jid: int
+    primary_name: str | None
+    primary: object
+    primary_location: object
+    secondary: object
+    secondary_name: str | None
+    secondary_location: object
+    extremes: tuple
+    at: int
+
+
+@dataclass(frozen=True, slots=True)
+class GoalArgs:
+    """One GOAL line of a STARTREACH block, as the compiled module passes it to :meth:`Runtime.reach`.
+
+    ``kind`` is "point", "plane" or "axis"; the goal's link is named by
+    ``link`` or by ``joint`` (the joint whose secondary link it is); the
+    others are None where the line does not give them. ``at`` is the line's
+    position index.
+    """
+
+    kind: str
+    link: str | None
+    joint: int | None
+    point: object
+    target: object
+    normal: object
+    weight: float | None
+    at: int
 
 
 class Program:
@@ -346,21 +387,33 @@ class Runtime(Arithmetic):
     def model_block(self, name, specs, at):
         shapes = {}
         out = []
-        for index, (jid, pname, pshape, loc1, sec, sname, loc2, exts, jat) in enumerate(specs):
-            shapes[pname] = pshape
+        for index, j in enumerate(specs):
+            shapes[j.primary_name] = j.primary
+            sec, sname = j.secondary, j.secondary_name
             if isinstance(sec, (F.Figure, Posed)):
-                secondary, sshape = self._segment(sec, sname, jat), None
+                secondary, sshape = self._segment(sec, sname, j.at), None
             else:
                 if sec is None:
-                    self.fail(jat, f"{sname or 'a segment'} is used before it has a value")
-                secondary, sshape = (sname if sname is not None else f"<segment of joint {jid}>"), sec
-            out.append(F.JointSpec(jid, pname, loc1, secondary, sshape, loc2, exts, index))
+                    self.fail(j.at, f"{sname or 'a segment'} is used before it has a value")
+                secondary, sshape = (sname if sname is not None else f"<segment of joint {j.jid}>"), sec
+            out.append(
+                F.JointSpec(
+                    j.jid,
+                    j.primary_name,
+                    j.primary_location,
+                    secondary,
+                    sshape,
+                    j.secondary_location,
+                    j.extremes,
+                    index,
+                )
+            )
         try:
             figure, warnings = F.assemble(out, shapes)
         except LigError as exc:
             self.fail(at, _sentence(exc.message), exc.hint)
         for index, sentence in warnings:
-            self.warn(specs[index][-1], _sentence(sentence))
+            self.warn(specs[index].at, _sentence(sentence))
         return self._guard(at, limits.check_figure, figure, f"the model {name}")
 
     def figure(self, m, kind, arg, at):
@@ -424,11 +477,12 @@ class Runtime(Arithmetic):
         if frames < 0:
             self.fail(at, f"the solved pose's frame cannot be negative ({frames:g})")
         built = []
-        for kind, link, joint, point, target, normal, weight, gat in goals:
+        for g in goals:
+            kind, link, point, target, normal, weight, gat = g.kind, g.link, g.point, g.target, g.normal, g.weight, g.at
             # The goal's link is settled here, so that an unknown or ambiguous
             # name is reported at its own GOAL line.
             if link is None:
-                link = self._guard(gat, fig.joint, int(joint)).secondary
+                link = self._guard(gat, fig.joint, int(g.joint)).secondary
             else:
                 link, ambiguous = self._guard(gat, R.resolve_link, fig, link)
                 if ambiguous:
@@ -469,7 +523,7 @@ class Runtime(Arithmetic):
             )
         for unmet in result.unmet or ():
             self.warn(
-                goals[unmet.index][-1],
+                goals[unmet.index].at,
                 _sentence(unmet.sentence),
                 "the model cannot get there within its extremes, or other goals pull it away",
             )
