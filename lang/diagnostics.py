@@ -7,12 +7,11 @@ Python traceback ever reaches the user.
 
 from __future__ import annotations
 
-import difflib
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from .ast import Pos
 from .display import at_end, escape_text, last_line, render_line, source_line
+from .messages import closest, did_you_mean  # noqa: F401  (the one did-you-mean, re-exported)
 
 
 @dataclass(slots=True)
@@ -39,21 +38,6 @@ class LigDiagnostics(Exception):
 def error(filename: str, pos: Pos, message: str, hint: str | None = None, source: str | None = None) -> LigDiagnostics:
     """Build the exception for a single error (the caller raises it)."""
     return LigDiagnostics([Diagnostic(filename, pos, message, hint, "error", source)])
-
-
-def closest(name: str, candidates: Iterable[str], n: int = 3) -> list:
-    """The known names closest to ``name``, for 'did you mean' hints."""
-    return difflib.get_close_matches(name.upper(), sorted({c.upper() for c in candidates}), n=n, cutoff=0.6)
-
-
-def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
-    """A hint sentence naming the closest known names, or None."""
-    near = closest(name, candidates)
-    if not near:
-        return None
-    if len(near) == 1:
-        return f"did you mean {near[0]}?"
-    return "did you mean " + ", ".join(near[:-1]) + " or " + near[-1] + "?"
 
 
 def format_diagnostic(d: Diagnostic, source: str | None = None) -> str:

@@ -7,7 +7,25 @@ program's author reads one sentence for one rule, whichever stage found it.
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 from .numbers import MIN_FRAME_GAP
+
+
+def closest(name: str, candidates: Iterable[str], n: int = 3, cutoff: float = 0.6) -> list:
+    """The known names closest to ``name`` (compared upper-cased), best first, for 'did you mean' hints."""
+    return difflib.get_close_matches(name.upper(), sorted({c.upper() for c in candidates}), n=n, cutoff=cutoff)
+
+
+def did_you_mean(name: str, candidates: Iterable[str], cutoff: float = 0.6) -> str | None:
+    """The one 'did you mean' hint: a sentence naming the closest known names, or None if none is close."""
+    near = closest(name, candidates, cutoff=cutoff)
+    if not near:
+        return None
+    if len(near) == 1:
+        return f"did you mean {near[0]}?"
+    return "did you mean " + ", ".join(near[:-1]) + " or " + near[-1] + "?"
 
 
 def _num(x) -> str:

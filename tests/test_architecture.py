@@ -33,18 +33,21 @@ CONTRACT = {
     "liganimate.runtime.motion": ("liganimate.lang.numbers", "liganimate.lang.messages", "liganimate.runtime.errors"),
     "liganimate.runtime.figure": (
         "liganimate.lang.numbers",
+        "liganimate.lang.messages",
         "liganimate.runtime.errors",
         "liganimate.runtime.values",
         "liganimate.runtime.motion",
     ),
     "liganimate.runtime.ik": (
         "liganimate.lang.numbers",
+        "liganimate.lang.messages",
         "liganimate.runtime.errors",
         "liganimate.runtime.figure",
         "liganimate.runtime.motion",
     ),
     "liganimate.runtime.render": (
         "liganimate.lang.numbers",
+        "liganimate.lang.messages",
         "liganimate.lang.diagnostics",
         "liganimate.runtime.errors",
         "liganimate.runtime.values",

@@ -29,7 +29,6 @@ valid tree, though, and nothing relies on that order.
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -38,6 +37,7 @@ from typing import NamedTuple, overload
 
 import numpy as np
 
+from liganimate.lang import messages
 from liganimate.lang.numbers import INT_MAX, MAX_ANGLE, magnitude
 from liganimate.runtime.errors import FigureError
 
@@ -631,12 +631,11 @@ class Figure:
         found = self.links_named(name)
         if not found:
             names = sorted({l.name.upper() for l in self.links if l.name is not None})
-            close = difflib.get_close_matches(name.upper(), names, n=3, cutoff=0.5)
+            # Link names are short and often abbreviated: a looser match than for program names.
+            hint = messages.did_you_mean(name, names, cutoff=0.5)
             raise FigureError(
                 f"the model has no link named {name}.",
-                hint=f"did you mean {' or '.join(close)}?"
-                if close
-                else f"its links are named {', '.join(names) or 'nothing'}",
+                hint=hint or f"its links are named {', '.join(names) or 'nothing'}",
             )
         chosen = found[0]
         warning = None
