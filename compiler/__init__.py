@@ -57,12 +57,13 @@ def compile_source(
     path = path if path is not None else source.filename
     # The stages build trees and tables, not cycles: see lang/collector.py.
     with collector.paused():
-        names, failed = _scan_loads(source, path, stack)
+        opened: dict = {}  # library name -> Library or its failure, for this compile (library.open_library)
+        names, failed = _scan_loads(source, path, stack, opened)
         try:
             program = parse_source(source, names)
         except LigDiagnostics as exc:
             raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
-        checked = check(program, path=path, stack=stack)
+        checked = check(program, path=path, stack=stack, opened=opened)
         python = lower(checked, module_name or source.filename, consume)
     return Compiled(python, list(source.warnings) + checked.warnings, checked)
 
@@ -115,31 +116,23 @@ def load_program(path: str | None = None, *, text: str | None = None, name: str 
     return namespace["program"], warnings
 
 
-def _scan_loads(source: Source, path: str, stack: tuple) -> tuple:
-    """Load what the source's LOAD statements name, before parsing.
+def _scan_loads(source: Source, path: str, stack: tuple, opened: dict | None = None) -> tuple:
+    """Open what the source's LOAD statements name, before parsing (``library.open_library``).
 
     Returns ``(names, failed)``: the names of the primitives they bring, for
     the lexer, and ``[(library name, Pos, exception), ...]`` for each LOAD
     that failed in one of the ways a LOAD reports at its line
-    (``library.FAILURES``). The checker loads again and reports those; if
-    parsing fails first, :func:`compile_source` reports them itself. Any
-    other exception is a bug and is not swallowed.
+    (``library.FAILURES``). The checker reports those from ``opened``; if
+    parsing fails first, :func:`compile_source` reports them itself.
     """
-    import os
-
     from . import library
 
+    opened = {} if opened is None else opened
     names, failed = set(), []
-    requests = source.load_requests()
-    if not requests:
-        return names, failed
-    # The loading file joins the chain as the checker adds it, so a cycle is a LibraryCycle here too.
-    around = stack + ((os.path.abspath(path),) if path and not path.startswith("<") else ())
-    for lib_name, wanted, pos in requests:
-        try:
-            lib = library.load(lib_name, library.resolve(lib_name, path), around)
-        except library.FAILURES as exc:
-            failed.append((lib_name, pos, exc))
+    for lib_name, wanted, pos in source.load_requests():
+        lib = library.open_library(lib_name, path, stack, opened)
+        if isinstance(lib, Exception):
+            failed.append((lib_name, pos, lib))
             continue
         names.update(n for n in (wanted if wanted is not None else lib.signatures) if n in lib.signatures)
     return names, failed

@@ -82,8 +82,9 @@ class _Stop(Exception):
 class Checker:
     """Walks the tree once per scope, twice to settle implicit number types."""
 
-    def __init__(self, program: A.Program, path: str | None = None, stack: tuple = ()):
+    def __init__(self, program: A.Program, path: str | None = None, stack: tuple = (), opened: dict | None = None):
         self.program = program
+        self.opened = {} if opened is None else opened  # see library.open_library
         self.path = path if path is not None else program.filename
         self.stack = stack
         self.libraries: list = []
@@ -199,11 +200,9 @@ class Checker:
                 for name in bindings.defined(stmt):
                     defined.setdefault(name.name, name.pos)
                 continue
-            try:
-                path = L.resolve(stmt.library, self.path)
-                lib = L.load(stmt.library, path, self.stack + _here(self.path))
-            except L.FAILURES as exc:
-                message, hint, inner = L.failure(exc, stmt.library)
+            lib = L.open_library(stmt.library, self.path, self.stack, self.opened)
+            if isinstance(lib, Exception):
+                message, hint, inner = L.failure(lib, stmt.library)
                 self.errors.extend(inner)
                 self.err(stmt.library_pos, message, hint)
                 continue
@@ -1017,17 +1016,11 @@ def _prim_calls(node) -> set:
     return {n.name for n in _prim_call_nodes(node)}
 
 
-def check(program: A.Program, path: str | None = None, stack: tuple = ()) -> Checked:
+def check(program: A.Program, path: str | None = None, stack: tuple = (), opened: dict | None = None) -> Checked:
     """Check a parsed program; raise LigDiagnostics listing every error found.
 
     ``path`` is the program's file (relative LOADs start from its folder);
-    ``stack`` the libraries being loaded around it.
+    ``stack`` the libraries being loaded around it; ``opened`` the libraries
+    this compile has already opened (see ``library.open_library``).
     """
-    return Checker(program, path, stack).run()
-
-
-def _here(path: str | None) -> tuple:
-    """The loading file as the LOAD cycle check compares it (absolute), or nothing for text."""
-    import os
-
-    return (os.path.abspath(path),) if path and not path.startswith("<") else ()
+    return Checker(program, path, stack, opened).run()

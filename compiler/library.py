@@ -414,6 +414,27 @@ def failure(exc: Exception, name: str) -> tuple:
 FAILURES = (LibraryNotFound, LibraryCycle, LigDiagnostics, OSError)
 
 
+def open_library(name: str, loading_file: str | None, stack: tuple, opened: dict):
+    """The library a ``LOAD ... FROM 'name'`` opens, or the exception (one of FAILURES) saying why it cannot.
+
+    The one place a LOAD is resolved and loaded: before parsing (the lexer
+    needs the names of loaded primitives) and by the checker (which reports
+    failures at the LOAD's line), for one compile, through ``opened``, a
+    dict kept for that compile, so a library is resolved and loaded once.
+    ``stack`` is the chain of libraries being loaded around the loading
+    file; the file joins it here, so a cycle is a LibraryCycle.
+    """
+    found = opened.get(name)
+    if found is None:
+        around = stack + ((os.path.abspath(loading_file),) if loading_file and not loading_file.startswith("<") else ())
+        try:
+            found = load(name, resolve(name, loading_file), around)
+        except FAILURES as exc:
+            found = exc
+        opened[name] = found
+    return found
+
+
 def _has_scenes(stmts) -> bool:
     from liganimate.lang import ast as A
 
@@ -434,6 +455,7 @@ def forget() -> None:
 
 __all__ = [
     "FAILURES",
+    "open_library",
     "Library",
     "LibraryCycle",
     "LibraryNotFound",

@@ -307,3 +307,20 @@ def test_a_missing_standard_library_does_not_quote_where_the_package_lives(tmp_p
     assert "stdlib" not in r.stderr.split("hint:")[0] and "humanoid" in r.stderr
     r = cli("check", str(write(tmp_path, "LOAD 'lib/nowhere.lig'\n", "q.lig")), cwd=tmp_path)
     assert r.returncode == 1 and "looked for " in r.stderr and "nowhere.lig" in r.stderr
+
+
+def test_each_load_is_resolved_and_loaded_once_per_compile(monkeypatch):
+    # The lexer needs the loaded primitives before parsing and the checker
+    # reports at the LOAD line after: both read library.open_library's result.
+    calls = []
+    real = library.load
+    monkeypatch.setattr(library, "load", lambda *a, **k: calls.append(a[0]) or real(*a, **k))
+    compile_text("LOAD ARM FROM 'arm'\nLOAD ARM FROM 'arm'\nX = 1\n")
+    assert calls == ["arm"]
+
+
+def test_a_failing_library_is_reported_once_at_its_load():
+    with pytest.raises(LigDiagnostics) as info:
+        compile_text("LOAD X FROM 'no_such_library'\nY = 1\n")
+    found = [d for d in info.value.diagnostics if "no_such_library" in d.message]
+    assert len(found) == 1 and found[0].pos.line == 1
