@@ -469,15 +469,8 @@ def residual_warnings(figure: Figure, goals: Sequence, solution: PoseSolution) -
 
     The text of :func:`unmet_goals` (and of :attr:`Reach.limit_warning`),
     for callers that want sentences; code that needs the goal's index or
-    distance reads :class:`UnmetGoal` instead.
-
-    Parameters
-    ----------
-    figure : Figure
-    goals : sequence of PointGoal, PlaneGoal, AxisGoal
-        As given to the solve.
-    solution : PoseSolution
-        Unbatched.
+    distance reads :class:`UnmetGoal` instead.  The parameters are those of
+    :func:`unmet_goals`.
 
     Returns
     -------
