@@ -58,12 +58,16 @@ __all__ = [
     "SOLVERS",
     "SOLVER_NAMES",
     "SOLVER_KEYWORDS",
+    "DEFAULT_SOLVER",
     "SolveResult",
     "solve",
     "CONVERGED",
     "STALLED",
     "LIMIT",
 ]
+
+#: The solver used when none is named (the language's default too).
+DEFAULT_SOLVER = "dls"
 
 # Status codes per batch element.
 RUNNING, CONVERGED, STALLED, LIMIT = 0, 1, 2, 3
@@ -334,7 +338,7 @@ def solve(
     x0: np.ndarray,
     base: np.ndarray,
     *,
-    method: str = "dls",
+    method: str = DEFAULT_SOLVER,
     tolerance: float,
     max_iterations: int,
     restarts: int = 0,

@@ -611,6 +611,7 @@ def test_the_solver_registry_is_the_one_table_of_names_words_and_limits():
     assert DEFAULT_MAX_ITERATIONS == {name: spec.max_iterations for name, spec in S.SOLVERS.items()}
     assert DEFAULT_MAX_ITERATIONS == {"dls": 200, "transpose": 5000, "ccd": 500}
     assert not S.SOLVERS["ccd"].jacobian and S.SOLVERS["dls"].jacobian
+    assert S.DEFAULT_SOLVER == "dls" and S.DEFAULT_SOLVER in S.SOLVERS
     with pytest.raises(TypeError):
         S.SOLVERS["newton"] = S.SOLVERS["dls"]  # read-only: one table, not a copy per reader
 
