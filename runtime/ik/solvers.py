@@ -864,24 +864,12 @@ def _dls_one(
         )
         gave_up |= hopeless
         if (status == STALLED or status == LIMIT) and (attempts_left > 0 or st is not None):
+            # An attempt ended unconverged with restarts in play (some left, or
+            # some taken): _State restarts or resumes it, as for a batch.
             if st is None:
                 st = _attempts_of_one(prob, x0, first, evaluate, curvature, tol, max_iter, restarts, seed)
-            st.put(
-                0,
-                x=x,
-                r=r,
-                J=J,
-                f=f,
-                dist=dist,
-                status=status,
-                attempt_iter=attempt_iter,
-                window_f=window_f,
-                fast_f=fast_f,
-                gave_up=gave_up,
-                curv=curv,
-                mu=mu,
-                nu=nu,
-            )
+            attempt = (x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu)
+            st.put(0, **dict(zip(_ATTEMPT, attempt)))
             st.end_attempts(_ONE)
             x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = st.get(0, *_ATTEMPT)
             attempts_left = int(st.attempts_left[0])
