@@ -34,7 +34,7 @@ from liganimate.runtime.figure import pose as PO
 from liganimate.runtime.figure.tree import Figure
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
 from liganimate.runtime.ik.model import IKModel
-from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
+from liganimate.runtime.ik.solvers import CONVERGED, DEFAULT_SOLVER, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
 
 __all__ = [
@@ -301,7 +301,7 @@ def solve_pose(
     start=None,
     movable=None,
     translate: bool = False,
-    solver: str = "dls",
+    solver: str = DEFAULT_SOLVER,
     tolerance: float | None = None,
     max_iterations: int | None = None,
     restarts: int = 0,
@@ -328,7 +328,8 @@ def solve_pose(
         axis locked by its extremes (``min == max``).
     translate : bool, default False
         Whether the whole figure may also move (POSIT's root translation).
-    solver : {"dls", "transpose", "ccd"}, default "dls"
+    solver : str, default :data:`solvers.DEFAULT_SOLVER` ("dls")
+        A name in :data:`solvers.SOLVER_NAMES`: "dls", "transpose" or "ccd".
     tolerance : float, optional
         World units; default :data:`DEFAULT_TOLERANCE` times the figure's
         length.  The solve stops when every goal is this close (an axis goal
@@ -469,15 +470,8 @@ def residual_warnings(figure: Figure, goals: Sequence, solution: PoseSolution) -
 
     The text of :func:`unmet_goals` (and of :attr:`Reach.limit_warning`),
     for callers that want sentences; code that needs the goal's index or
-    distance reads :class:`UnmetGoal` instead.
-
-    Parameters
-    ----------
-    figure : Figure
-    goals : sequence of PointGoal, PlaneGoal, AxisGoal
-        As given to the solve.
-    solution : PoseSolution
-        Unbatched.
+    distance reads :class:`UnmetGoal` instead.  The parameters are those of
+    :func:`unmet_goals`.
 
     Returns
     -------
@@ -517,7 +511,7 @@ def reach(
     start=None,
     movable=None,
     translate: bool = False,
-    solver: str = "dls",
+    solver: str = DEFAULT_SOLVER,
     tolerance: float | None = None,
     max_iterations: int | None = None,
     restarts: int = 0,
@@ -590,7 +584,7 @@ def reach_keyframes(
     start=None,
     movable=None,
     translate: bool = False,
-    solver: str = "dls",
+    solver: str = DEFAULT_SOLVER,
     tolerance: float | None = None,
     max_iterations: int | None = None,
     restarts: int = 0,

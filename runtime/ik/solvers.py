@@ -58,12 +58,16 @@ __all__ = [
     "SOLVERS",
     "SOLVER_NAMES",
     "SOLVER_KEYWORDS",
+    "DEFAULT_SOLVER",
     "SolveResult",
     "solve",
     "CONVERGED",
     "STALLED",
     "LIMIT",
 ]
+
+#: The solver used when none is named (the language's default too).
+DEFAULT_SOLVER = "dls"
 
 # Status codes per batch element.
 RUNNING, CONVERGED, STALLED, LIMIT = 0, 1, 2, 3
@@ -334,7 +338,7 @@ def solve(
     x0: np.ndarray,
     base: np.ndarray,
     *,
-    method: str = "dls",
+    method: str = DEFAULT_SOLVER,
     tolerance: float,
     max_iterations: int,
     restarts: int = 0,
@@ -860,24 +864,12 @@ def _dls_one(
         )
         gave_up |= hopeless
         if (status == STALLED or status == LIMIT) and (attempts_left > 0 or st is not None):
+            # An attempt ended unconverged with restarts in play (some left, or
+            # some taken): _State restarts or resumes it, as for a batch.
             if st is None:
                 st = _attempts_of_one(prob, x0, first, evaluate, curvature, tol, max_iter, restarts, seed)
-            st.put(
-                0,
-                x=x,
-                r=r,
-                J=J,
-                f=f,
-                dist=dist,
-                status=status,
-                attempt_iter=attempt_iter,
-                window_f=window_f,
-                fast_f=fast_f,
-                gave_up=gave_up,
-                curv=curv,
-                mu=mu,
-                nu=nu,
-            )
+            attempt = (x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu)
+            st.put(0, **dict(zip(_ATTEMPT, attempt)))
             st.end_attempts(_ONE)
             x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = st.get(0, *_ATTEMPT)
             attempts_left = int(st.attempts_left[0])

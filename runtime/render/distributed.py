@@ -27,6 +27,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import itertools
+import logging
 import os
 import secrets
 import socket
@@ -65,6 +66,10 @@ class DaskExecutor:
     connect_timeout, worker_wait, close_wait : float, optional
         Seconds to reach the scheduler, to wait for a worker to join it,
         and for :meth:`shutdown` to wait for the tasks being drawn.
+    silence_logs : bool, optional
+        Keep Dask's log lines (reconnection attempts, with tracebacks) off
+        stderr while the executor is open; what goes wrong reaches the
+        caller as a :class:`RenderError` instead.  False leaves logging alone.
 
     Attributes
     ----------
@@ -87,10 +92,17 @@ class DaskExecutor:
         connect_timeout: float = CONNECT_TIMEOUT,
         worker_wait: float = WORKER_WAIT,
         close_wait: float = CLOSE_WAIT,
+        silence_logs: bool = True,
     ):
         self.retries = int(retries)
         self.close_wait = float(close_wait)
-        self._client, self._own = _connect(address, connect_timeout)
+        self._levels = _silence() if silence_logs else {}
+        try:
+            self._client, self._own = _connect(address, connect_timeout)
+        except BaseException:
+            _restore(self._levels)
+            raise
+        self.address = self._client.scheduler.address
         try:
             self.workers = _wait_for_workers(self._client, worker_wait)
             _check_workers(self._client)
@@ -136,15 +148,27 @@ class DaskExecutor:
             return
         future = entry[1]
         try:
-            if dask_future.status == "finished":
+            status = dask_future.status
+            if status == "finished":
                 future.set_result(dask_future.result())
-            elif dask_future.status == "cancelled":
-                future.set_exception(cf.CancelledError())
-            else:
+            elif status == "error":
                 future.set_exception(_worded(dask_future.exception()))
-        except BaseException as exc:  # the client closing under us, a result lost with its worker
+            else:
+                future.set_exception(self._lost(status))
+        except Exception as exc:  # the result could not be fetched
             if not future.done():
-                future.set_exception(_worded(exc))
+                future.set_exception(self._lost(exc))
+
+    def _lost(self, why) -> BaseException:
+        """A task that ended without a result: dropped by :meth:`shutdown`, or its scheduler lost."""
+        if self._closed:
+            return cf.CancelledError()
+        said = f" ({_why(why)})" if isinstance(why, BaseException) else ""
+        return RenderError(
+            f"the connection to the Dask scheduler at {self.address} was lost while drawing{said}; "
+            "the frames written before are complete",
+            "see the scheduler's log; render again when it runs",
+        )
 
     def shutdown(self, wait: bool = True, cancel_futures: bool = False) -> None:
         """Stop taking tasks, optionally drop those not started and wait for the rest, then disconnect.
@@ -186,10 +210,38 @@ class DaskExecutor:
                     future.set_exception(cf.CancelledError())
 
     def _close_client(self) -> None:
-        if self._own:
-            self._own = False
-            with contextlib.suppress(Exception):
-                self._client.close(timeout=self.close_wait)
+        try:
+            if self._own:
+                self._own = False
+                with contextlib.suppress(Exception):
+                    self._client.close(timeout=self.close_wait)
+        finally:
+            levels, self._levels = self._levels, {}
+            _restore(levels)
+
+
+# Loggers that print Dask's own troubles (with tracebacks) on stderr, and their children.
+_LOGGERS = ("distributed", "tornado")
+
+
+def _silence() -> dict:
+    """Turn Dask's loggers off; return their levels, for :func:`_restore`.
+
+    Dask's configuration gives some children levels of their own
+    (``distributed.client``), so each is set, not only the parents.
+    """
+    names = [n for n in list(logging.root.manager.loggerDict) if n.split(".")[0] in _LOGGERS]
+    levels = {}
+    for name in sorted(set(names) | set(_LOGGERS)):
+        logger = logging.getLogger(name)
+        levels[name] = logger.level
+        logger.setLevel(logging.CRITICAL + 1)
+    return levels
+
+
+def _restore(levels: dict) -> None:
+    for name, level in levels.items():
+        logging.getLogger(name).setLevel(level)
 
 
 def _connect(address, timeout: float):
@@ -235,6 +287,14 @@ def _probe(address: str, timeout: float) -> None:
 
 
 def _why(exc: BaseException) -> str:
+    """Why a connection failed, in a few words (Dask wraps the system's reason in its own exceptions)."""
+    cause = exc
+    while cause is not None and not (isinstance(cause, OSError) and cause.strerror):
+        cause = cause.__cause__ or cause.__context__
+    if cause is not None:
+        exc = cause
+    elif isinstance(exc, distributed.comm.CommClosedError):
+        return "the connection closed"
     if isinstance(exc, socket.gaierror):
         return "the host name is not known"
     if isinstance(exc, (TimeoutError, socket.timeout)) or "Timed out" in str(exc):

@@ -32,13 +32,16 @@ from liganimate.runtime.errors import RenderError
 from liganimate.runtime.files import AtomicWriter, publish, temporary_beside, write_error
 from liganimate.runtime.render.imagefiles import check_image
 
-# x264 presets, fastest first; chosen from by measurement (docs/semantics-render.md):
-# on 640x480 frames of five flat-shaded figures, veryfast at CRF 18 takes
-# 2.8 core-ms a frame (medium 5) for files 15% larger than medium's, at a
-# PSNR of 48.6 dB against the frames drawn (medium 50.6).
+# x264 presets, fastest first.  The defaults were chosen by measurement
+# (docs/semantics-render.md has the table): on 640x480 frames of five
+# flat-shaded figures, superfast at CRF 20 takes about 2 core-ms a frame
+# (veryfast 2.8, medium 5) at a PSNR of 52 dB against the frames drawn
+# (medium at CRF 18: 50.6), for files of 2.7 kB a frame (medium's 1.4):
+# the film of 170,000 frames fits the quarter of an hour on two cores, and
+# the files stay small.
 PRESETS = ("ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower", "veryslow")
-DEFAULT_PRESET = "veryfast"
-DEFAULT_CRF = 18
+DEFAULT_PRESET = "superfast"
+DEFAULT_CRF = 20
 MAX_CRF = 51
 # x264's output depends on its number of threads: a fixed number gives the
 # same bytes on every machine (and two keep a core busy beside the drawing).

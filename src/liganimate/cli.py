@@ -60,12 +60,17 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="image size (default 640x480)")
     p.add_argument("--gif", metavar="FILE", help="write an animated GIF")
     p.add_argument("--mp4", metavar="FILE", help="write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)")
-    p.add_argument("--crf", default=None, metavar="N", help="MP4 quality, 0 (lossless) to 51 (default 18)")
+    p.add_argument(
+        "--crf",
+        default=None,
+        metavar="N",
+        help="MP4 quality, 0 (lossless) to 51 (default 20); lower is better and larger",
+    )
     p.add_argument(
         "--preset",
         default=None,
         metavar="NAME",
-        help="MP4 encoding speed, ultrafast to veryslow (default veryfast); slower makes smaller files",
+        help="MP4 encoding speed, ultrafast to veryslow (default superfast); slower makes smaller files",
     )
     p.add_argument("--poses", metavar="FILE", help="write the pose record (JSON Lines, see docs/poses.md)")
     p.add_argument("--fps", default="24", help="frame rate of the GIF and MP4, 0.01 to 1000 (default 24)")

@@ -296,3 +296,81 @@ def test_a_cluster_whose_workers_lack_liganimate_is_refused_in_words(tmp_path, m
         with pytest.raises(RenderError) as err:
             DaskExecutor(bare)
     assert err.value.message.endswith("cannot import liganimate; install the same liganimate on every worker")
+
+
+def _wait_for(predicate, seconds: float = 60.0):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError("timed out")
+
+
+def test_a_scheduler_lost_mid_render_is_one_sentence_and_the_frames_before_are_whole(tmp_path, capfd):
+    # A scheduler of its own, in a process that can be killed (a LocalCluster's lives in this one).
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    dask = [sys.executable, "-m", "dask"]
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    scheduler = subprocess.Popen([*dask, "scheduler", "--port", str(port), "--dashboard-address", ":0"], **quiet)
+    worker = None
+    try:
+        _wait_for(lambda: _listening(port))
+        worker = subprocess.Popen([*dask, "worker", address, "--nworkers", "1", "--nthreads", "1"], **quiet)
+        flag = tmp_path / "drawing"
+
+        def kill_scheduler():
+            _wait_for(flag.exists, 120)
+            scheduler.kill()
+
+        killer = threading.Thread(target=kill_scheduler, daemon=True)
+        killer.start()
+        out = tmp_path / "frames"
+        program, _ = load_program(str(swing(tmp_path, ticks=400)))
+        executor = HookedExecutor(address, hook=_mark_then_draw(str(flag)), worker_wait=60)
+        capfd.readouterr()
+        with pytest.raises(RenderError) as err:
+            program.render(str(out), size=SIZE, quiet=True, executor=executor)
+        killer.join(5)
+    finally:
+        scheduler.kill()
+        if worker is not None:
+            worker.kill()
+            worker.wait(30)
+        scheduler.wait(30)
+    assert err.value.message.startswith(f"the connection to the Dask scheduler at {address} was lost while drawing")
+    assert "Traceback" not in capfd.readouterr().err  # Dask's reconnection attempts are not printed
+    names = sorted(p.name for p in (out / "scene1").iterdir())
+    assert names == [f"{i:05d}.png" for i in range(len(names))] and len(names) < 400  # whole, no gaps
+
+
+def _listening(port: int) -> bool:
+    with socket.socket() as s:
+        return s.connect_ex(("127.0.0.1", port)) == 0
+
+
+def _mark_then_draw(flag: str):
+    """A task that says drawing has begun, then draws slowly enough for the render to be cut off midway."""
+
+    def hook(fn, *args):
+        time.sleep(0.05)
+        with open(flag, "a") as f:
+            f.write("x")
+        return fn(*args)
+
+    return hook
+
+
+def test_dask_logging_is_silenced_while_the_executor_is_open_and_restored_after(cluster):
+    import logging
+
+    client_log = logging.getLogger("distributed.client")
+    before = client_log.level
+    ex = DaskExecutor(cluster)
+    assert not client_log.isEnabledFor(logging.CRITICAL)
+    ex.shutdown()
+    assert client_log.level == before
+    DaskExecutor(cluster, silence_logs=False).shutdown()
+    assert client_log.level == before
