@@ -19,14 +19,13 @@ from liganimate.lang import ast as A
 from liganimate.lang import bindings, messages, numbers
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
 from liganimate.lang.vocabulary import DRAW_WITH, MODIFIERS
+from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS  # the solver registry, by name only
 from liganimate.runtime.motion import interpolation
 
 from . import types as T
 from .primitives import builtin_signatures, signature_from_pattern
 
 MAX_ERRORS = 20
-# REACH solvers: the language's word -> the runtime's name (runtime/solvers.py).
-_SOLVERS = {"DLS": "dls", "TRANSPOSE": "transpose", "CCD": "ccd"}
 
 
 @dataclass
@@ -627,9 +626,11 @@ class Checker:
             self._want(s.chain, T.INTEGER, "a chain length")
         if s.translate is not None:
             self._define_as(s.translate, T.VECTOR, "{name} is {noun}; TRANSLATE INTO needs a VECTOR")
-        if s.solver is not None and s.solver.name not in _SOLVERS:
-            hint = did_you_mean(s.solver.name, list(_SOLVERS))
-            self.err(s.solver, f"{s.solver.name} is not a solver", hint or "the solvers are " + ", ".join(_SOLVERS))
+        if s.solver is not None and s.solver.name not in SOLVER_KEYWORDS:
+            hint = did_you_mean(s.solver.name, list(SOLVER_KEYWORDS))
+            self.err(
+                s.solver, f"{s.solver.name} is not a solver", hint or "the solvers are " + ", ".join(SOLVER_KEYWORDS)
+            )
         if s.tolerance is not None:
             self._want_number(s.tolerance, "the tolerance")
         if s.iterations is not None:

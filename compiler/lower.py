@@ -19,9 +19,10 @@ from liganimate.lang import ast as A
 from liganimate.lang import bindings
 from liganimate.lang import numbers as N
 from liganimate.lang.vocabulary import MODIFIERS
+from liganimate.runtime.ik.solvers import DEFAULT_SOLVER, SOLVER_KEYWORDS
 
 from . import types as T
-from .check import _SOLVERS, Checked, expr_type
+from .check import Checked, expr_type
 
 _ZERO = {
     T.INTEGER: "0",
@@ -374,7 +375,7 @@ class Lowerer:
             movable = f"('chain', {self.expr(s.chain)})"
         else:
             movable = "None"
-        solver = repr(_SOLVERS[s.solver.name]) if s.solver is not None else "'dls'"
+        solver = repr(SOLVER_KEYWORDS[s.solver.name] if s.solver is not None else DEFAULT_SOLVER)
         method = repr(s.method.name) if s.method is not None else "'LINEAR'"
         target = f"{s.name.name}, {s.translate.name}" if s.translate is not None else f"{s.name.name}, _"
         self.emit(f"{target} = rt.reach({self.expr(s.model)}, {opt(s.start)}, {self.expr(s.frames)}, {method}, (")

@@ -25,8 +25,9 @@ CONTRACT = {
     "liganimate.lang": (),
     "liganimate.compiler": (
         "liganimate.lang",
-        # The runtime's vocabularies, by name only: the interpolation methods a program may name.
+        # The runtime's vocabularies, by name only: the interpolation methods and solvers a program may name.
         "liganimate.runtime.motion.interpolation",
+        "liganimate.runtime.ik.solvers",
         # compiler.load_program executes the module it lowered, piece by piece.
         "liganimate.runtime.loader",
     ),
