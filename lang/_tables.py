@@ -5,7 +5,7 @@ the tables are shipped). A string literal, because Python reads one in a few
 milliseconds even where it may not write bytecode caches.
 """
 
-GRAMMAR_SHA256 = '7fea1d3cdb2cb47d2a9e2210be7b77f0b396d5e40720065ec1bbb9fec5b688d8'
+GRAMMAR_SHA256 = '1d06bd9b71f80a74ce90435eae4fbe4744d9e7aef0016c18bf0cfc2d5f0736b6'
 LARK_VERSION = '1.3.1'
 
 TABLES_JSON = (
@@ -660,7 +660,7 @@ TABLES_JSON = (
     '[55,{"name":"PRINT","pattern":{"value":"PRINT\\\\b(?!\\\\s*(:-|:=|=|\\\\[))","flags":["i"],"raw":"/PRINT\\\\b(?!\\\\s*(:-|:=|=|\\\\[))/i","_width":null,"__type__":"PatternRE"},"priority":2,"__type__":"TerminalDef"}],\n'
     '[56,{"name":"REPEAT","pattern":{"value":"REPEAT","flags":["i"],"raw":"\\"REPEAT\\"i","__type__":"PatternStr"},"priority":0,"__type__":"TerminalDef"}],\n'
     '[57,{"name":"RETURN","pattern":{"value":"RETURN","flags":["i"],"raw":"\\"RETURN\\"i","__type__":"PatternStr"},"priority":0,"__type__":"TerminalDef"}],\n'
-    '[58,{"name":"ROOT","pattern":{"value":"ROOT","flags":["i"],"raw":"\\"ROOT\\"i","__type__":"PatternStr"},"priority":0,"__type__":"TerminalDef"}],\n'
+    '[58,{"name":"ROOT","pattern":{"value":"ROOT\\\\b(?!\\\\s*(:-|:=|=|\\\\[))","flags":["i"],"raw":"/ROOT\\\\b(?!\\\\s*(:-|:=|=|\\\\[))/i","_width":null,"__type__":"PatternRE"},"priority":2,"__type__":"TerminalDef"}],\n'
     '[59,{"name":"ROT","pattern":{"value":"ROT","flags":["i"],"raw":"\\"ROT\\"i","__type__":"PatternStr"},"priority":0,"__type__":"TerminalDef"}],\n'
     '[60,{"name":"SAMEFRAME","pattern":{"value":"SAMEFRAME","flags":["i"],"raw":"\\"SAMEFRAME\\"i","__type__":"PatternStr"},"priority":0,"__type__":"TerminalDef"}],\n'
     '[61,{"name":"SCALE","pattern":{"value":"SCALE","flags":["i"],"raw":"\\"SCALE\\"i","__type__":"PatternStr"},"priority":0,"__type__":"TerminalDef"}],\n'

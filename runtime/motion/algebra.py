@@ -812,7 +812,8 @@ def synchronize(*motions: Motion) -> Motion:
         if not isinstance(m, Motion):
             raise MotionError(f"operand {i} of SYNCHRONIZE is not a motion")
         if m._root is not None:
-            if root is not None:
+            # The same path twice (two STRIPs of one motion) is one path, not two.
+            if root is not None and m._root is not root:
                 raise MotionError(
                     f"the root track is driven by both operand {root_owner} and operand {i} of SYNCHRONIZE",
                     hint="a figure travels along one path: build one of them without a ROOT track",
