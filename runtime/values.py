@@ -1,9 +1,15 @@
 """Host values: 3-vectors and graphical objects.
 
 A :class:`Graphical` is an immutable set of flat-shaded triangles in its own
-coordinates, each with a LIGHTNESS (0 black .. 100 white) and a flag saying
-whether it belongs to a closed, outward-wound solid (so the rasterizer may
-cull it when it faces away).
+coordinates, each with a LIGHTNESS (0 black .. 100 white), optionally a
+COLOUR, and a flag saying whether it belongs to a closed, outward-wound solid
+(so the rasterizer may cull it when it faces away).
+
+Colour is an extension: a triangle's COLOUR (r, g, b), each 0..100, is the
+colour of a surface that LIGHTNESS then lights, so the drawn channel is
+``LIGHTNESS * c / 100``. White (100, 100, 100) is the thesis' grey exactly,
+which is why a program that never says COLOUR draws the same bytes as
+before, and why the BOX's brighter top and sides stay brighter in colour.
 """
 
 from __future__ import annotations
@@ -63,15 +69,35 @@ class Graphical:
     closed : ndarray of bool, shape (N,)
         True where the triangle is part of a closed solid wound
         counter-clockwise seen from outside.
+    colour : ndarray, shape (N, 3), or None
+        Each triangle's COLOUR, components 0..100 (clipped when drawn); None
+        when every triangle is white, as in the thesis.
     """
 
-    __slots__ = ("_extent", "closed", "lightness", "triangles")
+    __slots__ = ("_extent", "closed", "colour", "lightness", "triangles")
 
-    def __init__(self, triangles, lightness, closed):
+    def __init__(self, triangles, lightness, closed, colour=None):
         self.triangles = np.ascontiguousarray(triangles, dtype=np.float64).reshape(-1, 3, 3)
         self.lightness = np.asarray(lightness, dtype=np.float64).reshape(-1)
         self.closed = np.asarray(closed, dtype=bool).reshape(-1)
+        self.colour = None if colour is None else np.asarray(colour, dtype=np.float64).reshape(-1, 3)
         self._extent = None
+
+    def colours(self) -> np.ndarray:
+        """Every triangle's COLOUR, white where none was given: shape (N, 3), components 0..100."""
+        if self.colour is not None:
+            return self.colour
+        return np.full((len(self), 3), 100.0)
+
+    def shades(self) -> np.ndarray:
+        """What the rasterizer draws: 8-bit grey levels, shape (N,), or RGB levels, shape (N, 3).
+
+        Grey when the object has no COLOUR, so greyscale programs draw
+        exactly the bytes they always did; see :func:`colour_levels`.
+        """
+        if self.colour is None:
+            return grey_levels(self.lightness)
+        return colour_levels(self.lightness, self.colour)
 
     def extent(self) -> float:
         """The largest coordinate magnitude of any vertex (0 when empty; NaN if one is NaN)."""
@@ -93,10 +119,14 @@ class Graphical:
             anything is allocated, so ``G = G + G`` in a loop fails cleanly).
         """
         check_triangles(len(self) + len(other), "the superposed object")
+        colour = None
+        if self.colour is not None or other.colour is not None:
+            colour = np.concatenate([self.colours(), other.colours()])
         return Graphical(
             np.concatenate([self.triangles, other.triangles]),
             np.concatenate([self.lightness, other.lightness]),
             np.concatenate([self.closed, other.closed]),
+            colour,
         )
 
     def transformed(self, matrix) -> Graphical:
@@ -105,11 +135,16 @@ class Graphical:
         tris = self.triangles @ m[:3, :3].T + m[:3, 3]
         if np.linalg.det(m[:3, :3]) < 0:
             tris = tris[:, ::-1, :]
-        return Graphical(tris, self.lightness, self.closed)
+        return Graphical(tris, self.lightness, self.closed, self.colour)
 
     def with_lightness(self, lightness: float) -> Graphical:
-        """Every triangle at one lightness."""
-        return Graphical(self.triangles, np.full(len(self), _clip_lightness(lightness)), self.closed)
+        """Every triangle at one lightness (its colour, if any, kept: LIGHTNESS lights it)."""
+        return Graphical(self.triangles, np.full(len(self), _clip_lightness(lightness)), self.closed, self.colour)
+
+    def with_colour(self, colour) -> Graphical:
+        """Every triangle of one COLOUR ``(r, g, b)``, each 0..100; lightnesses kept."""
+        rgb = np.array([_clip_lightness(c) for c in colour], dtype=np.float64)
+        return Graphical(self.triangles, self.lightness, self.closed, np.broadcast_to(rgb, (len(self), 3)).copy())
 
 
 EMPTY = Graphical(np.zeros((0, 3, 3)), np.zeros(0), np.zeros(0, dtype=bool))
@@ -119,6 +154,30 @@ def grey_levels(lightness) -> np.ndarray:
     """LIGHTNESS (0..100, clipped) to 8-bit grey levels, rounding half up."""
     l = np.clip(np.asarray(lightness, dtype=np.float64), 0.0, 100.0)
     return np.floor(l * 2.55 + 0.5).astype(np.uint8)
+
+
+def colour_levels(lightness, colour) -> np.ndarray:
+    """LIGHTNESS (N,) lighting COLOUR (N, 3), both 0..100 and clipped, to 8-bit RGB levels (N, 3).
+
+    Channel ``c`` is the grey level (:func:`grey_levels`) of
+    ``LIGHTNESS * c / 100``, so white (100) gives exactly the grey levels.
+    """
+    l = np.clip(np.asarray(lightness, dtype=np.float64), 0.0, 100.0)[:, None]
+    c = np.clip(np.asarray(colour, dtype=np.float64), 0.0, 100.0)
+    # l * 100 / 100 is l exactly in binary, which keeps white exact.
+    return grey_levels(l * c / 100.0)
+
+
+def joined_shades(shades) -> np.ndarray:
+    """Concatenate per-triangle shades, grey (N,) and RGB (N, 3) alike.
+
+    All grey stays grey; any RGB part makes the result RGB, a grey level g
+    becoming (g, g, g), which is what it looks like.
+    """
+    shades = list(shades)
+    if all(s.ndim == 1 for s in shades):
+        return np.concatenate(shades) if shades else np.zeros(0, dtype=np.uint8)
+    return np.concatenate([np.repeat(s[:, None], 3, axis=1) if s.ndim == 1 else s for s in shades])
 
 
 MAX_TRIANGLES = 10_000_000
@@ -144,16 +203,22 @@ def check_triangles(n: int, what: str) -> None:
 
 
 class Canvas:
-    """What a PRIMITIVE draws into: DRAW WITH <LIGHTNESS l> and DRAW POLY."""
+    """What a PRIMITIVE draws into: DRAW WITH <LIGHTNESS l>, DRAW WITH <COLOUR c> and DRAW POLY."""
 
     def __init__(self):
         self.polys: list = []
         self.light = 40.0
+        self.tint: tuple | None = None
+        self.tints: list = []  # per polygon, when any polygon has a colour
         self.triangles = 0
 
     def lightness(self, value) -> None:
         """Set the lightness of the polygons drawn next (clipped to 0..100 when drawn)."""
         self.light = _clip_lightness(value)
+
+    def colour(self, value) -> None:
+        """Set the COLOUR ``(r, g, b)`` of the polygons drawn next (each clipped to 0..100 when drawn)."""
+        self.tint = tuple(_clip_lightness(c) for c in value)
 
     def poly(self, points, at=None) -> None:
         """Add a polygon; a closing point equal to the first is dropped.
@@ -179,10 +244,17 @@ class Canvas:
         self.triangles += len(pts) - 2
         check_triangles(self.triangles, "the primitive's drawing")
         self.polys.append((np.asarray(pts, dtype=np.float64), self.light))
+        self.tints.append(self.tint)
 
     def result(self) -> Graphical:
         """The drawn polygons as one Graphical (fan-triangulated, solids detected)."""
-        return polygons_to_graphical(self.polys)
+        g = polygons_to_graphical(self.polys)
+        if all(t is None for t in self.tints):
+            return g
+        white = (100.0, 100.0, 100.0)
+        per_poly = np.array([white if t is None else t for t in self.tints], dtype=np.float64)
+        counts = [len(p) - 2 for p, _ in self.polys]
+        return Graphical(g.triangles, g.lightness, g.closed, np.repeat(per_poly, counts, axis=0))
 
 
 def polygons_to_graphical(polys) -> Graphical:
@@ -203,12 +275,12 @@ def polygons_to_graphical(polys) -> Graphical:
             tris.append((pts[0], pts[k], pts[k + 1]))
             light.append(l)
             owner.append(i)
-    tris = np.asarray(tris, dtype=np.float64)
+    corners = np.asarray(tris, dtype=np.float64)
     side = np.asarray(_solid_orientation(polys), dtype=np.int8)[owner]
     flip = side < 0
     if flip.any():
-        tris[flip] = tris[flip][:, ::-1, :]
-    return Graphical(tris, light, side != 0)
+        corners[flip] = corners[flip][:, ::-1, :]
+    return Graphical(corners, light, side != 0)
 
 
 def _solid_orientation(polys) -> list:

@@ -360,3 +360,26 @@ def assert_runs_or_is_diagnosed(text: str, limit: float = 2.0, budget: float = 1
         f"--- minimised program ---\n{_MINIMISED[text]}"
         f"--- generated program ---\n{text}"
     ) from out.exc
+
+
+def seeded_programs(cases: int):
+    """Decorate a test ``f(rng)`` to run on ``cases`` seeded random generators, the same ones every run.
+
+    Hypothesis only supplies the seeds (derandomized, no example database,
+    no shrinking phase: :func:`minimise` shrinks a failing program instead),
+    so the fuzz tests are reproducible in CI and on a laptop alike.
+    """
+    from hypothesis import HealthCheck, Phase, given, settings
+    from hypothesis import strategies as st
+
+    def wrap(test):
+        return settings(
+            max_examples=cases,
+            derandomize=True,
+            deadline=None,
+            database=None,
+            phases=(Phase.explicit, Phase.generate),
+            suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.large_base_example],
+        )(given(rng=st.randoms(use_true_random=False))(test))
+
+    return wrap

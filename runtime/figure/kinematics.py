@@ -414,7 +414,7 @@ def free_axes(figure: Figure) -> dict[int, tuple[bool, bool, bool]]:
     """
     ext = figure.extremes
     free = ext[..., 1] - ext[..., 0] >= 360.0
-    return {jid: tuple(bool(f) for f in row) for jid, row in zip(figure.joint_ids, free)}
+    return {jid: (bool(row[0]), bool(row[1]), bool(row[2])) for jid, row in zip(figure.joint_ids, free)}
 
 
 def clamp(figure: Figure, angles, out=None) -> np.ndarray:

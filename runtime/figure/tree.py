@@ -34,7 +34,7 @@ import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import NamedTuple
+from typing import NamedTuple, overload
 
 import numpy as np
 
@@ -61,6 +61,10 @@ AXES = ("X", "Y", "Z")
 # --------------------------------------------------------------------------
 
 
+@overload
+def _key(name: str) -> str: ...
+@overload
+def _key(name: None) -> None: ...
 def _key(name: str | None) -> str | None:
     # LIG ANIMATE translates identifiers to upper case, so FOOT and foot are
     # the same segment name.
@@ -309,7 +313,8 @@ class Figure:
     links: tuple[Link, ...]
     joints: tuple[Joint, ...] = ()
     root: int = 0
-    main: int | None = None
+    # None means the root; __post_init__ always stores an int, which is what readers see.
+    main: int = None  # type: ignore[assignment]
     placement: np.ndarray | None = None
 
     def __post_init__(self) -> None:
@@ -493,9 +498,9 @@ class Figure:
                         rows.append((k, link, other, rev))
             if not rows:
                 break
-            k, parents, children, rev = (np.array(c) for c in zip(*rows))
+            ks, parents, children, revs = (np.array(c) for c in zip(*rows))
             levels.append(
-                TraversalLevel(k.astype(np.intp), parents.astype(np.intp), children.astype(np.intp), rev.astype(bool))
+                TraversalLevel(ks.astype(np.intp), parents.astype(np.intp), children.astype(np.intp), revs.astype(bool))
             )
             frontier = [r[2] for r in rows]
         return tuple(levels)
@@ -640,7 +645,7 @@ class Figure:
             parent = self.parent_joint_of(chosen)
             which = "the original main link itself" if parent is None else f"the one attached by joint {parent.id}"
             # found[1:] are never the root (it comes first in pre-order), so each has a joint.
-            alts = [str(self.parent_joint_of(i).id) for i in found[1:]]
+            alts = [str(j.id) for i in found[1:] if (j := self.parent_joint_of(i)) is not None]
             more = f" (or {', '.join(alts[1:])})" if len(alts) > 1 else ""
             warning = (
                 f"{len(found)} links are named {name}; FIGURE {m} MAIN LINK {name} uses {which} "
@@ -737,7 +742,7 @@ class Figure:
         return "\n".join(_table(rows))
 
 
-def _table(rows: list[tuple[str, ...]], indent: str = "") -> list[str]:
+def _table(rows: Sequence[tuple[str, ...]], indent: str = "") -> list[str]:
     widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
     return [indent + "  ".join(cell.ljust(w) for cell, w in zip(r, widths)).rstrip() for r in rows]
 
@@ -903,23 +908,23 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
     for s in specs:
         if _key(s.primary_name) not in secondary_names:
             roots.setdefault(_key(s.primary_name), s.primary_name)
-    roots = list(roots.values())
-    if not roots:
+    root_names = list(roots.values())
+    if not root_names:
         raise FigureError(
             "no segment can be the main link: every segment is a secondary somewhere, so the model has a cycle.",
             hint="the main link must appear only as a primary segment",
         )
-    if len(roots) > 1:
+    if len(root_names) > 1:
         raise FigureError(
-            f"the model is not one tree: {', '.join(roots)} are each used only as primary segments, "
+            f"the model is not one tree: {', '.join(root_names)} are each used only as primary segments, "
             "so each would be a main link.",
             hint="join the pieces together, or check the spelling of the segment names",
         )
-    root_link = Link(roots[0], _lookup_shape(shapes, roots[0]))
+    root_link = Link(root_names[0], _lookup_shape(shapes, root_names[0]))
 
     # 3. Candidate links per name: (textual position of creator, link in piece);
     #    the root's creator is position -1 ("created first").
-    candidates: dict[str, list[tuple[int, int]]] = {_key(root_link.name): [(-1, 0)]}
+    candidates: dict[str, list[tuple[int, int]]] = {_key(root_names[0]): [(-1, 0)]}
     for pos, piece in enumerate(pieces):
         for local in piece.preorder:
             name = piece.links[local].name

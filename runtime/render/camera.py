@@ -122,6 +122,32 @@ class Camera:
         if not (math.isfinite(self.near) and self.near > 0.0):
             raise RenderError(f"The near clipping distance must be positive, not {near!r}.")
         self.axes = np.stack([right, up, forward])
+        self._supersampled: dict = {}
+
+    def supersampled(self, factor: int) -> Camera:
+        """The same view with ``factor`` times as many pixels in each direction.
+
+        Pixel ``(i, j)`` of this camera covers the ``factor x factor``
+        pixels ``(factor i + a, factor j + b)`` of the result, whose centres
+        form a regular grid inside it.  The result is remembered.
+
+        Parameters
+        ----------
+        factor : int
+            A whole number, at least 1.
+
+        Returns
+        -------
+        Camera
+            ``self`` when ``factor`` is 1.
+        """
+        if factor == 1:
+            return self
+        cam = self._supersampled.get(factor)
+        if cam is None:
+            W, H = self.size
+            cam = self._supersampled[factor] = Camera(self.point, self.width, (W * factor, H * factor), self.near)
+        return cam
 
     def __repr__(self) -> str:
         return f"Camera(point={self.point.tolist()}, width={self.width}, size={self.size})"

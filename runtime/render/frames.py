@@ -79,6 +79,15 @@ class Renderer:
     workers : int or None
         Processes rasterizing in parallel (default: the machine's cores, at
         most 8); 1 draws everything in this process.
+    aa : int
+        Anti-aliasing factor, 1 (none, the default) or more: each image is
+        drawn at ``aa`` times its size in each direction and averaged down.
+    executor : object or None
+        Where images are drawn instead of a pool of local processes: any
+        object with ``submit(fn, *args) -> concurrent.futures.Future`` and
+        ``shutdown(wait=True, cancel_futures=False)``, such as
+        :class:`liganimate.runtime.render.distributed.DaskExecutor`.  The
+        renderer uses it for every image and shuts it down when closed.
 
     Raises
     ------
@@ -100,7 +109,19 @@ class Renderer:
         workers=None,
         stdout=None,
         progress=None,
+        aa=1,
+        executor=None,
     ):
+        try:
+            self._init(out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor)
+        except BaseException:
+            if executor is not None:
+                executor.shutdown(wait=False, cancel_futures=True)
+            raise
+
+    def _init(self, out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor) -> None:
+        self.aa = check_aa(aa, "aa=")
+        self.executor = executor
         check_outputs(out_dir, gif, mp4, poses, fps, KEYWORD_NAMES, make_poses_folder=True)
         self.out_dir = out_dir
         self.size = (int(size[0]), int(size[1]))
@@ -274,6 +295,9 @@ class Renderer:
         chunk, self._chunk = self._chunk, []
         if not chunk:
             return
+        if self.pool is None and self.executor is not None:
+            self.pool = self.executor
+            self._worker_procs = []
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
             self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init, initargs=(os.getpid(),))
             self._worker_procs: list = []
@@ -282,17 +306,17 @@ class Renderer:
             # ignore them; this process receives it once the mask is restored.
             old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
             try:
-                self.futures.append(self.pool.submit(draw_images, self.size, chunk))
+                self.futures.append(self.pool.submit(draw_images, self.size, chunk, self.aa))
                 self._worker_procs = list((getattr(self.pool, "_processes", None) or {}).values())
             finally:
                 signal.pthread_sigmask(signal.SIG_SETMASK, old)
             return
         if self.pool is None:
-            draw_images(self.size, chunk)
+            draw_images(self.size, chunk, self.aa)
             return
-        self.futures.append(self.pool.submit(draw_images, self.size, chunk))
+        self.futures.append(self.pool.submit(draw_images, self.size, chunk, self.aa))
         # Enough in flight to keep every worker busy, no more (memory stays flat).
-        while len(self.futures) > 2 * self.workers:
+        while len(self.futures) > 2 * max(self.workers, 2):
             _result(self.futures.pop(0))
 
     def _show_progress(self) -> None:
@@ -357,7 +381,14 @@ class Renderer:
 
     def _stop_pool(self) -> None:
         pool, self.pool = self.pool, None
-        self.futures, self._chunk = [], []
+        futures, self.futures, self._chunk = self.futures, [], []
+        executor, self.executor = self.executor, None
+        if executor is not None:
+            # Not started: dropped; being drawn: waited for, so every file is whole.
+            for f in futures:
+                f.cancel()
+            executor.shutdown(wait=True, cancel_futures=True)
+            return
         if pool is None:
             return
         procs = self._worker_procs
@@ -418,7 +449,7 @@ def _worker_init(parent: int) -> None:
     mallopt(M_TRIM_THRESHOLD, 256 << 20)
 
 
-def draw_images(size, chunk) -> None:
+def draw_images(size, chunk, aa=1) -> None:
     """Draw and write several images: ``chunk`` is a list of (path, draws) (a worker's task).
 
     Each image is encoded and written by a helper thread while the next one
@@ -430,7 +461,7 @@ def draw_images(size, chunk) -> None:
     writes = []
     try:
         for path, draws in chunk:
-            writes.append(writer.submit(write_png, path, draw(size, draws)))
+            writes.append(writer.submit(write_png, path, draw(size, draws, aa)))
     finally:
         for w in writes:
             w.result()
@@ -448,13 +479,16 @@ def _writer() -> ThreadPoolExecutor:
     return ex
 
 
-def draw_image(path, size, draws) -> None:
+def draw_image(path, size, draws, aa=1) -> None:
     """Rasterize one image and write it atomically."""
-    write_png(path, draw(size, draws))
+    write_png(path, draw(size, draws, aa))
 
 
-def draw(size, draws) -> np.ndarray:
+def draw(size, draws, aa=1) -> np.ndarray:
     """Rasterize one image from its draws: a list of (camera, parts).
+
+    ``aa`` is the anti-aliasing factor (1: none).  The result is an array
+    of shape (H, W) (grey levels) or (H, W, 3) (colour), uint8.
 
     Consecutive draws seen by the same camera (the background and every tick
     of a still camera) are rasterized as one list of triangles: the
@@ -473,14 +507,35 @@ def draw(size, draws) -> np.ndarray:
         # The usual case: a fresh image, whose depth buffer need only cover what is drawn.
         camera, parts = merged[0]
         tris, grey, cull = _joined(parts)
-        image = rasterize(tris, grey, _camera(camera, size), 255, cull)
+        image = rasterize(tris, grey, _camera(camera, size), 255, cull, **_aa(aa))
     else:
-        fb = Framebuffer(size, 255)
+        fb = Framebuffer(size, 255, **_aa(aa))
         for camera, parts in merged:
             tris, grey, cull = _joined(parts)
             fb.draw(tris, grey, _camera(camera, size), cull)
         image = fb.image
     return image
+
+
+def _aa(aa) -> dict:
+    """The anti-aliasing keyword for the rasterizer: none at factor 1, so any rasterizer draws plain images."""
+    return {} if aa == 1 else {"aa": aa}
+
+
+MAX_AA = 8
+
+
+def check_aa(aa, name: str = "--aa") -> int:
+    """``aa`` as an int from 1 to :data:`MAX_AA`, or a RenderError saying why it cannot be."""
+    try:
+        n = int(aa)
+        ok = n == float(aa) and 1 <= n <= MAX_AA
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok or isinstance(aa, bool):
+        shown = f"{name}{aa!r}" if name.endswith("=") else f"{name} {aa}"
+        raise RenderError(f"{shown} is not an anti-aliasing factor; give a whole number from 1 (none) to {MAX_AA}")
+    return n
 
 
 def _joined(parts):

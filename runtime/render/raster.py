@@ -47,6 +47,9 @@ _INDEX_MASK = (1 << _INDEX_BITS) - 1
 _DEPTH_MASK = ~_INDEX_MASK
 _MAX_TRIANGLES = 1 << 31
 
+#: Largest anti-aliasing factor: aa x aa samples per pixel.
+MAX_AA = 8
+
 # Back-facing triangles have their 1/z scaled down by this fraction (about
 # four units of the key's last depth bit).  For a closed solid seen from
 # outside, every back-face pixel is also covered by a front face of the same
@@ -59,8 +62,13 @@ _BACK_BIAS = 4e-6
 # Fragments expanded at once; bounds temporary memory at about 50 bytes each.
 _CHUNK = 1 << 18
 
+# Spans are drawn in bands of whole rows of about this many pixels, one band
+# at a time: the band's depth keys (8 bytes a pixel) then stay in the L2
+# cache, and no pass ever runs over the whole frame's depth buffer.
+_BAND_PIXELS = 1 << 17
 
-def rasterize(triangles, shade, camera: Camera, background: int = 255, cull=None) -> np.ndarray:
+
+def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: int = 1) -> np.ndarray:
     """Draw flat-shaded triangles with a z-buffer into a new image.
 
     Parameters
@@ -68,35 +76,79 @@ def rasterize(triangles, shade, camera: Camera, background: int = 255, cull=None
     triangles : array_like, shape (N, 3, 3)
         World-space vertices, ``triangles[i, k]`` is vertex ``k`` of
         triangle ``i``.
-    shade : array_like, shape (N,)
-        Grey level (0 black .. 255 white) of each triangle.
+    shade : array_like, shape (N,) or (N, 3)
+        Grey level (0 black .. 255 white) of each triangle, or its
+        ``(r, g, b)`` colour (each 0..255).
     camera : Camera
         The view; its ``size`` is the image size.
-    background : int, optional
-        Grey level where no triangle is drawn; default 255 (white).
+    background : int or tuple of 3 int, optional
+        Grey level, or ``(r, g, b)`` colour, where no triangle is drawn;
+        default 255 (white).
     cull : array_like of bool, shape (N,), optional
         True where the triangle is part of a closed solid whose faces are
         wound counter-clockwise seen from outside (outward right-hand
         normals); such triangles are dropped when they face away from the
         eye.  This is only a speed-up: for closed solids seen from outside
         the image is the same with or without it.
+    aa : int, optional
+        Anti-aliasing: each pixel is the rounded mean of ``aa x aa``
+        samples on a regular grid (1, the default, is one sample at the
+        pixel centre).  See :func:`downsample`.
 
     Returns
     -------
-    ndarray, shape (H, W), uint8
-        The image, row 0 at the top.
+    ndarray, shape (H, W) or (H, W, 3), uint8
+        The image, row 0 at the top; (H, W, 3) RGB when ``shade`` or
+        ``background`` is a colour, else (H, W) grey.
 
     Raises
     ------
     RenderError
-        If the arrays have the wrong shape, coordinates are not finite, or a
-        grey level is outside 0..255.
+        If the arrays have the wrong shape, coordinates are not finite, a
+        grey level or colour component is outside 0..255, or ``aa`` is not
+        a whole number from 1 to ``MAX_AA``.
     """
-    W, H = camera.size
-    img = np.full((H, W), _grey(background, "background"), dtype=np.uint8)
+    aa = _aa(aa)
+    tris, shade = _check(triangles, shade, cull)
+    bg = _background(background)
+    shade, bg = _same_kind(shade, bg)
+    cam = camera.supersampled(aa)
+    W, H = cam.size
+    img = np.empty((H, W) + np.shape(bg), dtype=np.uint8)
+    img[...] = bg
     # Nothing drawn yet: the depth buffer need only span the pixels touched.
-    _draw(None, img, triangles, shade, camera, cull, 0)
-    return img
+    _draw(None, img, tris, shade, cam, cull, 0)
+    return downsample(img, aa)
+
+
+def downsample(img, aa: int) -> np.ndarray:
+    """Box-filter an image supersampled ``aa`` times in each direction.
+
+    Each output pixel is the mean of its ``aa x aa`` block, rounded to the
+    nearest integer with halves rounded up, in exact integer arithmetic
+    (so the bytes never depend on floating point).
+
+    Parameters
+    ----------
+    img : ndarray, shape (aa H, aa W) or (aa H, aa W, 3), uint8
+        The supersampled image.
+    aa : int
+        The supersampling factor.
+
+    Returns
+    -------
+    ndarray, shape (H, W) or (H, W, 3), uint8
+        ``img`` itself when ``aa`` is 1.
+    """
+    if aa == 1:
+        return img
+    H, W = img.shape[0] // aa, img.shape[1] // aa
+    blocks = img.reshape((H, aa, W, aa) + img.shape[2:])
+    total = blocks.sum(axis=(1, 3), dtype=np.uint32)
+    n = aa * aa
+    total += n // 2
+    total //= n
+    return total.astype(np.uint8)
 
 
 class Framebuffer:
@@ -104,26 +156,32 @@ class Framebuffer:
 
     Draws share the depth test, so e.g. several ticks drawn into one image
     hide each other correctly; a later draw counts as "later" for the tie
-    rule.
+    rule.  The buffers hold ``aa x aa`` samples per pixel; :attr:`image` is
+    their box-filtered mean.  The image turns RGB at the first draw in
+    colour (grey levels ``g`` are then the colour ``(g, g, g)``).
 
     Parameters
     ----------
     size : tuple of int
         ``(W, H)`` in pixels.
-    background : int, optional
-        Initial grey level; default 255.
+    background : int or tuple of 3 int, optional
+        Initial grey level or ``(r, g, b)`` colour; default 255.
+    aa : int, optional
+        Samples per pixel in each direction (see :func:`rasterize`); default 1.
 
     Attributes
     ----------
-    image : ndarray, shape (H, W), uint8
-        The image so far (updated in place by :meth:`draw`).
-    zbuf : ndarray, shape (H, W), int64
+    samples : ndarray, shape (aa H, aa W) or (aa H, aa W, 3), uint8
+        The supersampled image so far (updated in place by :meth:`draw`).
+    zbuf : ndarray, shape (aa H, aa W), int64
         Depth keys (see :func:`rasterize_into`); ``EMPTY`` where nothing is drawn.
     count : int
         Triangles drawn so far; the next draw's triangles are numbered from here.
+    aa : int
+        The supersampling factor.
     """
 
-    def __init__(self, size, background: int = 255):
+    def __init__(self, size, background=255, aa: int = 1):
         try:
             W, H = (int(s) for s in size)
             ok = W > 0 and H > 0 and (W, H) == tuple(size)
@@ -131,10 +189,22 @@ class Framebuffer:
             ok = False
         if not ok:
             raise RenderError(f"The image size must be two positive whole numbers, not {size!r}.")
+        self.aa = _aa(aa)
         self.size = (W, H)
-        self.image = np.full((H, W), _grey(background, "background"), dtype=np.uint8)
-        self.zbuf = np.zeros((H, W), dtype=np.int64)  # all EMPTY
+        bg = _background(background)
+        self.samples = np.empty((H * self.aa, W * self.aa) + np.shape(bg), dtype=np.uint8)
+        self.samples[...] = bg
+        self.zbuf = np.zeros((H * self.aa, W * self.aa), dtype=np.int64)  # all EMPTY
         self.count = 0
+
+    @property
+    def image(self) -> np.ndarray:
+        """The image so far, shape (H, W) or (H, W, 3), uint8.
+
+        With ``aa`` 1 this is :attr:`samples` itself, updated in place by
+        later draws; otherwise a new downsampled array.
+        """
+        return downsample(self.samples, self.aa)
 
     def draw(self, triangles, shade, camera: Camera, cull=None) -> None:
         """Draw triangles over what is already there, depth-tested.
@@ -143,21 +213,33 @@ class Framebuffer:
         ----------
         triangles : array_like, shape (N, 3, 3)
             World-space vertices.
-        shade : array_like, shape (N,)
-            Grey levels 0..255.
+        shade : array_like, shape (N,) or (N, 3)
+            Grey levels or ``(r, g, b)`` colours, 0..255.
         camera : Camera
             The view; ``camera.size`` must equal the framebuffer's size.
         cull : array_like of bool, shape (N,), optional
             See :func:`rasterize`.
         """
-        self.count = rasterize_into(self.zbuf, self.image, triangles, shade, camera, cull, self.count)
+        tris, shade = _check(triangles, shade, cull)
+        if shade.ndim == 2 and self.samples.ndim == 2:
+            self.samples = np.repeat(self.samples[:, :, None], 3, axis=2)
+        elif shade.ndim == 1 and self.samples.ndim == 3:
+            shade = np.repeat(shade[:, None], 3, axis=1)
+        W, H = camera.size
+        if (W, H) != self.size:
+            raise RenderError(
+                f"The camera's image size {W}x{H} does not match the {self.size[0]}x{self.size[1]} image being drawn into."
+            )
+        self.count = rasterize_into(
+            self.zbuf, self.samples, tris, shade, camera.supersampled(self.aa), cull, self.count
+        )
 
     def depth(self) -> np.ndarray:
-        """The depth of the visible surface at each pixel centre.
+        """The depth of the visible surface at each sample.
 
         Returns
         -------
-        ndarray, shape (H, W), float64
+        ndarray, shape (aa H, aa W), float64
             Camera-space depth to about 1e-6 relative (a back face that won
             reads about 4e-6 too far, see ``_BACK_BIAS``); ``inf`` where
             nothing was drawn.
@@ -179,12 +261,12 @@ def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first
         ``first_index + i``: the larger key is the nearer surface, or at
         equal depth the later triangle.  All draws into one buffer must
         use the same camera.
-    img : ndarray, shape (H, W), uint8, C-contiguous
+    img : ndarray, shape (H, W) or (H, W, 3), uint8, C-contiguous
         The image, updated in place where a triangle wins the depth test.
     triangles : array_like, shape (N, 3, 3)
         World-space vertices.
-    shade : array_like, shape (N,)
-        Grey levels 0..255.
+    shade : array_like, shape (N,) or (N, 3)
+        Grey levels, or colours when ``img`` is RGB, 0..255.
     camera : Camera
         The view; ``camera.size`` must be ``(W, H)``.
     cull : array_like of bool, shape (N,), optional
@@ -199,58 +281,79 @@ def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first
         ``first_index + N``: the number to give the next draw.
     """
     W, H = camera.size
-    if img.shape != (H, W) or zbuf.shape != (H, W):
+    if img.shape[:2] != (H, W) or zbuf.shape != (H, W):
         raise RenderError(
             f"The camera's image size {W}x{H} does not match the {img.shape[1]}x{img.shape[0]} image being drawn into."
         )
     if not (img.flags.c_contiguous and zbuf.flags.c_contiguous and zbuf.dtype == np.int64 and img.dtype == np.uint8):
         raise RenderError("The image and depth buffer must be C-contiguous uint8 and int64 arrays.")
-    return _draw(zbuf, img, triangles, shade, camera, cull, first_index)
-
-
-def _draw(zbuf, img, triangles, shade, camera, cull, first_index):
     tris, shade = _check(triangles, shade, cull)
+    if (shade.ndim == 2) != (img.ndim == 3) or img.ndim not in (2, 3) or img.shape[2:] not in ((), (3,)):
+        raise RenderError("Colours need an RGB image, and grey levels a grey one.")
+    return _draw(zbuf, img, tris, shade, camera, cull, first_index)
+
+
+def _draw(zbuf, img, tris, shade, camera, cull, first_index):
     n = len(tris)
     if first_index + n >= _MAX_TRIANGLES:
         raise RenderError(f"Too many triangles in one image (more than {_MAX_TRIANGLES - 1}).")
-    spans = _spans(tris, cull, camera, first_index) if n else None
+    W = camera.size[0]
+    spans = _spans(tris, cull, camera, first_index, max(1, _BAND_PIXELS // W)) if n else None
     if spans is None:
         return first_index + n
-    offset, wstart, step, tag, count = spans
-    flat_img = img.reshape(-1)
-    if zbuf is None:
-        # A fresh buffer: allocate depth keys for the touched range only.
-        drawn = count > 0
-        lo = int(offset[drawn].min())
-        hi = int((offset[drawn] + count[drawn]).max())
-        flat_z = np.zeros(hi - lo, dtype=np.int64)
-        flat_img = flat_img[lo:hi]
-        offset = offset - lo
-    else:
-        flat_z = zbuf.reshape(-1)
+    offset, wstart, step, tag, count, bounds = spans
+    flat_img = img.reshape((-1,) + img.shape[2:])
+    flat_z = None if zbuf is None else zbuf.reshape(-1)
+    if len(bounds) == 2:
+        # One band (the usual case below about 1080p): no per-band slicing.
+        lo = int(offset.min())
+        hi = int((offset + count).max())
+        zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
+        _band(zb, flat_img[lo:hi], offset - lo, wstart, step, tag, count, shade, first_index)
+        return first_index + n
+    starts = bounds[:-1]
+    los = np.minimum.reduceat(offset, starts).tolist()
+    his = np.maximum.reduceat(offset + count, starts).tolist()
+    if flat_z is None:
+        # One buffer for every band: clearing it while it is still in the
+        # cache is cheaper than fresh zeroed pages from the kernel.
+        scratch = np.zeros(max(h - l for l, h in zip(los, his)), dtype=np.int64)
+    for i, (lo, hi) in enumerate(zip(los, his)):
+        sl = slice(bounds[i], bounds[i + 1])
+        if flat_z is not None:
+            zb = flat_z[lo:hi]
+        else:
+            zb = scratch[: hi - lo]
+            if i:
+                zb.fill(EMPTY)
+        _band(zb, flat_img[lo:hi], offset[sl] - lo, wstart[sl], step[sl], tag[sl], count[sl], shade, first_index)
+    return first_index + n
+
+
+def _band(zb, im, offset, wstart, step, tag, count, shade, first_index):
+    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range)."""
     ends = np.cumsum(count)
     if ends[-1] <= _CHUNK:
         pix, key = _expand(offset, wstart, step, tag, count, ends)
-        np.maximum.at(flat_z, pix, key)
-        won = flat_z[pix] == key
+        np.maximum.at(zb, pix, key)
+        won = zb[pix] == key
         # A pixel is won by at most one fragment (keys are unique per
         # triangle, and a triangle covers a pixel at most once), so this
         # assignment has no repeated indices.
-        flat_img[pix[won]] = shade[(key[won] & _INDEX_MASK) - first_index]
-        return first_index + n
-    # Too many fragments for one go: depth-test chunk by chunk, then find
-    # this draw's winners by scanning the whole buffer for its numbers.
+        im[pix[won]] = shade[(key[won] & _INDEX_MASK) - first_index]
+        return
+    # Too many fragments for one go (deep overlap): depth-test chunk by
+    # chunk, then find this draw's winners by scanning the band.
     lo = 0
     for hi in np.searchsorted(ends, np.arange(_CHUNK, ends[-1], _CHUNK), side="right").tolist() + [len(count)]:
         if hi > lo:
             sl = slice(lo, hi)
             pix, key = _expand(offset[sl], wstart[sl], step[sl], tag[sl], count[sl], None)
-            np.maximum.at(flat_z, pix, key)
+            np.maximum.at(zb, pix, key)
             lo = hi
-    num = flat_z & _INDEX_MASK
-    sel = np.flatnonzero((flat_z != EMPTY) & (num >= first_index))
-    flat_img[sel] = shade[num[sel] - first_index]
-    return first_index + n
+    num = zb & _INDEX_MASK
+    sel = np.flatnonzero((zb != EMPTY) & (num >= first_index))
+    im[sel] = shade[num[sel] - first_index]
 
 
 # Shared read-only aranges, grown as needed (replaced, never modified, so
@@ -258,17 +361,23 @@ def _draw(zbuf, img, triangles, shade, camera, cull, first_index):
 _ARANGE = (np.arange(0, dtype=np.int64), np.arange(0, dtype=np.float64))
 
 
-def _expand(offset, wstart, step, tag, count, ends):
-    """Spans (P,) to fragments: pixel numbers (F,) and depth keys (F,)."""
+def _aranges(n: int):
+    """``arange`` of at least ``n`` elements as int64 and float64 (shared; do not modify)."""
     global _ARANGE
-    if ends is None:
-        ends = np.cumsum(count)
-    n = int(ends[-1])
     iar, far = _ARANGE
     if len(iar) < n:
         iar = np.arange(max(n, 2 * len(iar)), dtype=np.int64)
         far = iar.astype(np.float64)
         _ARANGE = (iar, far)
+    return iar, far
+
+
+def _expand(offset, wstart, step, tag, count, ends):
+    """Spans (P,) to fragments: pixel numbers (F,) and depth keys (F,)."""
+    if ends is None:
+        ends = np.cumsum(count)
+    n = int(ends[-1])
+    iar, far = _aranges(n)
     starts = ends - count
     pix = np.repeat(offset - starts, count)
     pix += iar[:n]
@@ -285,14 +394,45 @@ def _expand(offset, wstart, step, tag, count, ends):
     return pix, key
 
 
-def _grey(value, what: str) -> int:
+def _aa(aa) -> int:
     try:
-        v = int(value)
-    except (TypeError, ValueError):
-        v = -1
-    if v != value or not 0 <= v <= 255:
-        raise RenderError(f"The {what} grey level must be a whole number from 0 to 255, not {value!r}.")
+        v = int(aa)
+    except (TypeError, ValueError, OverflowError):
+        v = 0
+    if isinstance(aa, bool) or v != aa or not 1 <= v <= MAX_AA:
+        raise RenderError(
+            f"Anti-aliasing must be a whole number of samples from 1 to {MAX_AA} per pixel side, not {aa!r}."
+        )
     return v
+
+
+def _background(value):
+    """A grey level (int) or a colour (uint8 array, shape (3,))."""
+    if np.ndim(value) == 0:
+        try:
+            v = int(value)
+        except (TypeError, ValueError, OverflowError):
+            v = -1
+        if isinstance(value, bool) or v != value or not 0 <= v <= 255:
+            raise RenderError(f"The background grey level must be a whole number from 0 to 255, not {value!r}.")
+        return v
+    try:
+        c = np.asarray(value, dtype=np.float64)
+        ok = c.shape == (3,) and bool(np.all(c == np.round(c))) and bool(np.all((c >= 0) & (c <= 255)))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise RenderError(f"The background colour must be three whole numbers from 0 to 255, not {value!r}.")
+    return c.astype(np.uint8)
+
+
+def _same_kind(shade, bg):
+    """Grey shades and background stay grey; if either is a colour, both become colours."""
+    if shade.ndim == 2 and np.ndim(bg) == 0:
+        bg = np.full(3, bg, dtype=np.uint8)
+    elif shade.ndim == 1 and np.ndim(bg) == 1:
+        shade = np.repeat(shade[:, None], 3, axis=1)
+    return shade, bg
 
 
 def _check(triangles, shade, cull):
@@ -302,66 +442,82 @@ def _check(triangles, shade, cull):
     if not np.isfinite(tris).all():
         raise RenderError("A triangle has a coordinate that is not a finite number.")
     s = np.asarray(shade)
-    if s.shape != (len(tris),):
-        raise RenderError(f"Expected {len(tris)} grey levels, one per triangle, got shape {s.shape}.")
+    if s.shape not in ((len(tris),), (len(tris), 3)):
+        raise RenderError(
+            f"Expected {len(tris)} grey levels or {len(tris)} (r, g, b) colours, one per triangle, got shape {s.shape}."
+        )
     if s.dtype != np.uint8:
-        if s.size and (not np.all(np.isfinite(s)) or s.min() < 0 or s.max() > 255 or np.any(s != np.round(s))):
-            raise RenderError("Grey levels must be whole numbers from 0 to 255.")
+        try:
+            bad = s.size and (not np.all(np.isfinite(s)) or s.min() < 0 or s.max() > 255 or np.any(s != np.round(s)))
+        except TypeError:
+            bad = True
+        if bad:
+            what = "Colour components" if s.ndim == 2 else "Grey levels"
+            raise RenderError(f"{what} must be whole numbers from 0 to 255.")
         s = s.astype(np.uint8)
     if cull is not None and np.shape(cull) != (len(tris),):
         raise RenderError(f"Expected {len(tris)} cull flags, one per triangle, got shape {np.shape(cull)}.")
     return tris, s
 
 
-def _spans(tris, cull, camera: Camera, first_index: int):
-    """Triangles (N, 3, 3) to spans: (pixel offset, 1/z at first pixel, 1/z step, key tag, length).
+def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None = None):
+    """Triangles (N, 3, 3) to spans, grouped into bands of rows.
 
-    The pixel offset is ``row * W + first column``; all five arrays have
-    shape (P,), one entry per span, and some spans may be empty.  Returns
-    None when nothing is visible.
+    Returns ``(offset, wstart, step, tag, count, bounds)``, or None when
+    nothing is visible.  The first five have shape (P,), one entry per span:
+    pixel offset ``row * W + first column``, 1/z at its first pixel, 1/z
+    step, key tag and length (some spans may be empty).  ``bounds`` (list of
+    B + 1 int) splits them into bands: spans ``bounds[k]:bounds[k + 1]`` lie
+    in rows ``[b * band_rows, (b + 1) * band_rows)`` for some band ``b``
+    that grows with ``k``.  ``band_rows`` None means one band.
     """
     W, H = camera.size
-    v0, v1, v2 = tris[:, 0], tris[:, 1], tris[:, 2]
+    v0 = tris[:, 0]
     # Facing is decided in world space (camera space is left-handed).
-    a, b = v1 - v0, v2 - v0
+    a, b = tris[:, 1] - v0, tris[:, 2] - v0
     c = camera.point - v0
     front = (
         (a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]) * c[:, 0]
         + (a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]) * c[:, 1]
         + (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) * c[:, 2]
     ) > 0.0
-    src = np.arange(len(tris))
+    src = None  # the triangle each drawn one comes from; None for "itself"
     if cull is not None:
         keep = front | ~np.asarray(cull, dtype=bool)
         if not keep.all():
             src = np.flatnonzero(keep)
             tris = tris[src]
     cam, src = _clip_near(camera.to_camera(tris), src, camera.near)
-    m = len(src)
+    m = len(cam)
     if m == 0:
         return None
 
     scr = camera.camera_to_pixels(cam)  # (m, 3, 3): x, y, depth
     # Sorting vertices by y fixes the orientation of every edge (top end
     # first), which is what makes shared edges bit-identical.
-    order = np.argsort(scr[:, :, 1], axis=1, kind="stable") + 3 * np.arange(m)[:, None]
+    order = np.argsort(scr[:, :, 1], axis=1, kind="stable")
+    order += np.arange(0, 3 * m, 3)[:, None]
     scr = np.take(scr.reshape(-1, 3), order.reshape(-1), axis=0).reshape(m, 3, 3)
-    x0, x1, x2 = scr[:, 0, 0], scr[:, 1, 0], scr[:, 2, 0]
-    y0, y1, y2 = scr[:, 0, 1], scr[:, 1, 1], scr[:, 2, 1]
-    w0, w1, w2 = 1.0 / scr[:, 0, 2], 1.0 / scr[:, 1, 2], 1.0 / scr[:, 2, 2]
+    xs, ys = scr[:, :, 0], scr[:, :, 1]
+    x0, x1, x2 = xs[:, 0], xs[:, 1], xs[:, 2]
+    y0, y1, y2 = ys[:, 0], ys[:, 1], ys[:, 2]
+    w = 1.0 / scr[:, :, 2]
+    w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
 
     # Each triangle is two trapezoids: rows whose centre r + 0.5 lies in
     # [y0, y1) are bounded by the long edge 0-2 and the upper edge 0-1,
     # rows in [y1, y2) by the long edge and the lower edge 1-2.
-    r0 = np.clip(np.ceil(y0 - 0.5), 0, H).astype(np.int64)
-    r1 = np.clip(np.ceil(y1 - 0.5), 0, H).astype(np.int64)
-    r2 = np.clip(np.ceil(y2 - 0.5), 0, H).astype(np.int64)
+    # Trapezoids are numbered upper ones first, then lower ones.
+    r = np.ceil(ys - 0.5)
+    np.clip(r, 0, H, out=r)
+    r = r.astype(np.int64)
     det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
-    xmax = np.maximum(np.maximum(x0, x1), x2)
-    xmin = np.minimum(np.minimum(x0, x1), x2)
-    visible = (det != 0.0) & (xmax > 0.5 - 1e-9) & (xmin < W - 0.5 + 1e-9)
-    nrows = np.concatenate([np.where(visible, r1 - r0, 0), np.where(visible, r2 - r1, 0)])
-    if not nrows.any():
+    visible = (det != 0.0) & (xs.max(axis=1) > 0.5 - 1e-9) & (xs.min(axis=1) < W - 0.5 + 1e-9)
+    rows = np.diff(r, axis=1)  # (m, 2): rows of the upper and the lower trapezoid
+    rows *= visible[:, None]
+    nrows = rows.T.reshape(-1)
+    total = int(nrows.sum())
+    if total == 0:
         return None
 
     # An edge's crossing with row centre cy is x = xtop + (cy - ytop) * s,
@@ -369,31 +525,56 @@ def _spans(tris, cull, camera: Camera, first_index: int):
     # every triangle sharing the edge.
     with np.errstate(divide="ignore", invalid="ignore"):
         s_long = (x2 - x0) / (y2 - y0)
-        s_short = np.concatenate([(x1 - x0) / (y1 - y0), (x2 - x1) / (y2 - y1)])
+        s_short = np.diff(xs, axis=1) / np.diff(ys, axis=1)
         # 1/z is affine in screen space: 1/z = wc + gx x + gy y.
         gx = ((w1 - w0) * (y2 - y0) - (w2 - w0) * (y1 - y0)) / det
         gy = ((x1 - x0) * (w2 - w0) - (x2 - x0) * (w1 - w0)) / det
         wc = w0 - gx * x0 - gy * y0
-    wmin = np.minimum(np.minimum(w0, w1), w2)
-    wmax = np.maximum(np.maximum(w0, w1), w2)
+    wmin, wmax = w.min(axis=1), w.max(axis=1)
     if not front.all():
-        scale = np.where(front[src], 1.0, 1.0 - _BACK_BIAS)
+        scale = np.where(front if src is None else front[src], 1.0, 1.0 - _BACK_BIAS)
         wc, gx, gy, wmin, wmax = wc * scale, gx * scale, gy * scale, wmin * scale, wmax * scale
-    tag = first_index + src
+    tag = first_index + (np.arange(m) if src is None else src)
 
-    # One entry per (trapezoid, row).  Pairs are grouped by trapezoid, so
-    # np.repeat spreads per-trapezoid values over them; it costs a few
-    # instructions per element where a gather (np.take, fancy indexing)
-    # costs 15-30.
-    def per_row(values):
-        return np.repeat(values, nrows)
+    # A table of per-trapezoid values, one row per quantity: the long edge,
+    # the plane and the depth range (shared by a triangle's two
+    # trapezoids), the short edge, and (row 11, filled below) the first
+    # row's centre minus the number of rows before it.
+    table = np.empty((12, 2, m))
+    table[:8] = np.stack([x0, y0, s_long, gx, wc, gy, wmin, wmax])[:, None]
+    table[8] = xs[:, :2].T
+    table[9] = ys[:, :2].T
+    table[10] = s_short.T
+    table = table.reshape(12, 2 * m)
+    tags = np.concatenate([tag, tag])
+    first_row = r[:, :2].T.reshape(-1)
+    bounds = [0, total]
+    if band_rows is not None and band_rows < H:
+        # Cut trapezoids at band boundaries, and order the pieces by band.
+        live = np.flatnonzero(nrows)
+        top_band = first_row[live] // band_rows
+        pieces = (first_row[live] + nrows[live] - 1) // band_rows - top_band + 1
+        trap = np.repeat(live, pieces)
+        band = np.repeat(top_band - (np.cumsum(pieces) - pieces), pieces) + np.arange(len(trap))
+        order = np.argsort(band, kind="stable")
+        trap, band = trap[order], band[order]
+        start = np.maximum(first_row[trap], band * band_rows)
+        nrows = np.minimum(first_row[trap] + nrows[trap], (band + 1) * band_rows) - start
+        first_row = start
+        table, tags = table[:, trap], tags[trap]
+        ends = np.cumsum(nrows)
+        bounds = [0] + ends[np.flatnonzero(np.diff(band))].tolist() + [total]
+    else:
+        ends = np.cumsum(nrows)
+    table[11] = first_row - (ends - nrows) + 0.5
 
-    def both(values):
-        return np.concatenate([values, values])
-
-    cy = np.arange(int(nrows.sum())) + per_row(np.concatenate([r0, r1]) - (np.cumsum(nrows) - nrows) + 0.5)
-    xa = per_row(both(x0)) + (cy - per_row(both(y0))) * per_row(both(s_long))
-    xb = per_row(np.concatenate([x0, x1])) + (cy - per_row(np.concatenate([y0, y1]))) * per_row(s_short)
+    # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
+    # spreads per-trapezoid values over them: it costs a few instructions
+    # per element where a gather (np.take, fancy indexing) costs 15-30.
+    t = np.repeat(table, nrows, axis=1)
+    cy = _aranges(total)[1][:total] + t[11]
+    xa = t[0] + (cy - t[1]) * t[2]
+    xb = t[8] + (cy - t[9]) * t[10]
     c0 = np.minimum(np.maximum(np.ceil(np.minimum(xa, xb) - 0.5), 0), W)
     c1 = np.minimum(np.maximum(np.ceil(np.maximum(xa, xb) - 0.5), 0), W)
     count = (c1 - c0).astype(np.int64)
@@ -402,23 +583,22 @@ def _spans(tris, cull, camera: Camera, first_index: int):
 
     # 1/z at the first and last pixel centre, clamped to the triangle's range
     # so that a sliver's ill-conditioned plane cannot produce a wild depth.
-    tgx = per_row(both(gx))
-    wrow = per_row(both(wc)) + cy * per_row(both(gy))
-    lo, hi = per_row(both(wmin)), per_row(both(wmax))
     # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
-    wstart = np.fmin(np.fmax(wrow + (c0 + 0.5) * tgx, lo), hi)
-    wend = np.fmin(np.fmax(wrow + (c1 - 0.5) * tgx, lo), hi)
+    wrow = t[4] + cy * t[5]
+    wstart = np.fmin(np.fmax(wrow + (c0 + 0.5) * t[3], t[6]), t[7])
+    wend = np.fmin(np.fmax(wrow + (c1 - 0.5) * t[3], t[6]), t[7])
     step = (wend - wstart) / np.maximum(count - 1, 1)
     # Spans of no pixels stay: np.repeat skips them at no cost.
     offset = ((cy - 0.5) * W + c0).astype(np.int64)
-    return offset, wstart, step, per_row(both(tag)), count
+    return offset, wstart, step, np.repeat(tags, nrows), count, bounds
 
 
 def _clip_near(cam, src, near: float):
     """Clip camera-space triangles (M, 3, 3) to depth >= near.
 
     Returns the clipped triangles and, for each, the index of the triangle
-    it came from.  New vertices are always interpolated from the vertex in
+    it came from (``src`` of it; ``src`` None stands for ``arange(M)``, and
+    is returned as None when nothing is clipped).  New vertices are always interpolated from the vertex in
     front towards the vertex behind, so an edge shared by two triangles is
     cut at a bit-identical point in both.
     """
@@ -426,6 +606,8 @@ def _clip_near(cam, src, near: float):
     nin = inside.sum(axis=1)
     if (nin == 3).all():
         return cam, src
+    if src is None:
+        src = np.arange(len(cam))
     out = [cam[nin == 3]]
     out_src = [src[nin == 3]]
 

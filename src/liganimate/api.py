@@ -10,9 +10,13 @@ the viewer itself (``_repr_html_``), in a sandboxed frame.
 from __future__ import annotations
 
 import os
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
-from liganimate.lang.diagnostics import LigDiagnostics, format_diagnostic
+from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, format_diagnostic
+
+if TYPE_CHECKING:
+    from liganimate.runtime.exchange import SceneTake
+    from liganimate.runtime.host import Program
 
 __all__ = ["LigProgramError", "LoadedProgram", "View", "load"]
 
@@ -37,11 +41,11 @@ class View:
         The complete, self-contained HTML document (what ``liganimate view`` writes).
     """
 
-    def __init__(self, html: str, height: int = 560):
+    def __init__(self, html: str, height: int = 560) -> None:
         self.html = html
         self.height = height
 
-    def save(self, path) -> str:
+    def save(self, path: str | os.PathLike[str]) -> str:
         """Write the page to ``path`` atomically; return the path."""
         from liganimate.runtime.exchange import write_files
 
@@ -67,13 +71,13 @@ class LoadedProgram:
         The compiler's warnings.
     """
 
-    def __init__(self, name: str, program, warnings: list):
+    def __init__(self, name: str, program: Program, warnings: list[Diagnostic]) -> None:
         self.name = name
         self.program = program
         self.warnings = warnings
-        self._scenes: list | None = None
+        self._scenes: list[SceneTake] | None = None
 
-    def scenes(self) -> list:
+    def scenes(self) -> list[SceneTake]:
         """Run the program once without drawing; its shot scenes (``SceneTake``), cached.
 
         Raises
@@ -91,7 +95,7 @@ class LoadedProgram:
             self._scenes = scenes
         return self._scenes
 
-    def view(self, scene=None, height: int = 560) -> View:
+    def view(self, scene: int | None = None, height: int = 560) -> View:
         """The viewer for every scene, or for the scene whose identifier is ``scene``.
 
         Raises
@@ -121,7 +125,7 @@ class LoadedProgram:
         return f"<liganimate program {self.name!r}>"
 
 
-def load(path_or_text) -> LoadedProgram:
+def load(path_or_text: str | os.PathLike[str]) -> LoadedProgram:
     """Compile a LIG ANIMATE program from a file or from its text.
 
     Parameters
@@ -144,6 +148,8 @@ def load(path_or_text) -> LoadedProgram:
     """
     from liganimate.compiler import load_program
 
+    path: str | None
+    text: str | None
     if isinstance(path_or_text, os.PathLike):
         path, text = os.fspath(path_or_text), None
     elif not isinstance(path_or_text, str):

@@ -23,34 +23,28 @@ def _lig_name(text: str) -> str:
     return text.upper()
 
 
-def _seed(text: str) -> int:
+def _whole(text: str, low: int, high: int, message: str) -> int:
+    # One rule for every whole-number option: digits only, within its range,
+    # and the option's own sentence when not.
     try:
         value = int(text)
     except ValueError:
-        value = -1
-    if not 0 <= value <= 2**32 - 1:
-        raise argparse.ArgumentTypeError(f"the seed must be a whole number from 0 to 4294967295, not {text!r}")
+        value = low - 1
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(message.format(text=repr(text)))
     return value
+
+
+def _seed(text: str) -> int:
+    return _whole(text, 0, 2**32 - 1, "the seed must be a whole number from 0 to 4294967295, not {text}")
 
 
 def _port(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a port number (0 picks a free one)")
-    return value
+    return _whole(text, 0, 65535, "{text} is not a port number (0 picks a free one)")
 
 
 def _frames(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if not 1 <= value <= 1_000_000:
-        raise argparse.ArgumentTypeError(f"the frames between kept poses must be 1 to 1000000, not {text!r}")
-    return value
+    return _whole(text, 1, 1_000_000, "the frames between kept poses must be 1 to 1000000, not {text}")
 
 
 def add_commands(subparsers) -> None:

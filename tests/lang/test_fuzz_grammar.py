@@ -17,8 +17,7 @@ import random
 import fuzzgen
 import fuzzgrammar
 import fuzzrun
-from hypothesis import HealthCheck, Phase, event, given, settings
-from hypothesis import strategies as st
+from hypothesis import event
 
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.lang.parser import parse
@@ -59,15 +58,7 @@ def test_most_generated_programs_parse_and_many_run():
     assert ran >= 0.12 * n, ran
 
 
-@settings(
-    max_examples=CASES,
-    derandomize=True,
-    deadline=None,
-    database=None,
-    phases=(Phase.explicit, Phase.generate),
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.large_base_example],
-)
-@given(rng=st.randoms(use_true_random=False))
+@fuzzrun.seeded_programs(CASES)
 def test_grammar_programs_run_or_are_diagnosed(rng):
     out = fuzzrun.assert_runs_or_is_diagnosed(fuzzgen.grammar_program(rng))
     event(out.kind)

@@ -16,8 +16,7 @@ import re
 
 import fuzzgen
 import fuzzrun
-from hypothesis import HealthCheck, Phase, event, given, settings
-from hypothesis import strategies as st
+from hypothesis import event
 
 CASES = 600
 WILD_CASES = 200
@@ -68,29 +67,13 @@ def test_a_filled_slot_changes_only_that_slot():
     assert len(before) == len(after) and changed == [("0.5", "1e309")]
 
 
-@settings(
-    max_examples=CASES,
-    derandomize=True,
-    deadline=None,
-    database=None,
-    phases=(Phase.explicit, Phase.generate),
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.large_base_example],
-)
-@given(rng=st.randoms(use_true_random=False))
+@fuzzrun.seeded_programs(CASES)
 def test_extreme_numbers_are_diagnosed_or_handled(rng):
     out = fuzzrun.assert_runs_or_is_diagnosed(fuzzgen.number_program(rng))
     event(out.kind)
 
 
-@settings(
-    max_examples=WILD_CASES,
-    derandomize=True,
-    deadline=None,
-    database=None,
-    phases=(Phase.explicit, Phase.generate),
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.large_base_example],
-)
-@given(rng=st.randoms(use_true_random=False))
+@fuzzrun.seeded_programs(WILD_CASES)
 def test_extreme_numbers_anywhere_in_grammar_programs_are_diagnosed_or_handled(rng):
     # The templates put extremes where a program is known to work; here they
     # land wherever the grammar has a number, a quarter of the time.

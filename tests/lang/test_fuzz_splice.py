@@ -13,8 +13,7 @@ import random
 
 import fuzzgen
 import fuzzrun
-from hypothesis import HealthCheck, Phase, event, given, settings
-from hypothesis import strategies as st
+from hypothesis import event
 
 CASES = 600
 
@@ -39,15 +38,7 @@ def test_splices_change_the_text_and_keep_scenes_short():
             assert int(m.group(2)) <= fuzzgen.MAX_LENGTH
 
 
-@settings(
-    max_examples=CASES,
-    derandomize=True,
-    deadline=None,
-    database=None,
-    phases=(Phase.explicit, Phase.generate),
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.large_base_example],
-)
-@given(rng=st.randoms(use_true_random=False))
+@fuzzrun.seeded_programs(CASES)
 def test_spliced_programs_run_or_are_diagnosed(rng):
     out = fuzzrun.assert_runs_or_is_diagnosed(fuzzgen.splice_program(rng))
     event(out.kind)

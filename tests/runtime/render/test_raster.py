@@ -19,7 +19,7 @@ def fragments(tris, cull, cam):
     spans = _spans(np.asarray(tris, float), cull, cam, 0)
     if spans is None:
         return np.zeros(0, np.int64)
-    offset, wstart, step, tag, count = spans
+    offset, wstart, step, tag, count, _ = spans
     return _expand(offset, wstart, step, tag, count, None)[0]
 
 

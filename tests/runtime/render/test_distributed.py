@@ -1,0 +1,282 @@
+"""Rendering on a Dask cluster (``--scheduler``): the same bytes as a local run, a killed worker survived.
+
+The cluster is a :class:`distributed.LocalCluster` of two worker processes
+(one thread each), started once for the module: its workers are real
+processes that can be killed, on this machine, so they share its folders.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import pathlib
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+distributed = pytest.importorskip("distributed")  # the test extra installs it; a bare install has no Dask
+
+from test_render import PROGRAM  # noqa: E402
+
+from liganimate.compiler import load_program  # noqa: E402
+from liganimate.runtime.errors import RenderError  # noqa: E402
+from liganimate.runtime.render import distributed as dask_render  # noqa: E402
+from liganimate.runtime.render.distributed import MARKER, DaskExecutor  # noqa: E402
+
+TICKS = 40
+SIZE = (96, 72)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    with distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=":0", silence_logs=40
+    ) as c:
+        yield c
+
+
+def swing(folder: pathlib.Path, ticks: int = TICKS) -> pathlib.Path:
+    path = folder / "swing.lig"
+    path.write_text(PROGRAM.format(ticks=ticks, last=ticks - 1))
+    return path
+
+
+def render(folder: pathlib.Path, out: pathlib.Path, **options) -> None:
+    program, _ = load_program(str(swing(folder)))
+    program.render(str(out), size=SIZE, quiet=True, **options)
+
+
+def files(folder: pathlib.Path) -> dict:
+    """Every file under ``folder``, by relative path: its bytes."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def local_frames(tmp_path_factory) -> dict:
+    folder = tmp_path_factory.mktemp("local")
+    render(folder, folder / "frames")
+    frames = files(folder / "frames")
+    assert len(frames) == TICKS
+    return frames
+
+
+def liganimate(*args, cwd, env=None):
+    return subprocess.run(
+        [sys.executable, "-m", "liganimate", *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=300
+    )
+
+
+def test_frames_drawn_on_the_cluster_are_the_bytes_of_a_local_run(cluster, local_frames, tmp_path):
+    out = tmp_path / "frames"
+    render(tmp_path, out, executor=DaskExecutor(cluster, folder=out))
+    assert files(out) == local_frames  # also: no marker, lock or temporary file left behind
+
+
+def test_the_command_renders_on_the_scheduler_given_by_option_or_environment(cluster, local_frames, tmp_path):
+    program = swing(tmp_path)
+    size = f"{SIZE[0]}x{SIZE[1]}"
+    by_option = liganimate(
+        "run",
+        str(program),
+        "-o",
+        str(tmp_path / "a"),
+        "--size",
+        size,
+        "--quiet",
+        "--scheduler",
+        cluster.scheduler_address,
+        cwd=tmp_path,
+    )
+    assert by_option.returncode == 0, by_option.stderr
+    env = dict(os.environ, LIGANIMATE_SCHEDULER=cluster.scheduler_address)
+    by_env = liganimate(
+        "run", str(program), "-o", str(tmp_path / "b"), "--size", size, "--quiet", cwd=tmp_path, env=env
+    )
+    assert by_env.returncode == 0, by_env.stderr
+    assert files(tmp_path / "a") == local_frames
+    assert files(tmp_path / "b") == local_frames
+
+
+def _hook(flag: str):
+    """A task that, the first time any worker runs it, writes half its images and waits to be killed.
+
+    Made inside a function so that it is pickled by value: the workers
+    need not import this test module.
+    """
+
+    def hook(fn, size, chunk, *rest):
+        try:
+            fd = os.open(flag, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+        except FileExistsError:
+            return fn(size, chunk, *rest)
+        fn(size, chunk[: len(chunk) // 2], *rest)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        os.close(fd)
+        time.sleep(60)  # the test kills this process meanwhile
+
+    return hook
+
+
+class HookedExecutor(DaskExecutor):
+    """Every task goes through ``hook`` first."""
+
+    def __init__(self, *args, hook, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.hook = hook
+
+    def submit(self, fn, *args):
+        return super().submit(self.hook, fn, *args)
+
+
+def test_a_worker_killed_mid_task_is_survived_and_every_frame_is_whole(cluster, local_frames, tmp_path):
+    flag = tmp_path / "killed"
+    killed = []
+
+    def killer():
+        # Kill the worker process from outside, as an operator or the OOM killer would.
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            try:
+                pid = int(flag.read_text())
+            except (OSError, ValueError):
+                time.sleep(0.01)
+                continue
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+            return
+
+    watcher = threading.Thread(target=killer, daemon=True)
+    watcher.start()
+    out = tmp_path / "frames"
+    started = time.monotonic()
+    render(tmp_path, out, executor=HookedExecutor(cluster, folder=out, hook=_hook(str(flag))))
+    watcher.join(5)
+    assert killed, "no task reached the hook"
+    assert time.monotonic() - started < 60  # the killed task was retried, not waited out
+    with pytest.raises(ProcessLookupError):
+        os.kill(killed[0], 0)
+    assert files(out) == local_frames  # complete, whole, and no temporary file of the dead task left
+
+
+def test_a_worker_that_does_not_see_the_output_folder_stops_the_render_with_a_message(cluster, tmp_path):
+    class Unshared(DaskExecutor):
+        def _write_marks(self):
+            # As if the workers wrote to a folder of their own at the same path: the marker is not in it.
+            marks = super()._write_marks()
+            for folder, name, _token in marks:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(os.path.join(folder, name))
+            return marks
+
+    out = tmp_path / "frames"
+    with pytest.raises(RenderError) as err:
+        render(tmp_path, out, executor=Unshared(cluster, folder=out, retries=0))
+    assert f"does not see the output folder {out}" in err.value.message
+    assert list(out.rglob("*.png")) == []
+
+
+def test_the_worker_check_finds_the_marker_and_refuses_a_folder_without_it(tmp_path):
+    (tmp_path / f"{MARKER}.abc").write_text("abc")
+    dask_render._check_folder(str(tmp_path), f"{MARKER}.abc", "abc")
+    with pytest.raises(RenderError, match="does not see the output folder"):
+        dask_render._check_folder(str(tmp_path), f"{MARKER}.abc", "another run")
+    with pytest.raises(RenderError, match="does not see the output folder"):
+        dask_render._check_folder(str(tmp_path / "elsewhere"), f"{MARKER}.abc", "abc")
+
+
+def test_markers_of_a_killed_run_are_removed_and_this_run_removes_its_own(cluster, tmp_path):
+    (tmp_path / f"{MARKER}.0123456789abcdef").write_text("stale")
+    ex = DaskExecutor(cluster, folder=tmp_path)
+    assert ex.submit(abs, -3).result() == 3
+    assert [p.name for p in tmp_path.iterdir()] == [f"{MARKER}.{ex._token}"]
+    ex.shutdown()
+    assert list(tmp_path.iterdir()) == []
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_an_unreachable_scheduler_is_one_sentence_and_nothing_is_written(tmp_path):
+    program = swing(tmp_path)
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    done = liganimate("run", str(program), "-o", "out", "--quiet", "--scheduler", address, cwd=tmp_path)
+    assert done.returncode == 1
+    assert done.stderr.startswith(
+        f"liganimate: error: cannot reach the Dask scheduler at {address}: connection refused\n"
+    )
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("address", ["foo://somewhere:8786", "tcp://host:port", "no.such.host.invalid:8786"])
+def test_a_bad_scheduler_address_is_a_render_error(address):
+    with pytest.raises(RenderError) as err:
+        DaskExecutor(address, connect_timeout=2)
+    assert address in err.value.message
+    assert err.value.hint
+
+
+def test_a_scheduler_without_workers_is_a_render_error():
+    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=":0") as empty:
+        started = time.monotonic()
+        with pytest.raises(RenderError, match="has no workers"):
+            DaskExecutor(empty, worker_wait=0.5)
+        assert time.monotonic() - started < 10
+
+
+def _slow_writer(folder: str):
+    def task(i):
+        time.sleep(0.3)
+        pathlib.Path(folder, f"{i}.done").write_text("")
+        return i
+
+    return task
+
+
+def test_shutdown_drops_tasks_not_started_and_waits_for_those_running(cluster, tmp_path):
+    ex = DaskExecutor(cluster)
+    task = _slow_writer(str(tmp_path))
+    futures = [ex.submit(task, i) for i in range(12)]
+    time.sleep(0.1)  # the scheduler hands the first tasks to the workers
+    ex.shutdown(wait=True, cancel_futures=True)
+    ran = sorted(p.name for p in tmp_path.iterdir())
+    assert 0 < len(ran) < 12
+    time.sleep(1.0)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ran  # nothing still running after shutdown returned
+    assert all(f.done() for f in futures)
+    with pytest.raises(RuntimeError):
+        ex.submit(task, 99)
+
+
+def test_a_task_error_reaches_the_caller_after_its_retries(cluster, tmp_path):
+    count = tmp_path / "runs"
+
+    def failing():
+        with open(count, "a") as f:
+            f.write("x")
+        raise RenderError("no space left on device while writing out/00001.png")
+
+    ex = DaskExecutor(cluster, retries=2)
+    try:
+        with pytest.raises(RenderError, match="no space left"):
+            ex.submit(failing).result(timeout=60)
+    finally:
+        ex.shutdown()
+    assert count.read_text() == "xxx"
+
+
+def test_a_worker_process_sets_up_its_allocator_once_before_its_first_task(monkeypatch):
+    calls = []
+    monkeypatch.setattr(dask_render, "_keep_freed_memory", lambda: calls.append(os.getpid()))
+    monkeypatch.setattr(dask_render, "_TUNED", [])
+    assert dask_render._call(abs, (), -2) == 2
+    assert dask_render._call(abs, (), -3) == 3
+    assert calls == [os.getpid()]
