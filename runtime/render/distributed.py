@@ -100,6 +100,7 @@ class DaskExecutor:
         self._client, self._own = _connect(address, connect_timeout)
         try:
             self.workers = _wait_for_workers(self._client, worker_wait)
+            _check_workers(self._client)
         except BaseException:
             self._close_client()
             raise
@@ -332,6 +333,47 @@ def _wait_for_workers(client, timeout: float) -> int:
             "start workers with 'dask worker ADDRESS' on machines that share the output folder",
         ) from None
     return max(1, sum(client.nthreads().values()))
+
+
+def _check_workers(client) -> None:
+    """Refuse workers that cannot import liganimate, or whose versions would draw other bytes.
+
+    A task whose function a worker cannot unpickle does not fail in Dask:
+    the worker's connection to the scheduler breaks and the task waits
+    forever.  So every worker present is asked first (workers that join
+    later are not: they need the same environment, see docs/distributed.md).
+    """
+    try:
+        answers = client.run(_environment, on_error="return")
+    except Exception as exc:
+        raise RenderError(f"cannot ask the Dask workers what they run: {_why(exc)}", _HINT) from None
+    mine = _environment()
+    for address, theirs in sorted(answers.items()):
+        if isinstance(theirs, BaseException):
+            if "liganimate" in str(theirs):
+                raise RenderError(
+                    f"the Dask worker at {address} cannot import liganimate; install the same liganimate on every worker",
+                    "pip install 'liganimate[dask]' in the workers' environment",
+                )
+            raise RenderError(f"the Dask worker at {address} cannot run liganimate: {theirs}")
+        for (what, want), got in zip(mine, theirs, strict=True):
+            if got[1] != want:
+                raise RenderError(
+                    f"the Dask worker at {address} has {what} {got[1]}, this machine {want}; "
+                    "the frames would not be the bytes of a local run",
+                    "give the workers the same environment as this machine (the same liganimate, numpy and zlib)",
+                )
+
+
+def _environment() -> tuple:
+    """What decides the bytes of a frame, besides its draw list: ((name, version), ...)."""
+    import zlib
+
+    import numpy
+
+    import liganimate
+
+    return (("liganimate", liganimate.__version__), ("numpy", numpy.__version__), ("zlib", zlib.ZLIB_RUNTIME_VERSION))
 
 
 def _processing(client):

@@ -597,3 +597,32 @@ def test_a_one_link_figure_can_only_translate_and_no_goals_is_nothing_to_do():
     assert still.status == "stalled" and still.residuals[0] == pytest.approx(np.sqrt(14))
     idle = solve_pose(chain(2), [], start=np.full((2, 3), 10.0))
     assert idle.converged and np.all(idle.angles == 10.0)
+
+
+# ------------------------------------------------------------------ the solver registry
+
+
+def test_the_solver_registry_is_the_one_table_of_names_words_and_limits():
+    from liganimate.runtime.ik import solvers as S
+    from liganimate.runtime.ik.reach import DEFAULT_MAX_ITERATIONS
+
+    assert S.SOLVER_NAMES == tuple(SOLVERS)
+    assert dict(S.SOLVER_KEYWORDS) == {"DLS": "dls", "TRANSPOSE": "transpose", "CCD": "ccd"}
+    assert DEFAULT_MAX_ITERATIONS == {name: spec.max_iterations for name, spec in S.SOLVERS.items()}
+    assert DEFAULT_MAX_ITERATIONS == {"dls": 200, "transpose": 5000, "ccd": 500}
+    assert not S.SOLVERS["ccd"].jacobian and S.SOLVERS["dls"].jacobian
+    with pytest.raises(TypeError):
+        S.SOLVERS["newton"] = S.SOLVERS["dls"]  # read-only: one table, not a copy per reader
+
+
+def test_the_solver_names_load_without_the_figure_code():
+    """The compiler imports the registry for the solver names; that must not load the kinematics."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS; "
+        "print(sorted(m for m in sys.modules if m.startswith('liganimate.runtime.') and 'ik.solvers' not in m))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "['liganimate.runtime.ik']"

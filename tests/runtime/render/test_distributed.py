@@ -280,3 +280,52 @@ def test_a_worker_process_sets_up_its_allocator_once_before_its_first_task(monke
     assert dask_render._call(abs, (), -2) == 2
     assert dask_render._call(abs, (), -3) == 3
     assert calls == [os.getpid()]
+
+
+class _Answers:
+    """A client whose workers answer ``run`` with the given results (what a real cluster returns)."""
+
+    def __init__(self, answers):
+        self.answers = answers
+
+    def run(self, fn, on_error):
+        assert on_error == "return"
+        return self.answers
+
+
+def test_workers_without_liganimate_or_with_other_versions_are_refused_before_any_task():
+    mine = dask_render._environment()
+    dask_render._check_workers(_Answers({"tcp://w1:1": mine, "tcp://w2:1": [list(p) for p in mine]}))
+    missing = Exception("ModuleNotFoundError(\"No module named 'liganimate'\")")
+    with pytest.raises(RenderError, match=r"^the Dask worker at tcp://w2:1 cannot import liganimate"):
+        dask_render._check_workers(_Answers({"tcp://w1:1": mine, "tcp://w2:1": missing}))
+    older = tuple((name, "0.0.1") if name == "numpy" else (name, v) for name, v in mine)
+    with pytest.raises(RenderError, match=r"^the Dask worker at tcp://w1:1 has numpy 0\.0\.1, this machine "):
+        dask_render._check_workers(_Answers({"tcp://w1:1": older}))
+
+
+# Loaded by the workers' Python at start-up (sitecustomize on PYTHONPATH): liganimate is not installed there.
+_NO_LIGANIMATE = """\
+import sys
+
+
+class _Hide:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] == "liganimate":
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+        return None
+
+
+sys.meta_path.insert(0, _Hide())
+"""
+
+
+def test_a_cluster_whose_workers_lack_liganimate_is_refused_in_words(tmp_path, monkeypatch):
+    (tmp_path / "sitecustomize.py").write_text(_NO_LIGANIMATE)
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))  # read by the worker processes when they start
+    with distributed.LocalCluster(
+        n_workers=1, processes=True, threads_per_worker=1, dashboard_address=":0", silence_logs=50
+    ) as bare:
+        with pytest.raises(RenderError) as err:
+            DaskExecutor(bare)
+    assert err.value.message.endswith("cannot import liganimate; install the same liganimate on every worker")
