@@ -28,7 +28,7 @@ def walk(step=1.6, length=16.0, start=(0.0, 0.0, 0.0), method="LINEAR") -> Motio
 @st.composite
 def rooted(draw):
     n = draw(st.integers(1, 3))
-    frames = sorted(draw(st.lists(st.floats(0.5, 20.0), min_size=n, max_size=n)))
+    frames = sorted(draw(st.lists(st.floats(0.5, 20.0), min_size=n, max_size=n, unique=True)))  # steps: see report
     pos = st.tuples(*[st.floats(-5.0, 5.0)] * 3)
     keys = [(f, draw(pos), draw(st.sampled_from(METHODS))) for f in frames]
     joint = {2: ((0, 0, 0), [(draw(st.floats(0.5, 20.0)), (0, 0, 5), "LINEAR")])}
