@@ -27,6 +27,7 @@ import errno
 import os
 import sys
 import tempfile
+import threading
 from typing import Self
 
 from liganimate.runtime.errors import RenderError
@@ -251,10 +252,14 @@ class SyncBatch:
     """Files renamed into place without ``fsync``, made durable together every ``every`` files.
 
     :meth:`add` notes a file once it has been renamed into place; every
-    ``every`` files, and on :meth:`sync`, the noted files' data and then
-    their folders are flushed to disk.  On Linux one ``syncfs`` call flushes
-    the whole file system the folder is on (one journal commit for the
-    batch, not one a file); elsewhere each file is opened and synced.
+    ``every`` files the noted files' data and then their folders are
+    flushed to disk, in a thread of its own (the flush waits for the disk,
+    and the caller need not); :meth:`sync` flushes everything noted and
+    waits for it.  On Linux one ``syncfs`` call flushes the whole file
+    system the folder is on (one journal commit for the batch, not one a
+    file); elsewhere each file is opened and synced.  Failures to sync are
+    ignored: the files are whole either way, only their durability is at
+    stake.
 
     Parameters
     ----------
@@ -272,35 +277,49 @@ class SyncBatch:
         self.every = max(1, int(every))
         self.files: list = []
         self.folders: dict = {}  # folder -> None, in order first seen
+        self._thread: threading.Thread | None = None
 
     def add(self, path) -> None:
-        """Note ``path`` (renamed into place); sync the batch when it is full."""
+        """Note ``path`` (renamed into place); start a sync of the batch when it is full."""
         self.files.append(os.fspath(path))
-        if len(self.files) >= self.every:
-            self.sync()
+        if len(self.files) >= self.every and (self._thread is None or not self._thread.is_alive()):
+            files, folders = self._take()
+            self._thread = threading.Thread(target=_sync, args=(files, folders), name="liganimate-sync", daemon=True)
+            self._thread.start()
 
     def add_folder(self, folder) -> None:
         """Sync ``folder`` too at the next :meth:`sync` (a folder made, a file renamed into it)."""
         self.folders[os.fspath(folder)] = None
 
     def sync(self) -> None:
-        """Flush every noted file, then the folders holding them; errors are ignored (best effort)."""
+        """Flush every noted file, then the folders holding them, and wait for it (best effort)."""
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        _sync(*self._take())
+
+    def _take(self) -> tuple:
         files, self.files = self.files, []
         folders = dict.fromkeys(os.path.dirname(os.path.abspath(f)) for f in files)
         folders.update(self.folders)
         self.folders = {}
-        if not files and not folders:
-            return
-        # One syncfs per file system the files are on; per-file fsync where that is not possible.
-        devices: dict = {}
-        for folder in folders:
-            with contextlib.suppress(OSError):
-                devices.setdefault(os.stat(folder).st_dev, folder)
-        if files and not (devices and all(_syncfs(f) for f in devices.values())):
-            for f in files:
-                _fsync_path(f)
-        for folder in folders:
-            fsync_folder(folder)
+        return files, list(folders)
+
+
+def _sync(files: list, folders: list) -> None:
+    """Flush ``files`` to disk, then ``folders``; errors are ignored."""
+    if not files and not folders:
+        return
+    # One syncfs per file system the files are on; per-file fsync where that is not possible.
+    devices: dict = {}
+    for folder in folders:
+        with contextlib.suppress(OSError):
+            devices.setdefault(os.stat(folder).st_dev, folder)
+    if files and not (devices and all(_syncfs(f) for f in devices.values())):
+        for f in files:
+            _fsync_path(f)
+    for folder in folders:
+        fsync_folder(folder)
 
 
 def _fsync_path(path: str) -> None:

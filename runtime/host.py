@@ -537,23 +537,24 @@ class Runtime(Arithmetic):
         spec = {}
         for joint, start, kfs, jat in joints:
             if joint in spec:
-                self.fail(jat, f"joint {joint} appears twice in this motion")
+                self.fail(jat, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
             last = 0
             for frame, pos, _method, kat in kfs:
                 self._guard(kat, E.check_frame, frame)
-                self._guard(kat, E.check_angles, pos)
+                self._guard(kat, E.check_angles, pos, joint is None)
                 if frame < last:
                     self.fail(kat, messages.keyframes_out_of_order(frame, last))
                 if 0 < frame - last < N.MIN_FRAME_GAP:
                     self.fail(kat, messages.keyframes_too_close(frame, last), messages.GAP_HINT)
                 last = frame
             if start is not None:
-                self._guard(jat, E.check_angles, start)
+                self._guard(jat, E.check_angles, start, joint is None)
             spec[joint] = (
                 tuple(start) if start is not None else (0.0, 0.0, 0.0),
                 [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
-        return self._guard(at, M.Motion.from_tracks, spec)
+        root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
+        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root))
 
     def concat(self, a, b, at):
         return self._guard(at, M.concat, self._motion(a, at), self._motion(b, at))
@@ -674,7 +675,7 @@ class Runtime(Arithmetic):
         state = self.scene
         for name, value in pairs:
             if isinstance(value, Posed):
-                state.drawn.append((name, value))
+                state.drawn.append((name, _rooted(value)))
         if self.renderer is not None:
             self.renderer.add_tick(state, self)
         state.drawn = []
@@ -726,6 +727,15 @@ class SceneState:
         self.length = 0
         self.sameframe = 1
         self.at = at
+
+
+def _rooted(posed: Posed) -> Posed:
+    """A drawn pose with its motion's root path folded into the placement (world = placement @ Trans(root) @ pose)."""
+    if posed.motion.root is None:
+        return posed
+    fig = posed.figure
+    placed = P.rooted_placements(np.asarray(fig.placement)[None], posed.motion, np.array([posed.frame]))[0]
+    return posed.with_figure(fig.with_placement(placed))
 
 
 def _sentence(message: str) -> str:

@@ -28,13 +28,18 @@ def model_table(figure, label: str, motion=None, frame: float | None = None) -> 
 
 
 def motion_listing(motion, label: str) -> str:
-    """``PRINT motion``: its length and joints, then each joint's keyframes (at most 1,000 a joint)."""
+    """``PRINT motion``: its length and joints, then each joint's keyframes and the ROOT track's (at most 1,000 each)."""
     joints = ", ".join(map(str, motion.joints)) or "none"
     lines = [f"MOTION {label}: length {motion.length:g} frames, joints {joints}"]
     try:
         for j in motion.joints:
             start, kfs = motion.keyframes(j, limit=1000)
             lines.append(f"  JOINT {j} POSITION {_vector(start)}")
+            for frame, val, method in kfs:
+                lines.append(f"    FRAME {frame:g} POSITION {_vector(val)} INTERPOLATE {method}")
+        if motion.root is not None:
+            start, kfs = motion.root_keyframes(limit=1000)
+            lines.append(f"  ROOT POSITION {_vector(start)}")
             for frame, val, method in kfs:
                 lines.append(f"    FRAME {frame:g} POSITION {_vector(val)} INTERPOLATE {method}")
     except LigError:

@@ -520,23 +520,25 @@ class _State:
 
     def end_iteration(self, idx: np.ndarray) -> None:
         """Count an iteration of sub-batch ``idx``, apply :func:`_progress`, then :meth:`end_attempts`."""
-        self.iterations[idx] += 1
-        self.attempt_iter[idx] += 1
+        # The whole batch (so always, until the first element stops): views, not gathered copies.
+        sel = slice(None) if idx.size == self.x.shape[0] else idx
+        self.iterations[sel] += 1
+        self.attempt_iter[sel] += 1
         if self.history is not None:
             self.history.append(self.f.copy())
         status, window_f, fast_f, gave_up = _progress(
             np.where,
-            self.status[idx],
-            self.attempt_iter[idx],
-            self.f[idx],
-            self.window_f[idx],
-            self.fast_f[idx],
+            self.status[sel],
+            self.attempt_iter[sel],
+            self.f[sel],
+            self.window_f[sel],
+            self.fast_f[sel],
             self.max_iter,
-            self.attempts_left[idx] > 0,
-            self.giveup_floor[idx],
+            self.attempts_left[sel] > 0,
+            self.giveup_floor[sel],
         )
-        self.status[idx], self.window_f[idx], self.fast_f[idx] = status, window_f, fast_f
-        self.gave_up[idx] |= gave_up
+        self.status[sel], self.window_f[sel], self.fast_f[sel] = status, window_f, fast_f
+        self.gave_up[sel] |= gave_up
         self.end_attempts(idx)
 
     def end_attempts(self, idx: np.ndarray) -> None:

@@ -28,7 +28,7 @@ class EditError(MotionError):
 class KeyframeEdits:
     """A motion being written keyframe by keyframe: a base motion and a chain of edits.
 
-    ``edit`` is ``(joint, k, frame, position (3,), method or None, at)``.
+    ``edit`` is ``(joint, k, frame, position (3,), method or None, at)``; joint None is the ROOT track.
     """
 
     __slots__ = ("_cache", "base", "edit", "parent")
@@ -55,8 +55,20 @@ def check_frame(frame) -> None:
         )
 
 
-def check_angles(position) -> None:
-    """A keyframe's angles (3,) within the limits of lang/numbers.py, or MotionError."""
+def check_angles(position, root: bool = False) -> None:
+    """A keyframe's angles (3,) within the limits of lang/numbers.py, or MotionError.
+
+    ``root``: the position is a ROOT track's, a point within the geometry limit.
+    """
+    if root:
+        if not max(abs(a) for a in position) <= N.GEOMETRY_MAX:
+            far = max(abs(a) for a in position)
+            raise MotionError(
+                f"a root position {N.magnitude(far)} from the origin is beyond the geometry limit, "
+                f"{N.magnitude(N.GEOMETRY_MAX)}",
+                "everything drawn stays within 1E12 units of the origin",
+            )
+        return
     if not max(abs(a) for a in position) <= N.MAX_ANGLE:
         far = max(abs(a) for a in position)
         raise MotionError(
@@ -76,7 +88,7 @@ def set_keyframe(m, joint: int, k: int, frame, position, method: str | None, at)
             "number the keyframes of each joint 1, 2, 3, ...",
         )
     check_frame(frame)
-    check_angles(position)
+    check_angles(position, joint is None)
     if isinstance(m, KeyframeEdits):
         return KeyframeEdits(m.base, (joint, k, frame, tuple(position), method, at), m)
     return KeyframeEdits(m, (joint, k, frame, tuple(position), method, at), None)
@@ -102,9 +114,9 @@ def apply(m: KeyframeEdits) -> Motion:
     edits.reverse()
     base = m.base
     tracks: dict = {}
-    for j in base.joints:
+    for j in base.joints + ((None,) if base.root is not None else ()):
         # Keep each keyframe's ramp so a stretched motion stays stretched.
-        start, kfs = base.keyframes(j, with_ramps=True)
+        start, kfs = base.root_keyframes(with_ramps=True) if j is None else base.keyframes(j, with_ramps=True)
         tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None, kf[3]) for i, kf in enumerate(kfs)}]
     for joint, k, frame, position, method, eat in edits:
         entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
@@ -120,7 +132,7 @@ def apply(m: KeyframeEdits) -> Motion:
             # The keys are 1..n exactly when there are n of them; else find the first gap (O(set), not O(n)).
             first = next(i for i, k in enumerate(numbers, start=1) if k != i)
             raise EditError(
-                f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
+                f"keyframe {n} of {_track_name(joint)} is set, but keyframe {first} never is",
                 "number the keyframes of each joint 1, 2, 3, ... without gaps",
                 kfs[n][3],
             )
@@ -129,13 +141,18 @@ def apply(m: KeyframeEdits) -> Motion:
         for i in range(len(seq)):
             gap = seq[i][0] - previous
             if gap < 0:
-                where = f"keyframe {i + 1} of joint {joint}"
+                where = f"keyframe {i + 1} of {_track_name(joint)}"
                 raise EditError(messages.keyframes_out_of_order(seq[i][0], previous, where), None, seq[i][3])
             if 0 < gap < N.MIN_FRAME_GAP:
-                where = f"keyframe {i + 1} of joint {joint}"
+                where = f"keyframe {i + 1} of {_track_name(joint)}"
                 raise EditError(messages.keyframes_too_close(seq[i][0], previous, where), messages.GAP_HINT, seq[i][3])
             previous = seq[i][0]
         spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
-    motion = Motion.from_tracks(spec)
+    root = spec.pop(None, None)
+    motion = Motion.from_tracks(spec, root=root)
     m._cache = motion
     return motion
+
+
+def _track_name(joint) -> str:
+    return "the ROOT track" if joint is None else f"joint {joint}"

@@ -125,6 +125,14 @@ class Track:
     def _emit(self, out: _Emitter, offset: float) -> None:
         raise NotImplementedError
 
+    # Nodes defined elsewhere (the root path's Shift, liganimate.runtime.motion.path)
+    # take part in smooth junctions through these two.
+    def _edge_leaf(self, side: str) -> Leaf | None:
+        return None
+
+    def _with_edge(self, side: str, edge: Edge) -> Track:
+        raise TypeError(f"track {type(self).__name__} has no edge leaf")  # pragma: no cover
+
 
 # ---------------------------------------------------------------------------
 # Leaves
@@ -492,7 +500,7 @@ class Leaf(Track):
 
     def _emit(self, out, offset):
         for f, v, m, r in zip(self.frames, self.values, self.methods, self.ramps):
-            out.add(offset + f, v, m.name, r)
+            out.add(offset + f, v + out.shift, m.name, r)
 
 
 def _col(a):
@@ -978,7 +986,7 @@ def edge_leaf(track: Track, side: str) -> Leaf | None:
         if side == "right" and track.end != (track.n - 1) * track.period + track.inner.end:
             return None
         return edge_leaf(track.inner, side)
-    return None
+    return track._edge_leaf(side)
 
 
 def with_edge(track: Track, side: str, edge: Edge) -> Track:
@@ -1013,7 +1021,7 @@ def with_edge(track: Track, side: str, edge: Edge) -> Track:
         if side == "left":
             return concat(with_edge(inner, side, edge), rest, P, track.right, track.end)
         return concat(rest, with_edge(inner, side, edge), (n - 1) * P, track.right, track.end)
-    raise TypeError(f"track {type(track).__name__} has no edge leaf")  # pragma: no cover
+    return track._with_edge(side, edge)
 
 
 def join_smoothly(first: Track, second: Track, pivot: float) -> tuple[Track, Track]:
@@ -1307,6 +1315,8 @@ class _Emitter:
         self.limit = limit
         self.cur = start
         self.last = 0.0
+        # Added to every value emitted: the displacement a root path's Shift nodes carry.
+        self.shift = np.zeros(3)
 
     def add(self, frame, value, method, ramp):
         if len(self.keys) >= self.limit:
@@ -1342,6 +1352,7 @@ class _Emitter:
         """
         if smooth and self.last == frame:
             return
+        start = start + self.shift
         self.hold_until(frame)
         if not (self._at_step() and np.array_equal(self.cur, start)):
             self.add(frame, start, "LINEAR", RAMP)

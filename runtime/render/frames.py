@@ -30,13 +30,14 @@ leaves only whole files.
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import json
 import os
 import signal
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
@@ -63,6 +64,8 @@ BATCH = 32
 CHUNK = 8
 # Frames written between two flushes to disk (see the module's notes).
 SYNC_EVERY = 512
+# Threads writing PNG files.
+WRITERS = 2
 # Bounds of the memory of evaluated joint angles: (model, motion) pairs, frames each.
 _ANGLE_MODELS = 64
 _ANGLE_FRAMES = 4096
@@ -172,6 +175,8 @@ class Renderer:
         self._failed = False
         self._streams: list = []
         self._synced = SyncBatch(SYNC_EVERY)
+        self._files = None  # threads writing the PNG files, started with the first
+        self._writes: collections.deque = collections.deque()  # (future, path), in order
         # What the tasks send back: PNG bytes when frames are written, raw images for the movies.
         self._want = (out_dir is not None, bool(gif or mp4))
         if poses:
@@ -388,12 +393,42 @@ class Renderer:
             if png is not None:
                 folder = os.path.join(self.out_dir, f"scene{scene_id}")
                 path = os.path.join(folder, f"{number:05d}.png")
-                write_png_bytes(path, png, fsync=False)
-                self._synced.add(path)
+                self._write(path, png)
             if raw is not None:
                 for stream in self._streams:
                     stream.add(raw)
             self.written += 1
+
+    def _write(self, path, png) -> None:
+        """Write one PNG file in a helper thread: creating and renaming files waits on the file system.
+
+        The threads overlap that wait with the work of this process (the
+        system calls release the interpreter lock).  Files are noted for
+        the next flush to disk in order, as their writes complete.
+        """
+        if self._files is None:
+            self._files = ThreadPoolExecutor(max_workers=WRITERS, thread_name_prefix="liganimate-png")
+        self._writes.append((self._files.submit(write_png_bytes, path, png, fsync=False), path))
+        while self._writes and (len(self._writes) > 8 * WRITERS or self._writes[0][0].done()):
+            self._written()
+
+    def _written(self) -> None:
+        future, path = self._writes.popleft()
+        future.result()
+        self._synced.add(path)
+
+    def _stop_writes(self) -> None:
+        """Wait for every PNG being written (each is then whole, and none is missing before it)."""
+        files, self._files = self._files, None
+        if files is None:
+            return
+        try:
+            while self._writes:
+                future, path = self._writes.popleft()
+                if future.exception() is None:
+                    self._synced.add(path)
+        finally:
+            files.shutdown(wait=True)
 
     def _show_progress(self) -> None:
         if self.progress:
@@ -411,6 +446,8 @@ class Renderer:
         self._send()
         while self.futures:
             self._take()
+        while self._writes:
+            self._written()
         if self.progress and self.images:
             sys.stderr.write("\n")
         self._synced.sync()
@@ -466,6 +503,7 @@ class Renderer:
             self._stop_pool()
         finally:
             try:
+                self._stop_writes()
                 self._abort_outputs()
                 self.lock.sweep(self.out_dir, (self.gif, self.mp4, self.poses_path))
                 self._sync_folders()  # the frames of an interrupted run survive a power loss too
