@@ -1,6 +1,7 @@
-"""A vectorized z-buffer rasterizer for flat-shaded triangles.
+"""A vectorized z-buffer rasterizer for flat-shaded triangles, grey or RGB, with optional supersampling.
 
-No Python loop runs per triangle, row or pixel.  The pipeline:
+No Python loop runs per triangle, row or pixel (only per band of rows, a
+handful per frame).  The pipeline:
 
 1. to camera space; back faces dropped where ``cull`` allows;
 2. clipping against the near plane (a triangle with one vertex behind it
@@ -9,12 +10,17 @@ No Python loop runs per triangle, row or pixel.  The pipeline:
 3. projection; each triangle splits at its middle vertex into two
    trapezoids, and each trapezoid gives one span per pixel row, bounded by
    its two edges' crossings of the row's centre line;
-4. spans expand to fragments (pixels) with ``np.repeat``; each fragment
+4. on frames above ``_ONE_BAND_PIXELS``, trapezoids are cut at the edges
+   of bands of rows (about ``_BAND_PIXELS`` pixels each) and drawn band by
+   band, so a band's depth keys stay in the cache and no pass ever runs
+   over the whole frame: the cost grows with the pixels drawn, not faster;
+5. spans expand to fragments (pixels) with ``np.repeat``; each fragment
    gets an int64 key: the upper 32 bits of the float64 ``1/z`` (sign,
    exponent and 20 mantissa bits, so keys order like depths to about 1e-6
    relative) above the triangle's number.  One ``np.maximum.at`` then does
    the depth test *and* the tie rule: nearer wins, and at equal depth the
-   higher triangle number wins.
+   higher triangle number wins.  The fragments whose key is still there
+   afterwards paint their triangle's grey level or colour.
 
 Coverage rule: a pixel belongs to a triangle when its centre lies inside it;
 a centre exactly on an edge belongs to the triangle to its right, or below it
@@ -23,12 +29,19 @@ therefore never both cover, nor both miss, a pixel along it: the crossing
 point of a shared edge is computed from the same two vertices in the same
 order in both triangles, so it is bit-identical.
 
-Speed notes (measured with callgrind and wall time; see
+Anti-aliasing (``aa=N``) draws the same triangles with a camera of N times
+the resolution in each direction (:meth:`Camera.supersampled`), so each
+pixel gets N x N samples on a regular grid, then :func:`downsample` takes
+each block's mean rounded half up, in integers: the bytes are exact.
+
+Speed notes (measured with callgrind and CPU time; see
 ``benchmarks/raster.py``): ``np.repeat`` costs a few instructions per element
 where a gather (``np.take``, fancy indexing) costs 15-30, so per-span values
-reach fragments by repeating, never by gathering with a span index.  With
-EMPTY = 0 a new depth buffer is ``np.zeros``, whose pages the kernel supplies
-zeroed on first touch: cheaper than keeping a buffer and clearing it.
+reach fragments by repeating, never by gathering with a span index.  With a
+few hundred triangles a frame costs mostly numpy calls (about a microsecond
+each), so the per-triangle steps work on whole (k, N) blocks.  The algorithm
+before bands is kept in ``tests/runtime/render/raster_reference.py``; the
+tests check this one against it byte for byte.
 """
 
 from __future__ import annotations
@@ -318,7 +331,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
         hi = int(np.maximum.reduce(offset + count))
         zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
         offset -= lo
-        _band(zb, flat_img[lo:hi], offset, wstart, step, tag, count, shade, first_index)
+        _band(zb, flat_img[lo:hi], offset, wstart, step, tag, count, shade, first_index, flat_z is None)
         return first_index + n
     starts = bounds[:-1]
     los = np.minimum.reduceat(offset, starts).tolist()
@@ -335,16 +348,38 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
             zb = scratch[: hi - lo]
             if i:
                 zb.fill(EMPTY)
-        _band(zb, flat_img[lo:hi], offset[sl] - lo, wstart[sl], step[sl], tag[sl], count[sl], shade, first_index)
+        _band(
+            zb,
+            flat_img[lo:hi],
+            offset[sl] - lo,
+            wstart[sl],
+            step[sl],
+            tag[sl],
+            count[sl],
+            shade,
+            first_index,
+            flat_z is None,
+        )
     return first_index + n
 
 
-def _band(zb, im, offset, wstart, step, tag, count, shade, first_index):
-    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range)."""
+def _band(zb, im, offset, wstart, step, tag, count, shade, first_index, fresh):
+    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range).
+
+    ``fresh``: the depth keys were all EMPTY before this draw.
+    """
     ends = count.cumsum()
     if ends[-1] <= _CHUNK:
         pix, key = _expand(offset, wstart, step, tag, count, ends)
         np.maximum.at(zb, pix, key)
+        if fresh:
+            # Every key in the buffer is this draw's: each fragment may
+            # paint its pixel's winner (some pixels several times, alike).
+            key = zb.take(pix)
+            key &= _INDEX_MASK
+            key -= first_index
+            im[pix] = shade.take(key, axis=0)
+            return
         won = (zb.take(pix) == key).nonzero()[0]
         # A pixel is won by at most one fragment (keys are unique per
         # triangle, and a triangle covers a pixel at most once), so this
