@@ -73,6 +73,8 @@ class DaskExecutor:
 
     Attributes
     ----------
+    address : str
+        The scheduler's address, as messages give it.
     workers : int
         Threads of the cluster's workers when it was reached: how many tasks
         run at once (the renderer keeps about twice that many in flight).
