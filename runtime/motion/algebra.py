@@ -107,18 +107,18 @@ def _leaf(joint: int | None, spec) -> tr.Leaf:
         values.append(_vector(key[1], f"{where}: position"))
         methods.append(method)
         ramps.append(ramp)
-    values = np.reshape(values, (-1, 3))
+    positions = np.reshape(values, (-1, 3))
     tr.check_frames(np.asarray(frames, dtype=float), f"{who}: a keyframe list that")
     if joint is None:
-        far = float(np.max(np.abs(np.vstack([start[None, :], values]))))
+        far = float(np.max(np.abs(np.vstack([start[None, :], positions]))))
         if not far <= GEOMETRY_MAX:
             raise MotionError(
                 f"the root track: a position {magnitude(far)} from the origin is beyond the geometry limit, "
                 f"{magnitude(GEOMETRY_MAX)}"
             )
     else:
-        tr.check_angles(np.vstack([start[None, :], values]), f"{who}: a position that")
-    return tr.Leaf(start, frames, values, methods, ramps)
+        tr.check_angles(np.vstack([start[None, :], positions]), f"{who}: a position that")
+    return tr.Leaf(start, frames, positions, methods, ramps)
 
 
 class Motion:

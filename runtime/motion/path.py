@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from liganimate.runtime.motion import track as tr
+from . import track as tr
 
 __all__ = ["Drift", "Shift", "concat", "repeat", "reverse", "shift"]
 
@@ -201,10 +201,8 @@ def concat(a: tr.Track | None, la: float, b: tr.Track | None, lb: float) -> tr.T
         ``a`` until ``la``, then ``b`` moved so that it starts where ``a``
         ended; None if neither operand has a path.
     """
-    if a is None and b is None:
-        return None
     if b is None:
-        return tr.pad(a, la + lb)
+        return None if a is None else tr.pad(a, la + lb)
     if a is None:
         return b if la == 0 else tr.concat(tr.Const(b.start_value), b, la)
     moved = shift(b, a.end_value - b.start_value)

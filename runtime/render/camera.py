@@ -123,7 +123,6 @@ class Camera:
             raise RenderError(f"The near clipping distance must be positive, not {near!r}.")
         self.axes = np.stack([right, up, forward])
         self._supersampled: dict = {}
-        self._columns = np.ascontiguousarray(self.axes.T)
 
     def supersampled(self, factor: int) -> Camera:
         """The same view with ``factor`` times as many pixels in each direction.
@@ -167,17 +166,21 @@ class Camera:
             Camera-space coordinates; the third one is the depth.
         """
         q = np.asarray(points, dtype=np.float64) - self.point
-        # Written out as x * right + y * up + z * forward (each a row of
-        # ``axes`` broadcast against a column of ``q``) rather than as a
-        # matrix product: BLAS may round differently depending on a point's
-        # position in the array, and the rasterizer needs a shared vertex to
-        # land on bit-identical pixel coordinates in every triangle that
-        # uses it (no cracks along edges).
-        cols = self._columns
-        out = q[..., 0:1] * cols[0]
-        out += q[..., 1:2] * cols[1]
-        out += q[..., 2:3] * cols[2]
-        return out
+        a = self.axes
+        # Written out element-wise rather than as a matrix product: BLAS may
+        # round differently depending on a point's position in the array, and
+        # the rasterizer needs a shared vertex to land on bit-identical pixel
+        # coordinates in every triangle that uses it (no cracks along edges).
+        # (The rasterizer repeats this arithmetic on its own array layout.)
+        x, y, z = q[..., 0], q[..., 1], q[..., 2]
+        return np.stack(
+            [
+                x * a[0, 0] + y * a[0, 1] + z * a[0, 2],
+                x * a[1, 0] + y * a[1, 1] + z * a[1, 2],
+                x * a[2, 0] + y * a[2, 1] + z * a[2, 2],
+            ],
+            axis=-1,
+        )
 
     def camera_to_pixels(self, cam) -> np.ndarray:
         """Camera-space points to pixel coordinates and depth.

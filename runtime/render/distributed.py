@@ -73,6 +73,8 @@ class DaskExecutor:
 
     Attributes
     ----------
+    address : str
+        The scheduler's address, as messages give it.
     workers : int
         Threads of the cluster's workers when it was reached: how many tasks
         run at once (the renderer keeps about twice that many in flight).
@@ -132,7 +134,7 @@ class DaskExecutor:
         if self._closed:
             raise RuntimeError("cannot schedule new futures after shutdown")
         key = f"liganimate-draw-{self._token}-{next(self._count)}"
-        future = cf.Future()
+        future: cf.Future = cf.Future()
         future.set_running_or_notify_cancel()
         dask_future = self._client.submit(_call, fn, *args, key=key, pure=False, retries=self.retries)
         with self._lock:
@@ -258,7 +260,7 @@ def _connect(address, timeout: float):
     # left to the garbage collector, it prints a traceback while it times out again.
     client = distributed.Client.__new__(distributed.Client)
     try:
-        client.__init__(shown, timeout=timeout, set_as_default=False)
+        distributed.Client.__init__(client, shown, timeout=timeout, set_as_default=False)
     except Exception as exc:
         with contextlib.suppress(Exception):
             client.close(timeout=1)
@@ -288,7 +290,7 @@ def _probe(address: str, timeout: float) -> None:
 
 def _why(exc: BaseException) -> str:
     """Why a connection failed, in a few words (Dask wraps the system's reason in its own exceptions)."""
-    cause = exc
+    cause: BaseException | None = exc
     while cause is not None and not (isinstance(cause, OSError) and cause.strerror):
         cause = cause.__cause__ or cause.__context__
     if cause is not None:

@@ -1,6 +1,7 @@
-"""A vectorized z-buffer rasterizer for flat-shaded triangles.
+"""A vectorized z-buffer rasterizer for flat-shaded triangles, grey or RGB, with optional supersampling.
 
-No Python loop runs per triangle, row or pixel.  The pipeline:
+No Python loop runs per triangle, row or pixel (only per band of rows, a
+handful per frame).  The pipeline:
 
 1. to camera space; back faces dropped where ``cull`` allows;
 2. clipping against the near plane (a triangle with one vertex behind it
@@ -9,12 +10,17 @@ No Python loop runs per triangle, row or pixel.  The pipeline:
 3. projection; each triangle splits at its middle vertex into two
    trapezoids, and each trapezoid gives one span per pixel row, bounded by
    its two edges' crossings of the row's centre line;
-4. spans expand to fragments (pixels) with ``np.repeat``; each fragment
+4. on frames above ``_ONE_BAND_PIXELS``, trapezoids are cut at the edges
+   of bands of rows (about ``_BAND_PIXELS`` pixels each) and drawn band by
+   band, so a band's depth keys stay in the cache and no pass ever runs
+   over the whole frame: the cost grows with the pixels drawn, not faster;
+5. spans expand to fragments (pixels) with ``np.repeat``; each fragment
    gets an int64 key: the upper 32 bits of the float64 ``1/z`` (sign,
    exponent and 20 mantissa bits, so keys order like depths to about 1e-6
    relative) above the triangle's number.  One ``np.maximum.at`` then does
    the depth test *and* the tie rule: nearer wins, and at equal depth the
-   higher triangle number wins.
+   higher triangle number wins.  The fragments whose key is still there
+   afterwards paint their triangle's grey level or colour.
 
 Coverage rule: a pixel belongs to a triangle when its centre lies inside it;
 a centre exactly on an edge belongs to the triangle to its right, or below it
@@ -23,12 +29,19 @@ therefore never both cover, nor both miss, a pixel along it: the crossing
 point of a shared edge is computed from the same two vertices in the same
 order in both triangles, so it is bit-identical.
 
-Speed notes (measured with callgrind and wall time; see
+Anti-aliasing (``aa=N``) draws the same triangles with a camera of N times
+the resolution in each direction (:meth:`Camera.supersampled`), so each
+pixel gets N x N samples on a regular grid, then :func:`downsample` takes
+each block's mean rounded half up, in integers: the bytes are exact.
+
+Speed notes (measured with callgrind and CPU time; see
 ``benchmarks/raster.py``): ``np.repeat`` costs a few instructions per element
 where a gather (``np.take``, fancy indexing) costs 15-30, so per-span values
-reach fragments by repeating, never by gathering with a span index.  With
-EMPTY = 0 a new depth buffer is ``np.zeros``, whose pages the kernel supplies
-zeroed on first touch: cheaper than keeping a buffer and clearing it.
+reach fragments by repeating, never by gathering with a span index.  With a
+few hundred triangles a frame costs mostly numpy calls (about a microsecond
+each), so the per-triangle steps work on whole (k, N) blocks.  The algorithm
+before bands is kept in ``tests/runtime/render/raster_reference.py``; the
+tests check this one against it byte for byte.
 """
 
 from __future__ import annotations
@@ -318,7 +331,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
         hi = int(np.maximum.reduce(offset + count))
         zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
         offset -= lo
-        _band(zb, flat_img[lo:hi], offset, wstart, step, tag, count, shade, first_index)
+        _band(zb, flat_img[lo:hi], offset, wstart, step, tag, count, shade, first_index, flat_z is None)
         return first_index + n
     starts = bounds[:-1]
     los = np.minimum.reduceat(offset, starts).tolist()
@@ -335,16 +348,38 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
             zb = scratch[: hi - lo]
             if i:
                 zb.fill(EMPTY)
-        _band(zb, flat_img[lo:hi], offset[sl] - lo, wstart[sl], step[sl], tag[sl], count[sl], shade, first_index)
+        _band(
+            zb,
+            flat_img[lo:hi],
+            offset[sl] - lo,
+            wstart[sl],
+            step[sl],
+            tag[sl],
+            count[sl],
+            shade,
+            first_index,
+            flat_z is None,
+        )
     return first_index + n
 
 
-def _band(zb, im, offset, wstart, step, tag, count, shade, first_index):
-    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range)."""
+def _band(zb, im, offset, wstart, step, tag, count, shade, first_index, fresh):
+    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range).
+
+    ``fresh``: the depth keys were all EMPTY before this draw.
+    """
     ends = count.cumsum()
     if ends[-1] <= _CHUNK:
         pix, key = _expand(offset, wstart, step, tag, count, ends)
         np.maximum.at(zb, pix, key)
+        if fresh:
+            # Every key in the buffer is this draw's: each fragment may
+            # paint its pixel's winner (some pixels several times, alike).
+            key = zb.take(pix)
+            key &= _INDEX_MASK
+            key -= first_index
+            im[pix] = shade.take(key, axis=0)
+            return
         won = (zb.take(pix) == key).nonzero()[0]
         # A pixel is won by at most one fragment (keys are unique per
         # triangle, and a triangle covers a pixel at most once), so this
@@ -485,54 +520,64 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     in rows ``[b * band_rows, (b + 1) * band_rows)`` for some band ``b``
     that grows with ``k``.  ``band_rows`` None means one band.
 
-    Every step works on whole (N, 3) or (k, P) blocks: with a few hundred
+    Every step works on whole (k, N) or (k, P) blocks: with a few hundred
     triangles, the cost of a frame is mostly the number of numpy calls.
     """
     W, H = camera.size
+    # Component-major from here on, v[i, k] being coordinate k of vertex i
+    # of every triangle: numpy's loops over a last axis of length 3 cost
+    # more per element than the arithmetic.
+    n = len(tris)
+    v = np.ascontiguousarray(tris.reshape(n, 9).T).reshape(3, 3, n)
     # Facing is decided in world space (camera space is left-handed): the
     # sign of ((v1 - v0) x (v2 - v0)) . (eye - v0), cross product
     # component k being a[k+1] b[k+2] - a[k+2] b[k+1].
-    ab = tris[:, 1:] - tris[:, :1]  # (n, 2, 3): a, b
-    ab1, ab2 = ab.take(_NEXT, axis=2), ab.take(_AFTER, axis=2)
-    cross = ab1[:, 0] * ab2[:, 1]
-    cross -= ab2[:, 0] * ab1[:, 1]
-    cross *= camera.point - tris[:, 0]
-    front = cross[:, 0] + cross[:, 1]
-    front += cross[:, 2]
+    a, b = v[1] - v[0], v[2] - v[0]
+    cross = a.take(_NEXT, axis=0) * b.take(_AFTER, axis=0)
+    cross -= a.take(_AFTER, axis=0) * b.take(_NEXT, axis=0)
+    cross *= camera.point[:, None] - v[0]
+    front = cross[0] + cross[1]
+    front += cross[2]
     front = front > 0.0
     src = None  # the triangle each drawn one comes from; None for "itself"
     if cull is not None:
         keep = front | ~cull
         if not np.logical_and.reduce(keep):
             src = keep.nonzero()[0]
-            tris = tris.take(src, axis=0)
-    cam = camera.to_camera(tris)
-    if len(cam) and np.minimum.reduce(cam[:, :, 2], axis=None) < camera.near:
-        cam, src = _clip_near(cam, src, camera.near)
-    m = len(cam)
+            v = v.take(src, axis=2)
+    # To camera space as Camera.to_camera: component k is
+    # x a[k, 0] + y a[k, 1] + z a[k, 2], added in that order.
+    q = v - camera.point[:, None]
+    axes = camera.axes[:, :, None, None]
+    cam = q[:, 0] * axes[:, 0]  # (3 components, 3 vertices, n)
+    cam += q[:, 1] * axes[:, 1]
+    cam += q[:, 2] * axes[:, 2]
+    if cam.shape[2] and np.minimum.reduce(cam[2], axis=None) < camera.near:
+        clipped, src = _clip_near(cam.transpose(2, 1, 0), src, camera.near)
+        cam = np.ascontiguousarray(clipped.transpose(2, 1, 0))
+    m = cam.shape[2]
     if m == 0:
         return None
 
-    # Projection to pixels (as Camera.camera_to_pixels), with the vertices
+    # Projection to pixels (as Camera.camera_to_pixels), then the vertices
     # of each triangle sorted by y: that fixes the orientation of every edge
     # (top end first), which is what makes shared edges bit-identical.
-    xyw = np.empty((3, m, 3))  # x, y and 1/z of each vertex
-    s = camera.focal / cam[:, :, 2]
-    y = np.multiply(cam[:, :, 1], s, out=xyw[1])
+    xyw = np.empty((3, 3, m))  # x, y and 1/z of each vertex
+    s = camera.focal / cam[2]
+    y = np.multiply(cam[1], s, out=xyw[1])
     np.subtract(0.5 * H, y, out=y)
-    x = np.multiply(cam[:, :, 0], s, out=xyw[0])
+    x = np.multiply(cam[0], s, out=xyw[0])
     x += 0.5 * W
-    np.divide(1.0, cam[:, :, 2], out=xyw[2])
-    # A stable sort of three: vertex i goes to place rank_i, the number of
-    # vertices before it with y <= y_i plus those after it with y < y_i.
-    # (An argsort along axis 1 costs a sort call per triangle.)
-    later = y.take(_LATER, axis=1) < y.take(_EARLIER, axis=1)  # y1 < y0, y2 < y0, y2 < y1
-    place = later @ _RANKS
-    place += _aranges(3 * m)[0][: 3 * m].reshape(m, 3)
-    xyw_sorted = np.empty((3, 3 * m))
-    xyw_sorted[:, place.reshape(-1)] = xyw.reshape(3, 3 * m)
-    x, y, w = xyw_sorted.reshape(3, m, 3)
-    x0, y0, w0 = x[:, 0], y[:, 0], w[:, 0]
+    np.divide(1.0, cam[2], out=xyw[2])
+    # A stable sort of three (a bubble sort, swapping only on a strict <).
+    for i, j in ((0, 1), (1, 2), (0, 1)):
+        swap = xyw[1, j] < xyw[1, i]
+        if np.logical_or.reduce(swap):
+            was = xyw[:, i].copy()
+            np.copyto(xyw[:, i], xyw[:, j], where=swap)
+            np.copyto(xyw[:, j], was, where=swap)
+    x, y, w = xyw
+    x0, y0, w0 = x[0], y[0], w[0]
 
     # Each triangle is two trapezoids: rows whose centre r + 0.5 lies in
     # [y0, y1) are bounded by the long edge 0-2 and the upper edge 0-1,
@@ -543,15 +588,15 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     np.maximum(r, 0, out=r)
     np.minimum(r, H, out=r)
     r = r.astype(np.int64)
-    dx, dy, dw = x[:, 1:] - x[:, :1], y[:, 1:] - y[:, :1], w[:, 1:] - w[:, :1]  # vertices 1, 2 minus vertex 0
-    det = dx[:, 0] * dy[:, 1]
-    det -= dx[:, 1] * dy[:, 0]
+    dx, dy, dw = x[1:] - x[0], y[1:] - y[0], w[1:] - w[0]  # vertices 1, 2 minus vertex 0
+    det = dx[0] * dy[1]
+    det -= dx[1] * dy[0]
     visible = det != 0.0
-    visible &= np.maximum.reduce(x, axis=1) > 0.5 - 1e-9
-    visible &= np.minimum.reduce(x, axis=1) < W - 0.5 + 1e-9
-    rows = r[:, 1:] - r[:, :2]  # (m, 2): rows of the upper and the lower trapezoid
-    rows *= visible[:, None]
-    nrows = rows.T.ravel()
+    visible &= np.maximum(np.maximum(x0, x[1]), x[2]) > 0.5 - 1e-9
+    visible &= np.minimum(np.minimum(x0, x[1]), x[2]) < W - 0.5 + 1e-9
+    rows = r[1:] - r[:2]  # (2, m): rows of the upper and the lower trapezoid
+    rows *= visible
+    nrows = rows.reshape(-1)
     total = int(np.add.reduce(nrows))
     if total == 0:
         return None
@@ -564,33 +609,33 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     table = np.empty((13, 2, m))
     upper = table[:, 0]
     table[0] = x0
-    table[1] = x[:, :2].T
+    table[1] = x[:2]
     table[2] = y0
-    table[3] = y[:, :2].T
+    table[3] = y[:2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        np.divide(dx[:, 1], dy[:, 1], out=upper[4])
-        table[5] = (x[:, 1:] - x[:, :2]).T
-        table[5] /= (y[:, 1:] - y[:, :2]).T
+        np.divide(dx[1], dy[1], out=upper[4])
+        np.subtract(x[1:], x[:2], out=table[5])
+        table[5] /= y[1:] - y[:2]
         # 1/z is affine in screen space: 1/z = wc + gx x + gy y.
         gx, gy, wc = upper[6], upper[8], upper[7]
-        np.multiply(dw[:, 0], dy[:, 1], out=gx)
-        gx -= dw[:, 1] * dy[:, 0]
+        np.multiply(dw[0], dy[1], out=gx)
+        gx -= dw[1] * dy[0]
         gx /= det
-        np.multiply(dx[:, 0], dw[:, 1], out=gy)
-        gy -= dx[:, 1] * dw[:, 0]
+        np.multiply(dx[0], dw[1], out=gy)
+        gy -= dx[1] * dw[0]
         gy /= det
         np.multiply(gx, x0, out=wc)
         np.subtract(w0, wc, out=wc)
         wc -= gy * y0
-    np.minimum.reduce(w, axis=1, out=upper[9])
-    np.maximum.reduce(w, axis=1, out=upper[10])
+    np.minimum(np.minimum(w0, w[1]), w[2], out=upper[9])
+    np.maximum(np.maximum(w0, w[1]), w[2], out=upper[10])
     faces = front if src is None else front.take(src)
     if not np.logical_and.reduce(faces):
         upper[6:11] *= np.where(faces, 1.0, 1.0 - _BACK_BIAS)
     table[[4, 6, 7, 8, 9, 10], 1] = upper[[4, 6, 7, 8, 9, 10]]
     table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
     table = table.reshape(13, 2 * m)
-    first_row = r[:, :2].T.ravel()
+    first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
 
     bounds = [0, total]
     if band_rows is not None and band_rows < H:
@@ -663,11 +708,7 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
 # 1/z = wc + gx x + gy y, 9-10 the least and greatest 1/z, 11 the tag,
 # 12 first row centre minus the number of spans before.
 _NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
-# Vertex ranks by y from the three comparisons y1 < y0, y2 < y0, y2 < y1:
-# rank0 = a + b, rank1 = 1 - a + c, rank2 = 2 - b - c (the 0, 1, 2 come
-# from the arange added to them, which also adds 3 * triangle).
-_LATER, _EARLIER = np.array([1, 2, 2]), np.array([0, 0, 1])
-_RANKS = np.array([[1, -1, 0], [1, 0, -1], [0, 1, -1]])
+
 # From the first and one-past-last pixel column to the first and last centre.
 _CENTRES = np.array([[0.5], [-0.5]])
 

@@ -212,7 +212,7 @@ def test_shutdown_drops_tasks_not_started_and_waits_for_those_running(cluster, t
     ex = DaskExecutor(cluster)
     task = _slow_writer(str(tmp_path))
     futures = [ex.submit(task, i) for i in range(12)]
-    time.sleep(0.1)  # the scheduler hands the first tasks to the workers
+    _wait_for(lambda: dask_render._processing(ex.client))  # the scheduler has handed the first tasks out
     ex.shutdown(wait=True, cancel_futures=True)
     ran = sorted(p.name for p in tmp_path.iterdir())
     assert 0 < len(ran) < 12
