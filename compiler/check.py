@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from liganimate.lang import ast as A
 from liganimate.lang import bindings, messages, numbers
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import DRAW_WITH, MODIFIERS
 from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS  # the solver registry, by name only
 from liganimate.runtime.motion import interpolation
@@ -78,8 +79,12 @@ class _Stop(Exception):
     pass
 
 
-class Checker:
-    """Walks the tree once per scope, twice to settle implicit number types."""
+class Checker(NodeVisitor):
+    """Walks the tree once per scope, twice to settle implicit number types.
+
+    ``_s_<Node>(stmt, context)`` checks a statement, ``_e_<Node>(expr)`` an
+    expression and returns its type (see :class:`~liganimate.lang.visitor.NodeVisitor`).
+    """
 
     def __init__(self, program: A.Program, path: str | None = None, stack: tuple = (), opened: dict | None = None):
         self.program = program
@@ -337,17 +342,10 @@ class Checker:
             self._stmt(s, context)
 
     def _stmt(self, s, context: str) -> None:
-        method = getattr(self, "_s_" + type(s).__name__)
-        method(s, context)
+        self.dispatch("_s_", s)(s, context)
 
     def _s_PrimitiveDef(self, s, context):
         pass  # checked in its own scope
-
-    def _s_ProgramEnd(self, s, context):
-        pass
-
-    def _s_PatternDef(self, s, context):
-        pass
 
     def _s_Decl(self, s, context):
         for n in s.names:
@@ -467,9 +465,6 @@ class Checker:
                 items[1] if len(items) > 1 else node,
                 f"a position is three angles or one vector, not {len(items)} values",
             )
-
-    def _s_DoHeader(self, s, context):  # pragma: no cover - grouped away by the parser
-        pass
 
     def _s_Do(self, s, context):
         if isinstance(s.label, numbers.BadLiteral):
@@ -718,9 +713,6 @@ class Checker:
         if self.primitive is not None or context.startswith("scene"):
             self.err(s, "SHOOTSCENES belongs outside scenes and primitives")
 
-    def _s_Stop(self, s, context):
-        pass
-
     def _s_Load(self, s, context):
         if self.primitive is not None or context != "top" or id(s) not in self.top_loads:
             self.err(
@@ -746,9 +738,6 @@ class Checker:
             self.err(s, "DRAW belongs in a PRIMITIVE")
         for p in s.points:
             self._want(p, T.VECTOR, "a point (x, y, z)")
-
-    def _s_Continue(self, s, context):  # pragma: no cover - grouped away
-        pass
 
     # -------------------------------------------------------- expressions
     def _want(self, e, t: str, what: str) -> None:
@@ -784,7 +773,7 @@ class Checker:
         self.err(node, f"{name} is not defined", hint or "assign it or declare it (REAL, VECTOR, MODEL, ...) first")
 
     def expr(self, e):
-        t = getattr(self, "_e_" + type(e).__name__)(e)
+        t = self.dispatch("_e_", e, generic=False)(e)
         # A literal's type is its value's (expr_type): most nodes of a big
         # program are literals, and an entry each cost ~80 bytes a line.
         if type(e) is not A.Num:

@@ -18,6 +18,7 @@ from liganimate import __version__
 from liganimate.lang import ast as A
 from liganimate.lang import bindings
 from liganimate.lang import numbers as N
+from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import MODIFIERS
 from liganimate.runtime.ik.solvers import DEFAULT_SOLVER, SOLVER_KEYWORDS
 
@@ -66,8 +67,8 @@ _WORD = re.compile(r"(?<![\w.])[A-Z][A-Z0-9_]*\b")
 _CMP = {"=": "==", "<>": "!=", "/=": "!=", "<": "<", ">": ">", "<=": "<=", ">=": ">="}
 
 
-class Lowerer:
-    """Emits Python source line by line."""
+class Lowerer(NodeVisitor):
+    """Emits Python source line by line: ``s_<Node>`` for a statement, ``e_<Node>`` returns an expression's code."""
 
     def __init__(self, checked: Checked, module_doc_name: str):
         self.c = checked
@@ -196,7 +197,7 @@ class Lowerer:
             self.emit(item)
             cut(CHUNK_LINES)
         for i, stmt in enumerate(body):
-            getattr(self, "s_" + type(stmt).__name__)(stmt, "main")
+            self.dispatch("s_", stmt)(stmt, "main")
             if self.consume:
                 body[i] = stmt = None  # lowered: its part of the tree can go now
             cut(CHUNK_LINES)
@@ -261,20 +262,11 @@ class Lowerer:
     def block(self, stmts: list, where: str) -> None:
         start = len(self.lines)
         for s in stmts:
-            getattr(self, "s_" + type(s).__name__)(s, where)
+            self.dispatch("s_", s)(s, where)
         if len(self.lines) == start:
             self.emit("pass")
 
-    def s_Decl(self, s, where):
-        pass
-
     def s_PrimitiveDef(self, s, where):
-        pass
-
-    def s_PatternDef(self, s, where):
-        pass
-
-    def s_ProgramEnd(self, s, where):
         pass
 
     def s_Assign(self, s, where):
@@ -496,7 +488,7 @@ class Lowerer:
     def expr(self, e) -> str:
         if isinstance(e, tuple):  # a Python constant default (built-in primitives)
             return repr(e)
-        return getattr(self, "e_" + type(e).__name__)(e)
+        return self.dispatch("e_", e, generic=False)(e)
 
     def e_Num(self, e):
         return repr(e.value)
