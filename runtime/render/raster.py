@@ -130,8 +130,7 @@ def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: i
     shade, bg = _same_kind(shade, bg)
     cam = camera.supersampled(aa)
     W, H = cam.size
-    img = np.empty((H, W) + np.shape(bg), dtype=np.uint8)
-    img[...] = bg
+    img = np.full((H, W) + np.shape(bg), bg, dtype=np.uint8)
     # Nothing drawn yet: the depth buffer need only span the pixels touched.
     _draw(None, img, tris, shade, cam, cull, 0)
     return downsample(img, aa)
@@ -632,7 +631,8 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     faces = front if src is None else front.take(src)
     if not np.logical_and.reduce(faces):
         upper[6:11] *= np.where(faces, 1.0, 1.0 - _BACK_BIAS)
-    table[[4, 6, 7, 8, 9, 10], 1] = upper[[4, 6, 7, 8, 9, 10]]
+    table[4, 1] = upper[4]
+    table[6:11, 1] = upper[6:11]
     table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
     table = table.reshape(13, 2 * m)
     first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
