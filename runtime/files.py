@@ -46,7 +46,7 @@ _ERRNO_WORDS = {
 
 def os_error_words(exc: OSError) -> str:
     """A plain, lower-case phrase for an OSError ("no space left on device")."""
-    words = _ERRNO_WORDS.get(exc.errno)
+    words = _ERRNO_WORDS.get(exc.errno) if exc.errno is not None else None
     if words is None:
         text = exc.strerror or str(exc) or type(exc).__name__
         words = text[:1].lower() + text[1:]
@@ -209,6 +209,7 @@ class AtomicWriter:
         os.fchmod(self._fd, 0o666 & ~_UMASK)
         fd, self._fd = self._fd, -1
         os.close(fd)  # close can report a late write error (NFS, quotas): before the rename
+        assert self._tmp is not None  # set in __init__, cleared only here and by abort
         os.replace(self._tmp, self.path)
         self._tmp = None
 

@@ -278,7 +278,8 @@ class Renderer:
             fig, motion = r[4].figure, r[4].motion
             key = (id(fig.links), id(fig.joints), fig.main, id(motion))
             groups.setdefault(key, []).append(r)
-        results = {}
+        # (image, tick, object) -> its drawing; (image, tick, object, "pose") -> its pose record.
+        results: dict[tuple, tuple] = {}
         for reqs in groups.values():
             fig, motion = reqs[0][4].figure, reqs[0][4].motion
             frames = np.array([r[4].frame for r in reqs])
@@ -318,7 +319,7 @@ class Renderer:
             if len(self._angles) >= _ANGLE_MODELS:
                 self._angles.clear()
             entry = self._angles[key] = (fig.joints, motion, {})
-        memo = entry[2]
+        memo: dict = entry[2]
         missing = [f for f in dict.fromkeys(frames) if f not in memo]
         if missing:
             if len(memo) + len(missing) > _ANGLE_FRAMES:

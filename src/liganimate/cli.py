@@ -34,8 +34,8 @@ def _print_diagnostics(diags, stream=None) -> None:
 
 def _size(text: str):
     try:
-        w, h = text.lower().split("x")
-        w, h = int(w), int(h)
+        width, height = text.lower().split("x")
+        w, h = int(width), int(height)
         if w <= 0 or h <= 0 or w > 16384 or h > 16384:
             raise ValueError
         return w, h
