@@ -33,6 +33,7 @@ from liganimate.cli import load_program
 from liganimate.runtime.figure.pose import (
     joint_angles,
     mesh_table,
+    rooted_placements,
     world_transforms,
     world_triangles,
 )
@@ -69,7 +70,8 @@ def feet(fig, motion, speed):
     angles = joint_angles(fig, motion, frames)
     placement = np.repeat(np.asarray(fig.placement, dtype=np.float64)[None], len(frames), axis=0)
     placement[:, 0, 3] += speed * frames
-    X = world_transforms(fig, angles, placement)
+    # The motion's ROOT track carries the figure as ANIMATE does (placement @ Trans(root)).
+    X = world_transforms(fig, angles, rooted_placements(placement, motion, frames))
     table = mesh_table(fig)
     tris = world_triangles(table, X)  # (T, M, 3, 3)
     out = {}
@@ -130,18 +132,21 @@ def main() -> None:
     fig, motions = load()
     report = {}
     for name, motion in motions.items():
-        at = measure(fig, motion, SPEEDS[name])
+        # A motion that carries the figure needs no scene-level translation.
+        speed = 0.0 if motion.root is not None else SPEEDS[name]
+        at = measure(fig, motion, speed)
         v = best_speed(fig, motion)
         best = measure(fig, motion, v)
         report[name] = {
-            "speed": round(SPEEDS[name], 4),
+            "speed": round(speed, 4),
+            "root_track": motion.root is not None,
             **at,
             "best_speed": round(v, 4),
             "best_contact_mm": best["contact_mm"],
             "best_ankle_mm": best["ankle_mm"],
         }
         print(
-            f"{name:5s} at {SPEEDS[name] * 1000:6.1f} mm/frame: planted foot slides up to "
+            f"{name:5s} {'on its ROOT track' if motion.root is not None else f'at {speed * 1000:6.1f} mm/frame'}: planted foot slides up to "
             f"{at['contact_mm']:6.2f} mm/frame at the sole, {at['ankle_mm']:6.2f} at the ankle; "
             f"rests {at['rest_frames']} frames in a row; best body speed {v * 1000:6.1f} mm/frame "
             f"-> {best['contact_mm']:6.2f} / {best['ankle_mm']:6.2f} mm/frame"

@@ -11,7 +11,19 @@ Reported, side by side:
   and their ratio;
 * images/second of ``rasterize`` + ``write_png`` with one process and with
   two workers (processes and threads, both reported; the faster is
-  ``png_ips_2proc``).
+  ``png_ips_2proc``);
+* the cost of one frame at 640x480, 1920x1080 and 3840x2160 (same view, so
+  the figures cover proportionally more pixels), for the rasterizer and for
+  the previous one (``tests/runtime/render/raster_reference.py``) side by
+  side, with the ratios 1080p/480p (6.75x the pixels) and 4K/1080p (4x);
+* the fixed cost of a frame: a tiny scene (one box, 12 triangles) at
+  640x480, and the five figures at 64x48 (per-triangle work, almost no
+  pixels), old and new;
+* the cost multiplier of anti-aliasing (aa=2, aa=4) at 640x480.
+
+Frame costs are CPU time of this process (``time.process_time``), best of
+several rounds with old and new interleaved: on a shared machine, wall time
+also counts other processes' turns.
 
 The last line printed is one JSON object with the figures.
 
@@ -40,6 +52,11 @@ import numpy as np  # noqa: E402
 from liganimate.runtime.render.camera import Camera  # noqa: E402
 from liganimate.runtime.render.imagefiles import write_png  # noqa: E402
 from liganimate.runtime.render.raster import rasterize  # noqa: E402
+
+# The previous rasterizer, kept frozen beside the tests that check the new
+# one against it byte for byte.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "runtime", "render"))
+import raster_reference  # noqa: E402 - found through the sys.path line above
 
 SIZE = (640, 480)
 VIEW_POINT = (3.0, 4.0, 14.0)
@@ -246,6 +263,48 @@ def bench_png(frames: int, rounds: int, workers: int, mode: str) -> float:
             return _best_rate(run, frames, rounds)
 
 
+RESOLUTIONS = {"480p": (640, 480), "1080p": (1920, 1080), "4K": (3840, 2160)}
+
+
+def _frame_cost(draw, scenes, camera, frames: int, **kw) -> float:
+    """CPU milliseconds per frame of ``draw`` over ``frames`` frames of ``scenes``."""
+    cull = np.ones(len(scenes[0][0]), dtype=bool)
+    t0 = time.process_time()
+    for i in range(frames):
+        tris, shade = scenes[i % len(scenes)]
+        draw(tris, shade, camera, cull=cull[: len(tris)], **kw)
+    return (time.process_time() - t0) / frames * 1e3
+
+
+def bench_costs(frames: int, rounds: int) -> dict:
+    """Best CPU ms per frame: old and new at each resolution, the fixed costs, and aa.
+
+    Returns a dict keyed ``(implementation, case)``.
+    """
+    scenes = _scene_cache(20)
+    tiny = [(tris[:12], shade[:12]) for tris, shade in scenes]
+    cases = {name: (scenes, Camera(VIEW_POINT, VIEW_WIDTH, size), {}) for name, size in RESOLUTIONS.items()}
+    cases["tiny"] = (tiny, _camera(), {})
+    cases["64x48"] = (scenes, Camera(VIEW_POINT, VIEW_WIDTH, (64, 48)), {})
+    impls = {"old": raster_reference.rasterize, "new": rasterize}
+    jobs = [(impl, case) for case in cases for impl in impls]
+    jobs += [("new", "aa2"), ("new", "aa4")]
+    cases["aa2"] = (scenes, _camera(), {"aa": 2})
+    cases["aa4"] = (scenes, _camera(), {"aa": 4})
+    # Frames per round: fewer where a frame costs more, at least 2.
+    weight = {"480p": 1, "1080p": 6, "4K": 24, "tiny": 0.1, "64x48": 0.2, "aa2": 4, "aa4": 16}
+    best = {job: float("inf") for job in jobs}
+    for job in jobs:  # warm up (shared aranges, cameras)
+        impl, case = job
+        _frame_cost(impls[impl], cases[case][0], cases[case][1], 1, **cases[case][2])
+    for _ in range(rounds):
+        for job in jobs:
+            impl, case = job
+            n = max(2, int(frames / weight[case]))
+            best[job] = min(best[job], _frame_cost(impls[impl], cases[case][0], cases[case][1], n, **cases[case][2]))
+    return best
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="a short run (under a minute)")
@@ -277,6 +336,25 @@ def main(argv=None) -> int:
     print(f"rasterize + write_png, 1 process:   {png1:8.1f} images/s")
     print(f"rasterize + write_png, 2 processes: {png2p:8.1f} images/s")
     print(f"rasterize + write_png, 2 threads:   {png2t:8.1f} images/s")
+
+    cost = bench_costs(frames, rounds)
+    print("CPU ms per frame (best of rounds), previous rasterizer vs this one:")
+    for case in ["480p", "1080p", "4K", "tiny", "64x48"]:
+        old, new = cost["old", case], cost["new", case]
+        print(f"  {case:6s} old {old:8.3f}   new {new:8.3f}   old/new {old / new:5.2f}")
+    ratios = {
+        impl: (cost[impl, "1080p"] / cost[impl, "480p"], cost[impl, "4K"] / cost[impl, "1080p"])
+        for impl in ("old", "new")
+    }
+    for impl, (r1, r2) in ratios.items():
+        print(f"  {impl}: 1080p/480p {r1:5.2f} (pixels 6.75)   4K/1080p {r2:5.2f} (pixels 4)")
+    aa2, aa4 = cost["new", "aa2"] / cost["new", "480p"], cost["new", "aa4"] / cost["new", "480p"]
+    print(f"  anti-aliasing at 480p: aa=2 costs {aa2:5.2f}x aa=1, aa=4 {aa4:5.2f}x")
+    figures = {}
+    for case in ["480p", "1080p", "4K", "tiny", "64x48", "aa2", "aa4"]:
+        for impl in ("old", "new"):
+            if (impl, case) in cost:
+                figures[f"{impl}_ms_{case}"] = round(cost[impl, case], 4)
     print(
         json.dumps(
             {
@@ -289,6 +367,13 @@ def main(argv=None) -> int:
                 "png_ips_2proc": round(max(png2p, png2t), 1),
                 "png_ips_2proc_processes": round(png2p, 1),
                 "png_ips_2proc_threads": round(png2t, 1),
+                **figures,
+                "old_ratio_1080p_480p": round(ratios["old"][0], 2),
+                "new_ratio_1080p_480p": round(ratios["new"][0], 2),
+                "old_ratio_4k_1080p": round(ratios["old"][1], 2),
+                "new_ratio_4k_1080p": round(ratios["new"][1], 2),
+                "aa2_cost_x": round(aa2, 2),
+                "aa4_cost_x": round(aa4, 2),
                 "cores": os.cpu_count(),
                 "quick": args.quick,
             }

@@ -78,10 +78,12 @@ def capture_draws(program, size, every: int):
     """The triangles liganimate draws for every ``every``-th image: [(camera, tris, grey, cull)]."""
     got = []
     original = R.draw_images
+    seen = [0]  # images handed over so far: workers=1 hands them over in order
 
-    def grab(size_, chunk):
-        for path, draws in chunk:
-            index = int(os.path.basename(path)[:-4])
+    def grab(size_, draws_list, aa=1, png=True, raw=False):
+        for draws in draws_list:
+            index = seen[0]
+            seen[0] += 1
             if index % every:
                 continue
             parts = [(cam, p) for cam, ps in draws for p in ps]
@@ -95,6 +97,7 @@ def capture_draws(program, size, every: int):
                     np.concatenate([p[2] for _, p in parts]),
                 )
             )
+        return [(None, None)] * len(draws_list)
 
     R.draw_images = grab
     try:

@@ -438,7 +438,8 @@ class Checker:
 
     def _s_KeyframeAssign(self, s, context):
         self._define_as(s.target, T.MOTION, "{name} is {noun}; keyframes belong to a MOTION")
-        self._want(s.joint, T.INTEGER, "a joint identifier")
+        if not isinstance(s.joint, A.RootTrack):
+            self._want(s.joint, T.INTEGER, "a joint identifier")
         self._want(s.index, T.INTEGER, "a keyframe number")
         self._keyframe(s.keyframe)
         if self.scene is not None:
@@ -566,8 +567,17 @@ class Checker:
         self._define_as(s.name, T.MOTION, "{name} is {noun}, not a MOTION")
         seen = {}
         for j in s.joints:
-            self._want(j.joint, T.INTEGER, "a joint identifier")
-            if _const(j.joint) is not None and isinstance(j.joint, A.Num):
+            if isinstance(j.joint, A.RootTrack):
+                if "ROOT" in seen:
+                    self.err(
+                        j.joint,
+                        f"ROOT appears twice in motion {s.name.name}",
+                        f"the first is at line {seen['ROOT'].line}; a motion has one root track",
+                    )
+                seen["ROOT"] = j.joint.pos
+            else:
+                self._want(j.joint, T.INTEGER, "a joint identifier")
+            if isinstance(j.joint, A.Num) and _const(j.joint) is not None:
                 if j.joint.value in seen:
                     self.err(
                         j.joint,

@@ -293,9 +293,13 @@ class Lowerer:
         k = s.keyframe
         method = repr(k.method.name) if k.method is not None else "None"
         self.emit(
-            f"{s.target.name} = rt.set_keyframe({s.target.name}, {self.expr(s.joint)}, {self.expr(s.index)}, "
+            f"{s.target.name} = rt.set_keyframe({s.target.name}, {self.joint_or_root(s.joint)}, {self.expr(s.index)}, "
             f"{self.expr(k.frame)}, {self.position(k.position)}, {method}, {self.at(s)})"
         )
+
+    def joint_or_root(self, e) -> str:
+        """A keyframe's joint identifier, or None for the ROOT track."""
+        return "None" if isinstance(e, A.RootTrack) else self.expr(e)
 
     def position(self, items: list) -> str:
         if len(items) == 1:
@@ -350,7 +354,7 @@ class Lowerer:
                 method = repr(k.method.name) if k.method is not None else "None"
                 kfs.append(f"({self.expr(k.frame)}, {self.position(k.position)}, {method}, {self.at(k)})")
             inner = "".join(x + ", " for x in kfs)
-            self.emit(f"    ({self.expr(j.joint)}, {start}, ({inner}), {self.at(j)}),")
+            self.emit(f"    ({self.joint_or_root(j.joint)}, {start}, ({inner}), {self.at(j)}),")
         self.emit(f"), {self.at(s)})")
 
     def s_ReachBlock(self, s, where):

@@ -294,8 +294,13 @@ class ModelBlock(Node):
 
 
 @dataclass(slots=True)
+class RootTrack(Node):
+    """The word ROOT where a joint identifier stands: the motion's root-translation track."""
+
+
+@dataclass(slots=True)
 class MotionJoint(Node):
-    joint: Node
+    joint: Node  # RootTrack for the ROOT entry
     start: list | None
     keyframes: list
 

@@ -124,6 +124,8 @@ class ToAst(Transformer):
 
     def keyframe_assign(self, children):
         target, joint, index, op, keyframe = children
+        if isinstance(joint, TOKENS) and joint.type == "ROOT":
+            joint = A.RootTrack(_tpos(joint))
         return A.KeyframeAssign(span(children), _name(target), joint, index, op.value, keyframe)
 
     def keyframe(self, children):
@@ -273,6 +275,12 @@ class ToAst(Transformer):
                 keyframes.append(c)
             i += 1
         return A.MotionJoint(span(children), joint, start, keyframes)
+
+    def motion_root(self, children):
+        joint = A.MotionJoint(span(children), A.RootTrack(_tpos(children[0])), None, [])
+        rest = self.motion_joint([children[0], None] + list(children[1:]))
+        joint.start, joint.keyframes = rest.start, rest.keyframes
+        return joint
 
     def figure_stmt(self, children):
         model = _name(children[1])

@@ -436,7 +436,7 @@ class Runtime(Arithmetic):
                 f"keyframe {k} is beyond the last keyframe number allowed, {N.MAX_KEYFRAME:,}",
                 "number the keyframes of each joint 1, 2, 3, ...",
             )
-        self._keyframe_values(frame, position, at)
+        self._keyframe_values(frame, position, at, joint is None)
         base = m.base if isinstance(m, KeyframeEdits) else m
         return KeyframeEdits(
             base, (joint, k, frame, tuple(position), method, at), m if isinstance(m, KeyframeEdits) else None
@@ -453,9 +453,9 @@ class Runtime(Arithmetic):
         edits.reverse()
         base = m.base
         tracks: dict = {}
-        for j in base.joints:
+        for j in base.joints + ((None,) if base.root is not None else ()):
             # Keep each keyframe's ramp so a stretched motion stays stretched.
-            start, kfs = self._guard(at, lambda joint: base.keyframes(joint, with_ramps=True), j)
+            start, kfs = self._guard(at, _listing, base, j)
             tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None, kf[3]) for i, kf in enumerate(kfs)}]
         for joint, k, frame, position, method, eat in edits:
             entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
@@ -473,7 +473,7 @@ class Runtime(Arithmetic):
                 eat = kfs[n][3] if kfs[n][3] is not None else at
                 self.fail(
                     eat,
-                    f"keyframe {n} of joint {joint} is set, but keyframe {first} never is",
+                    f"keyframe {n} of {_track_name(joint)} is set, but keyframe {first} never is",
                     "number the keyframes of each joint 1, 2, 3, ... without gaps",
                 )
             seq = [kfs[i] for i in numbers]
@@ -484,14 +484,15 @@ class Runtime(Arithmetic):
                     eat = seq[i][3] if seq[i][3] is not None else at
                     self.fail(
                         eat,
-                        f"keyframe {i + 1} of joint {joint} is at frame {seq[i][0]:g}, "
+                        f"keyframe {i + 1} of {_track_name(joint)} is at frame {seq[i][0]:g}, "
                         + ("before" if gap < 0 else "too close after")
                         + f" keyframe {i} at frame {previous:g}",
                         None if gap < 0 else _GAP_HINT,
                     )
                 previous = seq[i][0]
             spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
-        motion = self._guard(at, M.Motion.from_tracks, spec)
+        root = spec.pop(None, None)
+        motion = self._guard(at, lambda: M.Motion.from_tracks(spec, root=root))
         m._cache = motion
         return motion
 
@@ -566,10 +567,10 @@ class Runtime(Arithmetic):
         spec = {}
         for joint, start, kfs, jat in joints:
             if joint in spec:
-                self.fail(jat, f"joint {joint} appears twice in this motion")
+                self.fail(jat, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
             last = 0
             for frame, pos, _method, kat in kfs:
-                self._keyframe_values(frame, pos, kat)
+                self._keyframe_values(frame, pos, kat, joint is None)
                 if frame < last:
                     self.fail(
                         kat, f"keyframes must be in ascending frame order: frame {frame:g} comes after frame {last:g}"
@@ -578,15 +579,16 @@ class Runtime(Arithmetic):
                     self.fail(kat, f"frame {frame:g} is too close after frame {last:g}", _GAP_HINT)
                 last = frame
             if start is not None:
-                self._angles(start, jat)
+                self._angles(start, jat, joint is None)
             spec[joint] = (
                 tuple(start) if start is not None else (0.0, 0.0, 0.0),
                 [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
-        return self._guard(at, M.Motion.from_tracks, spec)
+        root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
+        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root))
 
-    def _keyframe_values(self, frame, position, at) -> None:
-        """A keyframe's frame and angles within the limits of lang/numbers.py."""
+    def _keyframe_values(self, frame, position, at, root: bool = False) -> None:
+        """A keyframe's frame and angles (``root``: root positions) within the limits of lang/numbers.py."""
         if frame < 0:
             self.fail(at, f"frame {frame:g} is before the motion starts")
         if frame > N.MAX_FRAME:
@@ -594,9 +596,19 @@ class Runtime(Arithmetic):
                 at,
                 f"frame {N.magnitude(frame)} is beyond the last frame a keyframe may have, {N.magnitude(N.MAX_FRAME)}",
             )
-        self._angles(position, at)
+        self._angles(position, at, root)
 
-    def _angles(self, position, at) -> None:
+    def _angles(self, position, at, root: bool = False) -> None:
+        if root:
+            if not max(abs(a) for a in position) <= N.GEOMETRY_MAX:
+                far = max(abs(a) for a in position)
+                self.fail(
+                    at,
+                    f"a root position {N.magnitude(far)} from the origin is beyond the geometry limit, "
+                    f"{N.magnitude(N.GEOMETRY_MAX)}",
+                    "everything drawn stays within 1E12 units of the origin",
+                )
+            return
         if not max(abs(a) for a in position) <= N.MAX_ANGLE:
             far = max(abs(a) for a in position)
             self.fail(
@@ -724,7 +736,7 @@ class Runtime(Arithmetic):
         state = self.scene
         for name, value in pairs:
             if isinstance(value, Posed):
-                state.drawn.append((name, value))
+                state.drawn.append((name, _rooted(value)))
         if self.renderer is not None:
             self.renderer.add_tick(state, self)
         state.drawn = []
@@ -772,6 +784,11 @@ class Runtime(Arithmetic):
                     lines.append(f"  JOINT {j} POSITION {_fmt_vec(start)}")
                     for frame, val, method in kfs:
                         lines.append(f"    FRAME {frame:g} POSITION {_fmt_vec(val)} INTERPOLATE {method}")
+                if motion.root is not None:
+                    start, kfs = motion.root_keyframes(limit=1000)
+                    lines.append(f"  ROOT POSITION {_fmt_vec(start)}")
+                    for frame, val, method in kfs:
+                        lines.append(f"    FRAME {frame:g} POSITION {_fmt_vec(val)} INTERPOLATE {method}")
             except LigError:
                 lines.append("  " + motion.describe())
             return "\n".join(lines)
@@ -798,6 +815,26 @@ class SceneState:
 
 
 _GAP_HINT = f"two keyframes of a joint share a frame (a step) or lie at least {N.MIN_FRAME_GAP:g} frames apart"
+
+
+def _listing(motion: M.Motion, joint):
+    """One track's keyframes with their ramps (``joint`` None: the root track), so a stretched motion stays stretched."""
+    if joint is None:
+        return motion.root_keyframes(with_ramps=True)
+    return motion.keyframes(joint, with_ramps=True)
+
+
+def _track_name(joint) -> str:
+    return "the ROOT track" if joint is None else f"joint {joint}"
+
+
+def _rooted(posed: Posed) -> Posed:
+    """A drawn pose with its motion's root path folded into the placement (world = placement @ Trans(root) @ pose)."""
+    if posed.motion.root is None:
+        return posed
+    fig = posed.figure
+    placed = P.rooted_placements(np.asarray(fig.placement)[None], posed.motion, np.array([posed.frame]))[0]
+    return posed.with_figure(fig.with_placement(placed))
 
 
 def _fmt_vec(v) -> str:

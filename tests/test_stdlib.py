@@ -329,21 +329,39 @@ def test_hop_skip_jump_chain_without_a_jolt():
                 np.testing.assert_allclose(chain.evaluate([side]), 0.0, atol=1e-3)
 
 
-def test_walk_keeps_the_feet_near_the_ground():
-    # The pelvis is the main link and does not move, so the lowest point of
-    # the figure is where the ground must be: it stays within 4 cm over the
-    # cycle, and the foot off the ground never dips below the one on it.
+def _feet(name):
+    """World vertices (T, V, 3) of each foot over two cycles of a locomotion motion, on its ROOT track."""
     v = lib_values("humanoid")
-    fig, walk = v["HUMANOID"], v["WALK"]
-    times = np.arange(0.0, walk.length + 1)
-    angles = P.joint_angles(fig, walk, times)
-    X = P.world_transforms(fig, angles, np.repeat(np.eye(4)[None], len(times), axis=0))
+    fig, motion = v["HUMANOID"], v[name]
+    times = np.arange(0.0, 2 * motion.length + 1)
+    angles = P.joint_angles(fig, 2 * motion, times)
+    placed = np.repeat(np.asarray(fig.placement)[None], len(times), axis=0)
+    X = P.world_transforms(fig, angles, P.rooted_placements(placed, 2 * motion, times))
     table = P.mesh_table(fig)
     world = P.world_triangles(table, X)
     names = [l.name for l in fig.links]
-    lows = {foot: world[:, table.link == names.index(foot)][..., 1].min(axis=(1, 2)) for foot in ("R_FOOT", "L_FOOT")}
-    ground = np.minimum(lows["R_FOOT"], lows["L_FOOT"])
-    assert ground.max() - ground.min() < 0.04
+    return [world[:, table.link == names.index(foot)].reshape(len(times), -1, 3) for foot in ("R_FOOT", "L_FOOT")]
+
+
+@pytest.mark.parametrize("name", ["WALK", "RUN"])
+def test_locomotion_keeps_the_ground_level_and_the_planted_foot_still(name):
+    # The ROOT track carries the pelvis; the lowest point of the figure, where
+    # a foot is planted, stays on one level, the soles 0.972 m below the
+    # standing pelvis, and a planted foot slides less than 1 mm a frame.
+    feet = _feet(name)
+    ground = np.minimum(*[f[..., 1].min(axis=1) for f in feet])
+    assert ground.min() >= -0.972 - 1e-3  # no foot goes through the ground
+    if name == "WALK":  # a walk always has a foot on it (a run has flights)
+        np.testing.assert_allclose(ground, -0.972, atol=1e-3)
+    for f in feet:
+        planted = f[..., 1].min(axis=1) <= -0.972 + 1e-3
+        both = planted[1:] & planted[:-1]
+        assert both.sum() >= 4  # it does rest on the ground
+        slide = np.linalg.norm((f[1:] - f[:-1])[..., [0, 2]], axis=2).max(axis=1)
+        assert slide[both].max() < 1e-3, slide[both].max()
+    # And it travels: 1.2 m (WALK) or 2.2 m (RUN) a cycle.
+    travel = lib_values("humanoid")[name].root_offset([0.0, 1e9])
+    assert travel[1, 0] - travel[0, 0] == pytest.approx({"WALK": 1.2, "RUN": 2.2}[name])
 
 
 def test_squat_rooted_at_a_foot_keeps_both_feet_planted():

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import NoReturn
 
 import numpy as np
 
@@ -106,7 +107,7 @@ class _Tokens:
         self.line = 0  # index of the next line to read
         self.pending: list = []  # tokens left on the current line: (text, Pos)
 
-    def fail(self, pos: Pos, message: str, hint: str | None = None):
+    def fail(self, pos: Pos, message: str, hint: str | None = None) -> NoReturn:
         raise LigDiagnostics([Diagnostic(self.filename, pos, message, hint, source=self.text)])
 
     def end_pos(self) -> Pos:
@@ -173,7 +174,8 @@ def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
     if tok != "ROOT":
         tk.fail(pos, f"expected ROOT, the hierarchy's first joint, found '{tok}'")
 
-    names, parents, offsets, channels, end_sites, channel_pos = [], [], [], [], [], []
+    names, parents, offsets, channels, channel_pos = [], [], [], [], []
+    end_sites: list[np.ndarray | None] = []
 
     def joint(parent: int, keyword_pos: Pos) -> None:
         rest = tk.rest_of_line()
@@ -349,4 +351,5 @@ def _frames(tk: _Tokens, start: int, n_frames: int, n_channels: int) -> np.ndarr
                         f"'{t}' in frame {k + 1} is not a finite number",
                         "every channel value must be a number such as -12.5",
                     )
+        raise AssertionError("a frame value is not a finite number, yet every token is one")
     return values.reshape(n_frames, n_channels)

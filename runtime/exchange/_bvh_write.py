@@ -104,7 +104,9 @@ def bvh_text(model, fps: float, scene_id=None) -> bytes:
             edge_of[int(c)] = (int(k), near * factor, far * factor, bool(r))
 
     lines = ["HIERARCHY"]
-    columns = []  # (kind, index): ("pos", axis) / ("root", axis) / ("joint", k, axis, sign)
+    # Each channel, in the file's order, as (column, sign) of the (T, C) table
+    # [position (3), root angles (3), joint angles (3 per joint)] built below.
+    columns: list[tuple[int, float]] = []
 
     def visit(i: int, depth: int) -> None:
         pad = "  " * depth
@@ -113,7 +115,7 @@ def bvh_text(model, fps: float, scene_id=None) -> bytes:
             lines.append("{")
             lines.append("  OFFSET 0.0 0.0 0.0")
             lines.append("  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation")
-            columns.extend([("pos", 0), ("pos", 1), ("pos", 2), ("root", 2), ("root", 1), ("root", 0)])
+            columns.extend([(0, 1.0), (1, 1.0), (2, 1.0), (3 + 2, 1.0), (3 + 1, 1.0), (3 + 0, 1.0)])
             far_here = np.zeros(3)
         else:
             k, near, far, rev = edge_of[i]
@@ -124,10 +126,10 @@ def bvh_text(model, fps: float, scene_id=None) -> bytes:
             lines.append(f"{pad}  OFFSET {_num(off[0])} {_num(off[1])} {_num(off[2])}")
             if rev:
                 lines.append(f"{pad}  CHANNELS 3 Xrotation Yrotation Zrotation")
-                columns.extend([("joint", k, 0, -1.0), ("joint", k, 1, -1.0), ("joint", k, 2, -1.0)])
+                columns.extend([(6 + 3 * k + axis, -1.0) for axis in (0, 1, 2)])
             else:
                 lines.append(f"{pad}  CHANNELS 3 Zrotation Yrotation Xrotation")
-                columns.extend([("joint", k, 2, 1.0), ("joint", k, 1, 1.0), ("joint", k, 0, 1.0)])
+                columns.extend([(6 + 3 * k + axis, 1.0) for axis in (2, 1, 0)])
             far_here = far
         if children[i]:
             for c in children[i]:
@@ -149,16 +151,8 @@ def bvh_text(model, fps: float, scene_id=None) -> bytes:
     angles = model.angles.reshape(T, -1)
     table = np.concatenate([t, root, angles], axis=1)
     J3 = angles.shape[1]
-    idx = np.empty(len(columns), dtype=np.int64)
-    sign = np.ones(len(columns))
-    for n, col in enumerate(columns):
-        if col[0] == "pos":
-            idx[n] = col[1]
-        elif col[0] == "root":
-            idx[n] = 3 + col[1]
-        else:
-            idx[n] = 6 + 3 * col[1] + col[2]
-            sign[n] = col[3]
+    idx = np.array([c for c, _ in columns], dtype=np.int64)
+    sign = np.array([sg for _, sg in columns], dtype=np.float64)
     assert table.shape[1] == 6 + J3
     data = table[:, idx] * sign
     data += 0.0  # no -0.0

@@ -17,6 +17,7 @@ import base64
 
 import numpy as np
 import pygltflib as G
+from numpy.typing import ArrayLike
 
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure.pose import static_triangles
@@ -84,7 +85,7 @@ def gltf_document(scenes, fps: float = 24.0, size=(640, 480)):
     return b.finish()
 
 
-def _linear_from_grey(grey: np.ndarray) -> np.ndarray:
+def _linear_from_grey(grey: ArrayLike) -> np.ndarray:
     """sRGB-encoded grey levels (what the PNGs show) to glTF's linear colour factors."""
     c = np.asarray(grey, dtype=np.float64) / 255.0
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
@@ -95,7 +96,7 @@ class _Builder:
         self.fps = fps
         self.aspect = float(size[0]) / float(size[1])
         self.doc = G.GLTF2(asset=G.Asset(generator="liganimate", version="2.0"))
-        self.chunks = {0: [], 1: []}  # view 0: vertex data; view 1: animation data
+        self.chunks: dict[int, list[bytes]] = {0: [], 1: []}  # view 0: vertex data; view 1: animation data
         self.sizes = {0: 0, 1: 0}
         self.accessor_view: list = []
         self.materials: dict = {}

@@ -16,8 +16,9 @@ The motion has the captured frames as keyframes: frame ``f`` of the file is
 the order ``Zrotation Yrotation Xrotation`` (or any part of it) are the
 joint convention ``Rz Ry Rx`` already and are copied; any other order is
 turned into a rotation matrix and back into ``Rz Ry Rx`` angles, exactly.
-The ROOT's position channels are its path, written as a table in a comment
-(see :func:`read_root_path`): motions hold angles only.
+The ROOT's position channels are its path, written as the motion's ROOT
+track (one keyframe per frame), which ANIMATE follows; :func:`read_root_path`
+reads it back.
 """
 
 from __future__ import annotations
@@ -34,9 +35,8 @@ from liganimate.runtime.motion.algebra import Motion
 from ._numbers import format_rows
 from ._rotations import euler_zyx_from_matrix, matrix_from_axes
 
-__all__ = ["ROOT_PATH_MARK", "clip_angles", "lig_library", "read_root_path", "reduce_keyframes"]
+__all__ = ["clip_angles", "lig_library", "read_root_path", "reduce_keyframes"]
 
-ROOT_PATH_MARK = "ROOT PATH"
 DECIMALS = 7
 # Keywords and built-ins (compiler/names.py, read from the grammar), and the
 # segment name the writers give a figure's empty root.
@@ -195,8 +195,8 @@ def lig_library(
         f"C motion (frame 0 is its starting position). Play it with ANIMATE ... USING {motion}; for",
         "C real time render with --fps matching the capture.",
         "C",
-        "C The ROOT's path is the table in the comment at the end: a MOTION holds joint angles",
-        "C only, so the figure turns as captured but does not travel (see docs/exchange.md).",
+        "C The ROOT's path is the motion's ROOT track: ANIMATE carries the figure along it, in",
+        "C the model's own frame, after the placement (see docs/exchange.md).",
         "C",
         "C   joint  segment            BVH joint (channels)",
     ]
@@ -241,11 +241,15 @@ def lig_library(
     out.append("")
     head = ("\n".join(out) + "\n").encode("utf-8")
     keep = reduce_keyframes(angles, tolerance) if tolerance > 0 else None
-    return head + _motion_text(motion, angles, rotating, keep) + _path_table(path)
+    return head + _motion_text(motion, angles, rotating, keep, path)
 
 
-def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None) -> bytes:
-    """STARTMOTION ... ENDMOTION: keyframes at every frame (or at ``keep[j]``) for every joint that moves."""
+def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None) -> bytes:
+    """STARTMOTION ... ENDMOTION: keyframes at every frame (or at ``keep[j]``) for every joint that moves.
+
+    ``path`` (F, 3), if given, is the ROOT track: its start position, then a
+    keyframe at every frame if it moves.
+    """
     F, J = angles.shape[:2]
     parts = [f"      STARTMOTION {name}\n".encode("ascii")]
     moving = (angles != angles[:1]).any(axis=(0, 2)) if F > 1 else np.zeros(J, dtype=bool)
@@ -268,23 +272,24 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None)
                     suffix="\n",
                 )
             )
+    if path is not None:
+        parts.append(format_rows(path[:1], DECIMALS, sep=",", prefix="        ROOT POSITION", suffix="\n"))
+        if F > 1 and (path != path[:1]).any():
+            table = np.column_stack([frames, path[1:]])
+            parts.append(
+                format_rows(
+                    table,
+                    [0, DECIMALS, DECIMALS, DECIMALS],
+                    columns_prefix=["          FRAME", " POSITION", ",", ","],
+                    suffix="\n",
+                )
+            )
     parts.append(b"      ENDMOTION\n")
     return b"".join(parts)
 
 
-def _path_table(path: np.ndarray) -> bytes:
-    """The ROOT's path as a comment: a header line, then ``frame x y z`` per frame."""
-    F = len(path)
-    head = (
-        f"\n{{ {ROOT_PATH_MARK}: the BVH ROOT's position at each frame (frame, x, y, z). ANIMATE does not\n"
-        "  move a figure along it yet; liganimate.runtime.exchange.read_root_path reads it.\n"
-    )
-    table = np.column_stack([np.arange(F, dtype=np.float64), path])
-    return head.encode("ascii") + format_rows(table, [0, DECIMALS, DECIMALS, DECIMALS], prefix=" ") + b"}\n"
-
-
 def read_root_path(path: str) -> np.ndarray:
-    """The ROOT path table of a library written by ``liganimate import``.
+    """The ROOT track of a library written by ``liganimate import``, frame by frame.
 
     Parameters
     ----------
@@ -294,22 +299,27 @@ def read_root_path(path: str) -> np.ndarray:
     Returns
     -------
     ndarray, shape (F, 3)
-        The root's position at frames 0 .. F-1.
+        The root's position at frames 0 .. F-1 (F - 1 being its last
+        keyframe's frame; 1 row for a root that holds still).
 
     Raises
     ------
     ValueError
-        If the file has no such table.
+        If the file has no ROOT track.
     """
     with open(path, encoding="utf-8") as fh:
-        text = fh.read()
-    at = text.find("{ " + ROOT_PATH_MARK + ":")
-    if at < 0:
-        raise ValueError(f"{path} has no {ROOT_PATH_MARK} table")
-    body = text[at : text.index("}", at)]
-    rows = body.split("\n")[2:]
-    table = np.array([[float(v) for v in r.split()] for r in rows if r.strip()], dtype=np.float64).reshape(-1, 4)
-    return table[np.argsort(table[:, 0], kind="stable"), 1:]
+        lines = fh.read().split("\n")
+    at = next((i for i, line in enumerate(lines) if line.strip().startswith("ROOT POSITION")), None)
+    if at is None:
+        raise ValueError(f"{path} has no ROOT track")
+    rows = [[0.0] + [float(v) for v in lines[at].split("POSITION", 1)[1].split(",")]]
+    for line in lines[at + 1 :]:
+        words = line.split()
+        if not words or words[0] != "FRAME":
+            break
+        frame, rest = line.split("POSITION", 1)
+        rows.append([float(frame.split()[1])] + [float(v) for v in rest.split(",")])
+    return np.array(rows, dtype=np.float64)[:, 1:]
 
 
 def _wrapped(d: np.ndarray) -> np.ndarray:

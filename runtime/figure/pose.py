@@ -147,6 +147,34 @@ def mesh_table(fig: F.Figure) -> MeshTable:
     return table
 
 
+def rooted_placements(placements: np.ndarray, motion: Motion | None, frames: np.ndarray) -> np.ndarray:
+    """Host placements with a motion's root path applied: ``placement @ Trans(root(frame))``.
+
+    Parameters
+    ----------
+    placements : ndarray, shape (T, 4, 4)
+        Host placement of the current main link at each frame.
+    motion : Motion or None
+    frames : ndarray, shape (T,)
+        Motion frames.
+
+    Returns
+    -------
+    ndarray, shape (T, 4, 4)
+        ``placements`` itself when the motion has no root track; otherwise a
+        new array whose translation column moves by the placement's linear
+        part applied to the offset, so a model turned by ``<ROT Y 90>`` walks
+        along its turned path.
+    """
+    placements = np.asarray(placements, dtype=np.float64)
+    if motion is None or motion.root is None:
+        return placements
+    offset = motion.root_offset(np.asarray(frames, dtype=np.float64).reshape(-1))
+    out = placements.copy()
+    out[:, :3, 3] += np.einsum("tij,tj->ti", placements[:, :3, :3], offset)
+    return out
+
+
 def world_transforms(fig: F.Figure, angles: np.ndarray, placements: np.ndarray) -> np.ndarray:
     """Each link's shape-to-world transform.
 
@@ -219,7 +247,7 @@ def posed_graphical(fig: F.Figure, motion: Motion | None, frame: float) -> Graph
         angles = K.clamp(fig, np.zeros((1, fig.n_joints, 3)))
     else:
         angles = joint_angles(fig, motion, np.array([float(frame)]))
-    X = world_transforms(fig, angles, placement[None])
+    X = world_transforms(fig, angles, rooted_placements(placement[None], motion, np.array([float(frame)])))
     table = mesh_table(fig)
     closed = table.closed & (np.linalg.det(placement[:3, :3]) > 0)
     return Graphical(world_triangles(table, X)[0], table.lightness, closed, table.colour)

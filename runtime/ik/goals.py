@@ -299,9 +299,9 @@ class GoalStack:
         self.goals = tuple(goals)
         self.warnings: list[str] = []
         scale = model.link_scale
-        pts = {"link": [], "local": [], "target": [], "w": [], "index": []}
-        pls = {"link": [], "local": [], "origin": [], "normal": [], "w": [], "index": []}
-        axs = {"link": [], "local": [], "dir": [], "ell": [], "w": [], "index": []}
+        pts: dict[str, list] = {"link": [], "local": [], "target": [], "w": [], "index": []}
+        pls: dict[str, list] = {"link": [], "local": [], "origin": [], "normal": [], "w": [], "index": []}
+        axs: dict[str, list] = {"link": [], "local": [], "dir": [], "ell": [], "w": [], "index": []}
         mean_length = None  # only axis goals need it
         for i, g in enumerate(self.goals):
             if not isinstance(g, (PointGoal, PlaneGoal, AxisGoal)):

@@ -564,15 +564,15 @@ class IKModel:
         X = np.empty((fig.n_links, 4, 4))
         X[fig.main] = self._eye4
         if self._chain is not None:
-            joints, children = self._chain
+            chain_joints, chain_children = self._chain
             # Hillis-Steele scan: after the step of span d, P[k] is the
             # product of T[k-2d+1 .. k] (clipped at 0), left to right.
-            P = T[joints]
+            P = T[chain_joints]
             d = 1
             while d < J:
                 P[d:] = P[:-d] @ P[d:]
                 d *= 2
-            X[children] = P
+            X[chain_children] = P
         else:
             for joints, parents, children in self._levels:
                 if isinstance(joints, int):

@@ -18,6 +18,7 @@ Example (``arm`` a model with a link named HAND)::
               frames=24, method="ACCDCC", movable=3)
     r.motion        # a Motion of length 24 driving the three joints above the hand
     r.residuals     # the hand's distance to its goal, shape (1,)
+    r.unmet         # () when it gets there, else (UnmetGoal(0, distance, sentence),)
     r.translation   # (0, 0, 0): translate=True would let the whole arm move
 """
 
@@ -33,7 +34,7 @@ from liganimate.runtime.figure import pose as PO
 from liganimate.runtime.figure.tree import Figure
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
 from liganimate.runtime.ik.model import IKModel
-from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVERS, STALLED, solve
+from liganimate.runtime.ik.solvers import CONVERGED, DEFAULT_SOLVER, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
 
 __all__ = [
@@ -49,14 +50,16 @@ __all__ = [
     "chain_joints",
     "start_pose",
     "residual_warnings",
+    "UnmetGoal",
+    "unmet_goals",
     "DEFAULT_TOLERANCE",
     "DEFAULT_MAX_ITERATIONS",
 ]
 
 #: Default tolerance, as a fraction of the figure's length (the sum of its link lengths).
 DEFAULT_TOLERANCE = 1e-5
-#: Default iteration limits per solver (sweeps for CCD).
-DEFAULT_MAX_ITERATIONS = {"dls": 200, "transpose": 5000, "ccd": 500}
+#: Default iteration limits per solver (sweeps for CCD), from the solvers' registry.
+DEFAULT_MAX_ITERATIONS = {name: spec.max_iterations for name, spec in SOLVERS.items()}
 
 _STATUS = {CONVERGED: "converged", STALLED: "stalled", LIMIT: "limit"}
 
@@ -104,14 +107,39 @@ class PoseSolution:
     angles: np.ndarray
     translation: np.ndarray
     residuals: np.ndarray
-    converged: np.ndarray
-    status: np.ndarray
-    iterations: np.ndarray
+    converged: np.ndarray | bool
+    status: np.ndarray | str
+    iterations: np.ndarray | int
     tolerance: float
     weights: np.ndarray
     met: np.ndarray
     warnings: list = field(default_factory=list)
     history: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class UnmetGoal:
+    """A goal that a solve leaves unmet, as data.
+
+    Attributes
+    ----------
+    index : int
+        The goal's position in the list given to the solve, from 0 (the
+        user's "goal N" is ``index + 1``).
+    distance : float
+        How far it is left: world units for a point or plane goal, degrees
+        for an axis goal (its entry of ``PoseSolution.residuals``).
+    sentence : str
+        What that means, for a user, e.g. ``"the point of R_HAND stays
+        0.1231 from its target."``; ``str()`` prefixes ``"goal N: "``.
+    """
+
+    index: int
+    distance: float
+    sentence: str
+
+    def __str__(self) -> str:
+        return f"goal {self.index + 1}: {self.sentence}"
 
 
 @dataclass(frozen=True)
@@ -125,11 +153,21 @@ class Reach:
     solution : PoseSolution
     joints : tuple of int
         The joint ids the motion drives.
+    unmet : tuple of UnmetGoal, or None
+        The goals the solved pose leaves unmet, in the order given (empty
+        when it meets them all); None for :func:`reach_keyframes`'s batch
+        (see ``solution.met`` there).
     """
 
     motion: Motion
     solution: PoseSolution
     joints: tuple
+    unmet: tuple[UnmetGoal, ...] | None = None
+
+    @property
+    def limit_warning(self) -> str | None:
+        """A sentence when goals are unmet and the iteration limit stopped the solve, else None."""
+        return _limit_sentence(self.solution, self.unmet) if self.unmet else None
 
     @property
     def residuals(self) -> np.ndarray:
@@ -170,7 +208,7 @@ def chain_joints(figure: Figure, link: int, length: int) -> list[int]:
     for level in figure.traversal:
         for k, par, ch in zip(level.joints, level.parents, level.children):
             parent[int(ch)] = (int(par), int(k))
-    out = []
+    out: list[int] = []
     cur = link
     while cur != figure.main and len(out) < length:
         cur, k = parent[cur]
@@ -235,7 +273,7 @@ def _movable_mask(figure: Figure, goals: Sequence, movable) -> np.ndarray:
 
 def _options(figure: Figure, solver: str, tolerance, max_iterations) -> tuple[float, int]:
     if solver not in SOLVERS:
-        raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVERS)}")
+        raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVER_NAMES)}")
     from liganimate.runtime.ik.model import figure_length
 
     if tolerance is None:
@@ -263,7 +301,7 @@ def solve_pose(
     start=None,
     movable=None,
     translate: bool = False,
-    solver: str = "dls",
+    solver: str = DEFAULT_SOLVER,
     tolerance: float | None = None,
     max_iterations: int | None = None,
     restarts: int = 0,
@@ -290,7 +328,8 @@ def solve_pose(
         axis locked by its extremes (``min == max``).
     translate : bool, default False
         Whether the whole figure may also move (POSIT's root translation).
-    solver : {"dls", "transpose", "ccd"}, default "dls"
+    solver : str, default :data:`solvers.DEFAULT_SOLVER` ("dls")
+        A name in :data:`solvers.SOLVER_NAMES`: "dls", "transpose" or "ccd".
     tolerance : float, optional
         World units; default :data:`DEFAULT_TOLERANCE` times the figure's
         length.  The solve stops when every goal is this close (an axis goal
@@ -356,38 +395,40 @@ def solve_pose(
     t = result.x[:, model.n_vars :] * model.length if translate else np.zeros((B, 3))
     # Wrapping free axes changes no link, so the solver's last distances are the pose's.
     residuals = stack.report(result.dist)
-    sol = PoseSolution(
-        angles=angles,
-        translation=t,
-        residuals=residuals,
-        converged=result.status == CONVERGED,
-        status=np.array([_STATUS[s] for s in result.status]),
-        iterations=result.iterations,
-        tolerance=tol,
-        weights=stack.weights,
-        met=(result.dist <= tol) | ~stack.active,
-        warnings=stack.warnings,
-        history=result.history,
-    )
+    converged = result.status == CONVERGED
+    status = np.array([_STATUS[s] for s in result.status])
+    met = (result.dist <= tol) | ~stack.active
     if batched:
-        return sol
+        return PoseSolution(
+            angles=angles,
+            translation=t,
+            residuals=residuals,
+            converged=converged,
+            status=status,
+            iterations=result.iterations,
+            tolerance=tol,
+            weights=stack.weights,
+            met=met,
+            warnings=stack.warnings,
+            history=result.history,
+        )
     return PoseSolution(
-        angles=sol.angles[0],
-        translation=sol.translation[0],
-        residuals=sol.residuals[0],
-        converged=bool(sol.converged[0]),
-        status=str(sol.status[0]),
-        iterations=int(sol.iterations[0]),
+        angles=angles[0],
+        translation=t[0],
+        residuals=residuals[0],
+        converged=bool(converged[0]),
+        status=str(status[0]),
+        iterations=int(result.iterations[0]),
         tolerance=tol,
-        weights=sol.weights[0],
-        met=sol.met[0],
-        warnings=sol.warnings,
-        history=[h[0] for h in sol.history],
+        weights=stack.weights[0],
+        met=met[0],
+        warnings=stack.warnings,
+        history=[h[0] for h in result.history],
     )
 
 
-def residual_warnings(figure: Figure, goals: Sequence, solution: PoseSolution) -> list[str]:
-    """One sentence per goal an unbatched solution leaves unmet, for warnings.
+def unmet_goals(figure: Figure, goals: Sequence, solution: PoseSolution) -> tuple[UnmetGoal, ...]:
+    """The goals an unbatched solution leaves unmet, as data.
 
     Parameters
     ----------
@@ -399,25 +440,49 @@ def residual_warnings(figure: Figure, goals: Sequence, solution: PoseSolution) -
 
     Returns
     -------
+    tuple of UnmetGoal
+        In the order given; empty when every goal is met.
+    """
+    out = []
+    for i, (g, ok, d) in enumerate(zip(goals, solution.met, solution.residuals)):
+        if ok:
+            continue
+        link = figure.links[resolve_link(figure, g.link)[0]].label
+        if isinstance(g, PointGoal):
+            sentence = f"the point of {link} stays {d:.4g} from its target."
+        elif isinstance(g, PlaneGoal):
+            sentence = f"the point of {link} stays {d:.4g} from its plane."
+        else:
+            sentence = f"the axis of {link} stays {d:.3g} degrees from its direction."
+        out.append(UnmetGoal(i, float(d), sentence))
+    return tuple(out)
+
+
+def _limit_sentence(solution: PoseSolution, unmet: Sequence[UnmetGoal]) -> str | None:
+    """The sentence that says the iteration limit stopped a solve leaving ``unmet`` goals, or None."""
+    if unmet and solution.status == "limit":
+        return f"the solver stopped at its iteration limit ({solution.iterations}) before settling."
+    return None
+
+
+def residual_warnings(figure: Figure, goals: Sequence, solution: PoseSolution) -> list[str]:
+    """One sentence per goal an unbatched solution leaves unmet, for warnings.
+
+    The text of :func:`unmet_goals` (and of :attr:`Reach.limit_warning`),
+    for callers that want sentences; code that needs the goal's index or
+    distance reads :class:`UnmetGoal` instead.  The parameters are those of
+    :func:`unmet_goals`.
+
+    Returns
+    -------
     list of str
         E.g. ``"goal 2: the point of R_HAND stays 0.1231 from its target."``;
         when the iteration limit stopped the solve, a last sentence says so.
         Empty when every goal is met.
     """
-    out = []
-    for i, (g, ok, d) in enumerate(zip(goals, solution.met, solution.residuals), start=1):
-        if ok:
-            continue
-        link = figure.links[resolve_link(figure, g.link)[0]].label
-        if isinstance(g, PointGoal):
-            out.append(f"goal {i}: the point of {link} stays {d:.4g} from its target.")
-        elif isinstance(g, PlaneGoal):
-            out.append(f"goal {i}: the point of {link} stays {d:.4g} from its plane.")
-        else:
-            out.append(f"goal {i}: the axis of {link} stays {d:.3g} degrees from its direction.")
-    if out and solution.status == "limit":
-        out.append(f"the solver stopped at its iteration limit ({solution.iterations}) before settling.")
-    return out
+    unmet = unmet_goals(figure, goals, solution)
+    limit = _limit_sentence(solution, unmet)
+    return [str(u) for u in unmet] + ([limit] if limit else [])
 
 
 def _driven(figure: Figure, goals, movable, start, joints) -> list[int]:
@@ -446,7 +511,7 @@ def reach(
     start=None,
     movable=None,
     translate: bool = False,
-    solver: str = "dls",
+    solver: str = DEFAULT_SOLVER,
     tolerance: float | None = None,
     max_iterations: int | None = None,
     restarts: int = 0,
@@ -476,7 +541,9 @@ def reach(
         value and one keyframe ``(frames, solved angles, method)``.  The
         root translation cannot live in a motion (motions hold angles), so
         it is ``Reach.translation``: apply it to the model with a host
-        translation.
+        translation.  ``unmet`` lists the goals left unmet (unreachable
+        goals are not an error), ``limit_warning`` says when the iteration
+        limit stopped the solve short of them.
 
     Raises
     ------
@@ -505,7 +572,7 @@ def reach(
     for jid in driven:
         k = figure.joint_index(jid)
         tracks[jid] = (tuple(s0[k]), [(frames, tuple(sol.angles[k]), method)])
-    return Reach(Motion.from_tracks(tracks, name="REACH"), sol, tuple(driven))
+    return Reach(Motion.from_tracks(tracks, name="REACH"), sol, tuple(driven), unmet_goals(figure, goals, sol))
 
 
 def reach_keyframes(
@@ -517,7 +584,7 @@ def reach_keyframes(
     start=None,
     movable=None,
     translate: bool = False,
-    solver: str = "dls",
+    solver: str = DEFAULT_SOLVER,
     tolerance: float | None = None,
     max_iterations: int | None = None,
     restarts: int = 0,

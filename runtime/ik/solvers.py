@@ -28,21 +28,46 @@ costs what its slowest member costs, with numpy doing the rest.  Restarts
 (from random angles, for solves stuck in a local minimum) run inside the
 same loop as the other elements' iterations, so they cost little more than
 the iterations they take.
+
+The stopping, damping and progress rules are written once (the functions
+under "the rules"), for Python scalars and arrays alike; :class:`_State`
+owns restarts, resuming and the final choice of attempt for every loop,
+including the single-solve DLS loop (:func:`_dls_one`).  :data:`SOLVERS`, at
+the end, is the one table of solvers: a new solver is its loop and one
+entry there.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from liganimate.runtime.ik.goals import GoalStack
-from liganimate.runtime.ik.model import IKModel, cross3
+if TYPE_CHECKING:
+    # Only for annotations: importing this module (as the compiler does, for
+    # the solver names) loads numpy and nothing else of the runtime.
+    from liganimate.runtime.ik.goals import GoalStack
+    from liganimate.runtime.ik.model import IKModel
 
-__all__ = ["SOLVERS", "SolveResult", "solve", "CONVERGED", "STALLED", "LIMIT"]
+__all__ = [
+    "Solver",
+    "SOLVERS",
+    "SOLVER_NAMES",
+    "SOLVER_KEYWORDS",
+    "DEFAULT_SOLVER",
+    "SolveResult",
+    "solve",
+    "CONVERGED",
+    "STALLED",
+    "LIMIT",
+]
 
-SOLVERS = ("dls", "transpose", "ccd")
+#: The solver used when none is named (the language's default too).
+DEFAULT_SOLVER = "dls"
 
 # Status codes per batch element.
 RUNNING, CONVERGED, STALLED, LIMIT = 0, 1, 2, 3
@@ -203,9 +228,108 @@ class _Problem:
         return stack.evaluate(R, p, t, omega, pivot)[1]
 
 
-def _converged(dist: np.ndarray, active: np.ndarray, tol: float) -> np.ndarray:
-    """Every goal that counts is within the tolerance, shape (B,)."""
-    return np.all((dist <= tol) | ~active, axis=1)
+# ---------------------------------------------------------------- the rules
+# The stopping, progress and damping rules, written once for the batched loops
+# and the single-solve loop: each function works alike on one solve's Python
+# scalars (``where`` is :func:`_pick`) and on a batch's arrays of shape (B',)
+# (``where`` is :func:`numpy.where`), with only arithmetic, comparisons, ``&``
+# and ``|``.
+
+
+def _pick(cond, a, b):
+    """:func:`numpy.where` for one solve's Python scalars: ``a`` if ``cond`` else ``b``."""
+    return a if cond else b
+
+
+def _converged(dist: np.ndarray, inactive: np.ndarray, tol: float) -> np.ndarray:
+    """Every goal that counts is within the tolerance.
+
+    Parameters
+    ----------
+    dist, inactive : numpy.ndarray, shape (..., n_goals)
+        Goal distances, and which goals have weight 0 (asking for nothing).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (...)
+    """
+    return ((dist <= tol) | inactive).all(axis=-1)
+
+
+def _giveup_floor(tol: float, active: np.ndarray):
+    """The cost below which an attempt is never given up, shape (...) for ``active`` (..., n_goals)."""
+    return GIVEUP_FLOOR * 0.5 * tol * tol * np.maximum(active.sum(axis=-1), 1)
+
+
+def _step_status(where, converged, accept, gain, f_old, step, size, spent=False):
+    """The status after an iteration's step: CONVERGED, STALLED or RUNNING.
+
+    Converged: every goal within tolerance.  Stalled: an accepted step
+    gained less than FTOL of the cost, or a step was shorter than XTOL
+    relative to the variables, or ``spent`` (see :func:`_damping_spent`).
+    ``step`` and ``size`` are the lengths of the step and of the variables.
+    """
+    stalled = (accept & (gain <= FTOL * f_old)) | (step <= XTOL * (XTOL + size)) | spent
+    return where(converged, CONVERGED, where(stalled, STALLED, RUNNING))
+
+
+def _first_damping(where, status, curv):
+    """An attempt's first damping and growth factor, and its status.
+
+    The damping starts at MU0 times the largest curvature (diagonal entry
+    of ``J^T J``); where no variable moves any goal (``curv`` 0) there is
+    nothing to do, and a running attempt is stalled.
+
+    Returns
+    -------
+    status, mu, nu
+    """
+    return where((status == RUNNING) & (curv == 0.0), STALLED, status), MU0 * where(curv > 0, curv, 1.0), 2.0
+
+
+def _damping(where, mu, nu, accept, rho):
+    """Nielsen's update of the damping ``mu`` and its growth factor ``nu`` after a step.
+
+    Shrink after a kept step by the gain ratio ``rho``, grow fast after a
+    rejected one.  Returns ``mu, nu``.
+    """
+    shrink = 1 - (2 * rho - 1) ** 3
+    return where(accept, mu * where(shrink > 1 / 3, shrink, 1 / 3), mu * nu), where(accept, 2.0, nu * 2.0)
+
+
+def _damping_spent(where, mu, curv):
+    """The damping grew beyond MU_MAX times the largest curvature: no step can lower the cost any more."""
+    return mu > MU_MAX * where(curv > 1e-300, curv, 1e-300)
+
+
+def _progress(where, status, k, f, window_f, fast_f, max_iter, may_give_up, giveup_floor):
+    """The rules at the end of an attempt's iteration ``k``, for attempts still running.
+
+    Every WINDOW iterations, an attempt whose cost fell by less than
+    WINDOW_FTOL of it is stalled: near a joint limit or a saddle (a straight
+    chain pulled along its length), steps can keep lowering the cost by a
+    hair for hundreds of iterations, and a pose that close to stationary is
+    the best pose.  At ``max_iter`` it stops at the LIMIT.  While it
+    ``may_give_up`` (restarts remain), an attempt converging slowly toward a
+    cost well above the tolerance's (a local minimum) is given up early
+    (GIVEUP_*), so that restarts cost few iterations.
+
+    Returns
+    -------
+    status, window_f, fast_f, gave_up
+        ``gave_up``: the attempt was given up just now.
+    """
+    running = status == RUNNING
+    due = running & (k % WINDOW == 0)
+    status = where(due & (window_f - f <= WINDOW_FTOL * window_f), STALLED, status)
+    window_f = where(due, f, window_f)
+    status = where(running & (k >= max_iter), LIMIT, status)
+    check = (k % GIVEUP_EVERY == 0) & may_give_up & (status == RUNNING)
+    hopeless = check & (k >= GIVEUP_FROM) & (f > giveup_floor) & (f > 0.5 * fast_f)
+    return where(hopeless, STALLED, status), window_f, where(check, f, fast_f), hopeless
+
+
+# ---------------------------------------------------------------- solving
 
 
 def solve(
@@ -214,7 +338,7 @@ def solve(
     x0: np.ndarray,
     base: np.ndarray,
     *,
-    method: str = "dls",
+    method: str = DEFAULT_SOLVER,
     tolerance: float,
     max_iterations: int,
     restarts: int = 0,
@@ -233,7 +357,8 @@ def solve(
         translation over the figure's length).
     base : numpy.ndarray, shape (B, n_joints, 3) or (1, n_joints, 3)
         Radians, for the axes that are not variables.
-    method : {"dls", "transpose", "ccd"}
+    method : str
+        A name in :data:`SOLVER_NAMES`: ``"dls"``, ``"transpose"`` or ``"ccd"``.
     tolerance : float
         A goal is met when its distance (see :meth:`GoalStack.evaluate`) is
         at most this.
@@ -258,9 +383,9 @@ def solve(
     SolveResult
         ``iterations`` counts every attempt.
     """
-    if method not in SOLVERS:
-        raise ValueError(f"unknown solver {method!r}; expected one of {', '.join(SOLVERS)}")
-    run = {"dls": _dls, "transpose": _transpose, "ccd": _ccd}[method]
+    spec = SOLVERS.get(method)
+    if spec is None:
+        raise ValueError(f"unknown solver {method!r}; expected one of {', '.join(SOLVER_NAMES)}")
     prob = _Problem(model, stack, base)
     x = np.clip(np.array(x0, dtype=float), prob.lower, prob.upper)
     if method == "dls" and x.shape[0] == 1:
@@ -272,12 +397,12 @@ def solve(
         x,
         float(tolerance),
         trace,
-        jac=method != "ccd",
+        jac=spec.jacobian,
         max_iter=int(max_iterations),
         restarts=int(restarts),
         seed=seed,
     )
-    run(prob, st)
+    spec.run(prob, st)
     return st.finish()
 
 
@@ -286,23 +411,57 @@ class _State:
 
     Holds the current variables ``x`` (B, P), residuals ``r`` (B, M),
     Jacobian ``J`` (B, M, P) (None for CCD), cost ``f`` (B,) and goal
-    distances ``dist`` (B, n_goals) of every batch element.
+    distances ``dist`` (B, n_goals) of every batch element, and each
+    element's attempt: its status, iterations, progress marks and the first
+    attempt set aside by a restart.  This is the one home of restarting,
+    resuming and the final choice between attempts, for the batched loops
+    and the single solve alike (:func:`_dls_one` hands it its attempts as
+    they end).
+
+    Parameters
+    ----------
+    prob : _Problem
+    x : numpy.ndarray, shape (B, P)
+        Start variables (kept, and restarts take the translation from them).
+    tol, trace, jac, max_iter, restarts, seed
+        As for :func:`solve`; ``jac``: whether the loop needs the Jacobian.
+    first : tuple, optional
+        ``r, J, dist, f`` at ``x`` when already known.
+    evaluate : callable, optional
+        ``evaluate(idx, x) -> (r, J, dist, f)`` for sub-batch ``idx`` at
+        ``x`` (B', P); by default the batched kinematics.
     """
 
     def __init__(
-        self, prob: _Problem, x: np.ndarray, tol: float, trace: bool, jac: bool, max_iter: int, restarts: int, seed: int
+        self,
+        prob: _Problem,
+        x: np.ndarray,
+        tol: float,
+        trace: bool,
+        jac: bool,
+        max_iter: int,
+        restarts: int,
+        seed: int,
+        *,
+        first: tuple | None = None,
+        evaluate: Callable[[np.ndarray, np.ndarray], tuple] | None = None,
     ):
         self.prob = prob
         self.x = x
         self.x0 = x.copy()
         B = x.shape[0]
         self.jac = jac
-        self.r, self.J, self.dist = prob.evaluate(np.arange(B), prob.stack, x, jac)
-        self.f = 0.5 * np.einsum("bm,bm->b", self.r, self.r)
+        self.evaluate: Callable[[np.ndarray, np.ndarray], tuple] = evaluate or self._evaluate_batch
+        if first is None:
+            self.r, self.J, self.dist = prob.evaluate(np.arange(B), prob.stack, x, jac)
+            self.f = 0.5 * np.einsum("bm,bm->b", self.r, self.r)
+        else:
+            self.r, self.J, self.dist, self.f = first
         self.active_goals = prob.stack.active
+        self.inactive = ~self.active_goals
         self.tol = tol
         self.max_iter = max_iter
-        self.status = np.where(_converged(self.dist, self.active_goals, tol), CONVERGED, RUNNING)
+        self.status = np.where(_converged(self.dist, self.inactive, tol), CONVERGED, RUNNING)
         if max_iter <= 0:
             self.status[self.status == RUNNING] = LIMIT
         self.iterations = np.zeros(B, dtype=int)
@@ -312,18 +471,38 @@ class _State:
         V = prob.model.n_vars
         self.attempts_left = np.full(B, restarts if V else 0)
         self.rng = np.random.default_rng(seed)
-        self.saved: dict | None = None  # the first attempt of elements that restarted
+        # The first attempt of elements that restarted (one dict, made at the first restart).
+        self.saved: dict = {}
         self.gave_up = np.zeros(B, dtype=bool)  # the current attempt was given up early
         self.resumed = np.zeros(B, dtype=bool)  # the first attempt was taken up again
         self.fast_f = self.f.copy()
-        n_active = np.maximum(self.active_goals.sum(axis=1), 1)
-        self.giveup_floor = GIVEUP_FLOOR * 0.5 * tol * tol * n_active
-        self.on_restart = None  # the solver's hook to reset its own per-element state
+        self.giveup_floor = _giveup_floor(tol, self.active_goals)
+        # The solver's hook to reset its own per-element state.
+        self.on_restart: Callable[[np.ndarray], None] | None = None
         self.solver_arrays: dict = {}  # the solver's own per-element state, (B,) arrays, saved with an attempt
+
+    def _evaluate_batch(self, idx: np.ndarray, x: np.ndarray) -> tuple:
+        """``r (B', M)``, ``J (B', M, P)`` (or None), ``dist (B', n_goals)`` and ``f (B',)`` of sub-batch ``idx`` at ``x``."""
+        prob = self.prob
+        r, J, dist = prob.evaluate(idx, prob.stack.take(idx), x, self.jac)
+        return r, J, dist, 0.5 * np.einsum("bm,bm->b", r, r)
 
     def running(self) -> np.ndarray:
         """Indices of the elements still iterating."""
         return np.flatnonzero(self.status == RUNNING)
+
+    def put(self, i: int, **values) -> None:
+        """Set element ``i``'s fields (attributes, or the solver's own arrays) by name."""
+        for key, value in values.items():
+            (self.solver_arrays[key] if key in self.solver_arrays else getattr(self, key))[i] = value
+
+    def get(self, i: int, *names: str) -> list:
+        """Element ``i``'s fields by name: copies of array rows, Python scalars."""
+        out = []
+        for key in names:
+            value = (self.solver_arrays[key] if key in self.solver_arrays else getattr(self, key))[i]
+            out.append(value.copy() if isinstance(value, np.ndarray) else value.item())
+        return out
 
     def accept(self, idx, accept, x, r, dist, f, J=None) -> None:
         """Keep the trial values of sub-batch ``idx`` where ``accept``."""
@@ -332,62 +511,50 @@ class _State:
         if J is not None:
             self.J[a] = J
 
-    def stop_checks(self, idx, accept, gain, f_old, dx) -> None:
-        """Mark converged and stalled elements of sub-batch ``idx`` after an iteration.
-
-        Converged: every goal within tolerance.  Stalled: an accepted step
-        gained less than FTOL of the cost, or a step was shorter than XTOL
-        relative to the variables.
-        """
-        conv = _converged(self.dist[idx], self.active_goals[idx], self.tol)
-        small_gain = accept & (gain <= FTOL * f_old)
+    def stop_checks(self, idx, accept, gain, f_old, dx, spent=False) -> None:
+        """Mark converged and stalled elements of sub-batch ``idx`` after a step (see :func:`_step_status`)."""
+        conv = _converged(self.dist[idx], self.inactive[idx], self.tol)
         size = np.sqrt(np.einsum("bp,bp->b", self.x[idx], self.x[idx]))
-        small_step = np.sqrt(np.einsum("bp,bp->b", dx, dx)) <= XTOL * (XTOL + size)
-        self.status[idx[conv]] = CONVERGED
-        self.status[idx[~conv & (small_gain | small_step)]] = STALLED
+        step = np.sqrt(np.einsum("bp,bp->b", dx, dx))
+        self.status[idx] = _step_status(np.where, conv, accept, gain, f_old, step, size, spent)
 
     def end_iteration(self, idx: np.ndarray) -> None:
-        """Count an iteration of sub-batch ``idx``; apply the window and the limit; restart.
-
-        Every WINDOW iterations, an element whose cost fell by less than
-        WINDOW_FTOL of it is stalled: near a joint limit or a saddle (a
-        straight chain pulled along its length), steps can keep lowering
-        the cost by a hair for hundreds of iterations, and a pose that close
-        to stationary is the best pose.
-
-        While an element has restarts left, an attempt converging slowly
-        toward a cost well above the tolerance's (a local minimum) is given
-        up early (GIVEUP_*) and restarted, so that restarts cost few
-        iterations; should every restart fail, the first attempt is resumed
-        where it was given up, so the result does not depend on restarts
-        being allowed.
-        """
-        self.iterations[idx] += 1
-        self.attempt_iter[idx] += 1
+        """Count an iteration of sub-batch ``idx``, apply :func:`_progress`, then :meth:`end_attempts`."""
+        # The whole batch (so always, until the first element stops): views, not gathered copies.
+        sel = slice(None) if idx.size == self.x.shape[0] else idx
+        self.iterations[sel] += 1
+        self.attempt_iter[sel] += 1
         if self.history is not None:
             self.history.append(self.f.copy())
-        run = idx[self.status[idx] == RUNNING]
-        k = self.attempt_iter[run]
-        due = run[k % WINDOW == 0]
-        slow = due[self.window_f[due] - self.f[due] <= WINDOW_FTOL * self.window_f[due]]
-        self.status[slow] = STALLED
-        self.window_f[due] = self.f[due]
-        self.status[run[k >= self.max_iter]] = LIMIT
-        check = run[(k % GIVEUP_EVERY == 0) & (self.attempts_left[run] > 0) & (self.status[run] == RUNNING)]
-        if check.size:
-            hopeless = (
-                (self.attempt_iter[check] >= GIVEUP_FROM)
-                & (self.f[check] > self.giveup_floor[check])
-                & (self.f[check] > 0.5 * self.fast_f[check])
-            )
-            self.status[check[hopeless]] = STALLED
-            self.gave_up[check[hopeless]] = True
-            self.fast_f[check] = self.f[check]
+        status, window_f, fast_f, gave_up = _progress(
+            np.where,
+            self.status[sel],
+            self.attempt_iter[sel],
+            self.f[sel],
+            self.window_f[sel],
+            self.fast_f[sel],
+            self.max_iter,
+            self.attempts_left[sel] > 0,
+            self.giveup_floor[sel],
+        )
+        self.status[sel], self.window_f[sel], self.fast_f[sel] = status, window_f, fast_f
+        self.gave_up[sel] |= gave_up
+        self.end_attempts(idx)
+
+    def end_attempts(self, idx: np.ndarray) -> None:
+        """Restart or resume the elements of sub-batch ``idx`` whose attempt has just ended unconverged.
+
+        While an element has restarts left, it starts again from random
+        angles (:meth:`_restart`).  When the last restart has ended too, a
+        first attempt that was given up early is taken up again where it was
+        set aside (:meth:`_resume`), so the result does not depend on
+        restarts being allowed.
+        """
         ended = idx[(self.status[idx] == STALLED) | (self.status[idx] == LIMIT)]
         # Decide who resumes before restarting: an element that has just drawn
         # its last restart has no restarts left either, but must run it.
         back = ended[:0]
-        if self.saved is not None:
+        if self.saved:
             back = ended[(self.attempts_left[ended] == 0) & self.saved["mask"][ended]]
             back = back[self.saved["gave_up"][back] & ~self.resumed[back]]
         again = ended[self.attempts_left[ended] > 0]
@@ -400,7 +567,7 @@ class _State:
 
     def _restart(self, idx: np.ndarray) -> None:
         """Start elements ``idx`` again from random angles within the limits."""
-        if self.saved is None:
+        if not self.saved:
             self.saved = {key: getattr(self, key).copy() for key in self._SAVED}
             self.saved["mask"] = np.zeros(self.x.shape[0], dtype=bool)
             if self.jac:
@@ -418,16 +585,15 @@ class _State:
         hi = np.where(np.isfinite(prob.upper[:V]), prob.upper[:V], np.pi)
         x = self.x0[idx].copy()
         x[:, :V] = self.rng.uniform(lo, hi, size=(idx.size, V))
-        r, J, dist = prob.evaluate(idx, prob.stack.take(idx), x, self.jac)
-        self.x[idx], self.r[idx], self.dist[idx] = x, r, dist
+        r, J, dist, f = self.evaluate(idx, x)
+        self.x[idx], self.r[idx], self.dist[idx], self.f[idx] = x, r, dist, f
         if self.jac:
             self.J[idx] = J
-        self.f[idx] = 0.5 * np.einsum("bm,bm->b", r, r)
         self.window_f[idx] = self.fast_f[idx] = self.f[idx]
         self.attempt_iter[idx] = 0
         self.attempts_left[idx] -= 1
         self.gave_up[idx] = False
-        self.status[idx] = np.where(_converged(dist, self.active_goals[idx], self.tol), CONVERGED, RUNNING)
+        self.status[idx] = np.where(_converged(dist, self.inactive[idx], self.tol), CONVERGED, RUNNING)
         if self.on_restart is not None:
             self.on_restart(idx)
 
@@ -446,7 +612,7 @@ class _State:
     def finish(self) -> SolveResult:
         """The result; elements whose every attempt failed get their first attempt back."""
         self.status[self.status == RUNNING] = LIMIT
-        if self.saved is not None:
+        if self.saved:
             back = self.saved["mask"] & (self.status != CONVERGED) & ~self.resumed
             for key in ("x", "f", "dist", "status"):
                 getattr(self, key)[back] = self.saved[key][back]
@@ -492,13 +658,9 @@ def _dls(prob: _Problem, st: _State) -> None:
     nu = np.full(B, 2.0)
 
     def reset(idx):
-        # The damping starts at a fraction of the largest curvature; where
-        # no variable moves any goal there is nothing to do.
         c = np.einsum("bmp,bmp->bp", st.J[idx], st.J[idx]).max(axis=1, initial=0.0)
         curv[idx] = c
-        mu[idx] = MU0 * np.where(c > 0, c, 1.0)
-        nu[idx] = 2.0
-        st.status[idx[(st.status[idx] == RUNNING) & (c == 0.0)]] = STALLED
+        st.status[idx], mu[idx], nu[idx] = _first_damping(np.where, st.status[idx], c)
 
     reset(np.arange(B))
     st.on_restart = reset
@@ -532,30 +694,73 @@ def _dls(prob: _Problem, st: _State) -> None:
         gain = fs - fn
         accept = (gain > 0) & (predicted > 0)
         rho = np.divide(gain, predicted, out=np.zeros_like(gain), where=predicted > 0)
-        # Nielsen's damping update: shrink after a good step, grow fast after a bad one.
-        mu[idx] = np.where(accept, mus * np.maximum(1 / 3, 1 - (2 * rho - 1) ** 3), mus * nu[idx])
-        nu[idx] = np.where(accept, 2.0, nu[idx] * 2.0)
+        mu[idx], nu[idx] = _damping(np.where, mus, nu[idx], accept, rho)
         # The Jacobian is only needed where the step is kept.
         st.accept(idx, accept, xn, rn, dn, fn, prob.jacobian(stack, kept, accept))
-        st.stop_checks(idx, accept, gain, fs, dx)
-        blown = mu[idx] > MU_MAX * np.maximum(curv[idx], 1e-300)
-        st.status[idx[blown & (st.status[idx] == RUNNING)]] = STALLED
+        st.stop_checks(idx, accept, gain, fs, dx, _damping_spent(np.where, mu[idx], curv[idx]))
         st.end_iteration(idx)
+
+
+# What :func:`_dls_one` hands to a :class:`_State` when an attempt ends.
+_ATTEMPT = ("x", "r", "J", "f", "dist", "status", "attempt_iter", "window_f", "fast_f", "gave_up", "curv", "mu", "nu")
+_ONE = np.zeros(1, dtype=np.intp)
+
+
+def _attempts_of_one(prob: _Problem, x0, first, evaluate, curvature, tol, max_iter, restarts, seed) -> _State:
+    """The :class:`_State` of a batch of one that :func:`_dls_one` hands its ended attempts to.
+
+    It evaluates and resets a restarted attempt as :func:`_dls_one` does
+    (``evaluate(x) -> (r, J, dist, f)`` on one problem, ``curvature(J)``),
+    so a single solve's iterates do not depend on whether it restarted.
+    ``first`` is ``evaluate(x0)``.
+    """
+
+    def batch_of_one(values):
+        return tuple(np.array([v]) if np.ndim(v) == 0 else v[None] for v in values)
+
+    st = _State(
+        prob,
+        x0[None].copy(),
+        tol,
+        False,
+        jac=True,
+        max_iter=max_iter,
+        restarts=restarts,
+        seed=seed,
+        first=batch_of_one(first),
+        evaluate=lambda idx, x: batch_of_one(evaluate(x[0])),
+    )
+    st.solver_arrays = {"curv": np.zeros(1), "mu": np.zeros(1), "nu": np.zeros(1)}
+
+    def on_restart(idx):
+        c = curvature(st.J[0])
+        status, mu, nu = _first_damping(_pick, int(st.status[0]), c)
+        st.put(0, status=status, curv=c, mu=mu, nu=nu)
+
+    st.on_restart = on_restart
+    return st
 
 
 def _dls_one(
     prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts: int, seed: int, trace: bool
 ) -> SolveResult:
-    """:func:`_dls` and :class:`_State` for a batch of one, with plain Python control.
+    """:func:`_dls` for a batch of one: the same step in 2-D arithmetic, the same rules and restarts.
 
     A single solve is a few dozen iterations on arrays of a handful of
-    entries, where every numpy call costs far more than its arithmetic: the
-    batched loop's per-element status arrays, index gathers and masked
-    writes were most of its time.  This is the same algorithm step for step
-    -- hold, damped step, cap, projection, acceptance, Nielsen's update, the
-    stopping rules, the progress window, giving up, restarts and resuming --
-    so a batch of one gives what the batched loop gives (the tests compare
-    the two), with the bookkeeping in Python scalars.
+    entries, where every numpy call costs far more than its arithmetic:
+    run through :func:`_dls` and :class:`_State`, a batch of one spends most
+    of its time in per-element status arrays, index gathers and masked
+    writes (about 2.8 times as long per solve on the benchmark's chains).
+    So here the step -- hold, damped step, cap, projection, acceptance --
+    is computed with 2-D products on the one problem, and the rules
+    (:func:`_step_status`, :func:`_first_damping`, :func:`_damping`,
+    :func:`_damping_spent`, :func:`_progress`) run on Python scalars.  An
+    attempt that ends unconverged while restarts are in play is handed to a
+    :class:`_State` of one element, which restarts or resumes it as it does
+    for a batch (:meth:`_State.end_attempts`) and chooses the final attempt
+    (:meth:`_State.finish`).  A batch of one thus ends where the batched
+    loop ends it (same status and iterations, angles equal up to rounding:
+    the 2-D products round differently from the batched ``einsum``).
 
     Parameters
     ----------
@@ -574,38 +779,30 @@ def _dls_one(
     model = prob.model
     V, P = model.n_vars, model.n_params
     lower, upper = prob.lower, prob.upper
-    evaluate = prob.one
     active = prob.stack.active[0]
-    all_active = bool(active.all())
+    inactive = ~active
 
-    def converged(dist):
-        if all_active:
-            return bool(dist.max(initial=0.0) <= tol)
-        return bool(((dist <= tol) | ~active).all())
+    def evaluate(x):
+        r, J, dist = prob.one(x)
+        return r, J, dist, 0.5 * float(r @ r)
 
-    def reset(J):
-        # The first damping: a fraction of the largest curvature (see _dls).
-        c = float((J * J).sum(axis=0).max(initial=0.0))
-        return c, MU0 * (c if c > 0 else 1.0), 2.0
+    def curvature(J):
+        return float((J * J).sum(axis=0).max(initial=0.0))
 
-    x0 = x.copy()
-    r, J, dist = evaluate(x)
-    f = 0.5 * float(r @ r)
-    status = CONVERGED if converged(dist) else RUNNING
+    x0 = x
+    r, J, dist, f = first = evaluate(x)
+    status = CONVERGED if _converged(dist, inactive, tol) else RUNNING
     if max_iter <= 0 and status == RUNNING:
         status = LIMIT
-    history = [np.array([f])] if trace else None
+    history = [np.array([f])] if trace else []
     iterations = attempt_iter = 0
     window_f = fast_f = f
     attempts_left = restarts if V else 0
-    rng = None
-    saved = None  # the first attempt, set aside by a restart
-    gave_up = resumed = False
-    n_active = max(int(active.sum()), 1)
-    giveup_floor = GIVEUP_FLOOR * 0.5 * tol * tol * n_active
-    curv, mu, nu = reset(J)
-    if status == RUNNING and curv == 0.0:
-        status = STALLED
+    gave_up = False
+    giveup_floor = float(_giveup_floor(tol, active))
+    curv = curvature(J)
+    status, mu, nu = _first_damping(_pick, status, curv)
+    st = None  # the attempts' _State, from the first attempt that ends while restarts are in play
     small = r.size < P
     diagonal = slice(None, None, min(r.size, P) + 1)  # of the flattened normal matrix
 
@@ -641,93 +838,49 @@ def _dls_one(
         xn = x + (np.where(free, dx, 0.0) if at_limit else dx)
         dx = np.minimum(np.maximum(xn, lower), upper) - x
         xn = x + dx
-        rn, Jn, dn = evaluate(xn)
-        fn = 0.5 * float(rn @ rn)
+        rn, Jn, dn, fn = evaluate(xn)
         lin = r + J @ dx
         predicted = f - 0.5 * float(lin @ lin)
         gain = f - fn
         accept = gain > 0 and predicted > 0
         f_old = f
+        mu, nu = _damping(_pick, mu, nu, accept, gain / predicted if accept else 0.0)
         if accept:
-            rho = gain / predicted
-            mu = mu * max(1 / 3, 1 - (2 * rho - 1) ** 3)
-            nu = 2.0
             x, r, J, dist, f = xn, rn, Jn, dn, fn
-        else:
-            mu = mu * nu
-            nu = nu * 2.0
-        # Stopping rules (see _State.stop_checks).
-        if converged(dist):
-            status = CONVERGED
-        elif (accept and gain <= FTOL * f_old) or (
-            math.sqrt(float(dx @ dx)) <= XTOL * (XTOL + math.sqrt(float(x @ x)))
-        ):
-            status = STALLED
-        if status == RUNNING and mu > MU_MAX * max(curv, 1e-300):
-            status = STALLED
-        # _State.end_iteration, for one element.
+        status = _step_status(
+            _pick,
+            _converged(dist, inactive, tol),
+            accept,
+            gain,
+            f_old,
+            math.sqrt(float(dx @ dx)),
+            math.sqrt(float(x @ x)),
+            _damping_spent(_pick, mu, curv),
+        )
         iterations += 1
         attempt_iter += 1
         if trace:
             history.append(np.array([f]))
-        if status == RUNNING:
-            k = attempt_iter
-            if k % WINDOW == 0:
-                if window_f - f <= WINDOW_FTOL * window_f:
-                    status = STALLED
-                window_f = f
-            if k >= max_iter:
-                status = LIMIT
-            if k % GIVEUP_EVERY == 0 and attempts_left > 0 and status == RUNNING:
-                if k >= GIVEUP_FROM and f > giveup_floor and f > 0.5 * fast_f:
-                    status = STALLED
-                    gave_up = True
-                fast_f = f
-        if status in (STALLED, LIMIT):
-            if attempts_left > 0:
-                if saved is None:
-                    saved = dict(
-                        x=x,
-                        r=r,
-                        J=J,
-                        f=f,
-                        dist=dist,
-                        status=status,
-                        attempt_iter=attempt_iter,
-                        window_f=window_f,
-                        gave_up=gave_up,
-                        fast_f=fast_f,
-                        curv=curv,
-                        mu=mu,
-                        nu=nu,
-                    )
-                if rng is None:
-                    rng = np.random.default_rng(seed)
-                lo = np.where(np.isfinite(lower[:V]), lower[:V], -np.pi)
-                hi = np.where(np.isfinite(upper[:V]), upper[:V], np.pi)
-                x = x0.copy()
-                # Drawn as a batch of one, so the angles are the batched loop's.
-                x[:V] = rng.uniform(lo, hi, size=(1, V))[0]
-                r, J, dist = evaluate(x)
-                f = 0.5 * float(r @ r)
-                window_f = fast_f = f
-                attempt_iter = 0
-                attempts_left -= 1
-                gave_up = False
-                status = CONVERGED if converged(dist) else RUNNING
-                curv, mu, nu = reset(J)
-                if status == RUNNING and curv == 0.0:
-                    status = STALLED
-            elif saved is not None and saved["gave_up"] and not resumed:
-                # Every restart used and ended: take the first attempt up where it was given up.
-                x, r, J, f, dist = saved["x"], saved["r"], saved["J"], saved["f"], saved["dist"]
-                attempt_iter, window_f, fast_f = saved["attempt_iter"], saved["window_f"], saved["fast_f"]
-                curv, mu, nu = saved["curv"], saved["mu"], saved["nu"]
-                status, gave_up, resumed = RUNNING, False, True
+        status, window_f, fast_f, hopeless = _progress(
+            _pick, status, attempt_iter, f, window_f, fast_f, max_iter, attempts_left > 0, giveup_floor
+        )
+        gave_up |= hopeless
+        if (status == STALLED or status == LIMIT) and (attempts_left > 0 or st is not None):
+            # An attempt ended unconverged with restarts in play (some left, or
+            # some taken): _State restarts or resumes it, as for a batch.
+            if st is None:
+                st = _attempts_of_one(prob, x0, first, evaluate, curvature, tol, max_iter, restarts, seed)
+            attempt = (x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu)
+            st.put(0, **dict(zip(_ATTEMPT, attempt)))
+            st.end_attempts(_ONE)
+            x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = st.get(0, *_ATTEMPT)
+            attempts_left = int(st.attempts_left[0])
 
-    if saved is not None and status != CONVERGED and not resumed:
-        x, f, dist, status = saved["x"], saved["f"], saved["dist"], saved["status"]
-    return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None], history or [])
+    if st is None:
+        return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None], history)
+    st.put(0, x=x, f=f, dist=dist, status=status, iterations=iterations)
+    st.history = history
+    return st.finish()
 
 
 def _transpose(prob: _Problem, st: _State) -> None:
@@ -774,6 +927,8 @@ _GRID = 33  # samples of the 1-D cost per variable before Newton polishing
 
 def _rotate(d: np.ndarray, w: np.ndarray, s: np.ndarray, cm: np.ndarray) -> np.ndarray:
     """Rodrigues: ``d`` turned about unit ``w`` by the angle with sine ``s``, ``1 - cos`` ``cm``."""
+    from liganimate.runtime.ik.model import cross3
+
     wd = cross3(w, d)
     return d + s[..., None] * wd + cm[..., None] * cross3(w, wd)
 
@@ -821,6 +976,8 @@ def _trig_minimum(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 def _ccd(prob: _Problem, st: _State) -> None:
     """Cyclic coordinate descent with exact 1-D minimisation (see module docstring)."""
+    from liganimate.runtime.ik.model import cross3
+
     model = prob.model
     V = model.n_vars
     A = model.A
@@ -909,7 +1066,7 @@ def _ccd(prob: _Problem, st: _State) -> None:
         # sweep can only lower f (up to rounding, which the check absorbs).
         accept = gain >= 0
         st.accept(idx, accept, xs, rn, dn, fn)
-        conv = _converged(st.dist[idx], st.active_goals[idx], st.tol)
+        conv = _converged(st.dist[idx], st.inactive[idx], st.tol)
         st.status[idx[conv]] = CONVERGED
         st.status[idx[~conv & (~accept | (gain <= FTOL * fs))]] = STALLED
         st.end_iteration(idx)
@@ -928,3 +1085,48 @@ def _sums(a: np.ndarray, b: np.ndarray, g: np.ndarray) -> np.ndarray:
         ],
         axis=1,
     )
+
+
+# ---------------------------------------------------------------- the registry
+
+
+@dataclass(frozen=True)
+class Solver:
+    """One solver: the one table that the compiler, :func:`solve` and ``reach`` read.
+
+    Attributes
+    ----------
+    name : str
+        The runtime's name (``solve(method=...)``, ``reach(solver=...)``).
+    keyword : str
+        The language's word for it (``SOLVER DLS`` in a STARTREACH block).
+    run : callable
+        Its batched loop, ``run(problem, state)``.
+    jacobian : bool
+        Whether its loop needs the goals' Jacobian.
+    max_iterations : int
+        Its default iteration limit per attempt (sweeps for CCD).
+    """
+
+    name: str
+    keyword: str
+    run: Callable[[_Problem, _State], None]
+    jacobian: bool
+    max_iterations: int
+
+
+#: The solvers by name, in the order they are listed to users.
+SOLVERS: Mapping[str, Solver] = MappingProxyType(
+    {
+        s.name: s
+        for s in (
+            Solver("dls", "DLS", _dls, jacobian=True, max_iterations=200),
+            Solver("transpose", "TRANSPOSE", _transpose, jacobian=True, max_iterations=5000),
+            Solver("ccd", "CCD", _ccd, jacobian=False, max_iterations=500),
+        )
+    }
+)
+#: The runtime's solver names.
+SOLVER_NAMES: tuple[str, ...] = tuple(SOLVERS)
+#: The language's solver words -> the runtime's names (``{"DLS": "dls", ...}``).
+SOLVER_KEYWORDS: Mapping[str, str] = MappingProxyType({s.keyword: s.name for s in SOLVERS.values()})

@@ -15,8 +15,10 @@ from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
+from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
+from liganimate.runtime.motion import path as rp
 from liganimate.runtime.motion import track as tr
 
 __all__ = [
@@ -65,17 +67,18 @@ def _real(r, what: str) -> float:
     return r
 
 
-def _leaf(joint: int, spec) -> tr.Leaf:
-    """Validate one joint's ``(start, keyframes)`` and build its leaf."""
+def _leaf(joint: int | None, spec) -> tr.Leaf:
+    """Validate one joint's ``(start, keyframes)`` and build its leaf (``joint`` None: the root track)."""
+    who = "the root track" if joint is None else f"joint {joint}"
     try:
         start, keys = spec
     except (TypeError, ValueError):
-        raise MotionError(f"joint {joint}: expected (start position, list of keyframes)") from None
-    start = np.zeros(3) if start is None else _vector(start, f"joint {joint}: start position")
+        raise MotionError(f"{who}: expected (start position, list of keyframes)") from None
+    start = np.zeros(3) if start is None else _vector(start, f"{who}: start position")
     frames, values, methods, ramps = [], [], [], []
     previous = 0.0
     for k, key in enumerate(keys, start=1):
-        where = f"joint {joint}, keyframe {k}"
+        where = f"{who}, keyframe {k}"
         if not isinstance(key, Sequence) or len(key) not in (3, 4):
             raise MotionError(f"{where}: expected (frame, position, method)")
         frame = _real(key[0], f"{where}: frame")
@@ -104,10 +107,18 @@ def _leaf(joint: int, spec) -> tr.Leaf:
         values.append(_vector(key[1], f"{where}: position"))
         methods.append(method)
         ramps.append(ramp)
-    values = np.reshape(values, (-1, 3))
-    tr.check_frames(np.asarray(frames, dtype=float), f"joint {joint}: a keyframe list that")
-    tr.check_angles(np.vstack([start[None, :], values]), f"joint {joint}: a position that")
-    return tr.Leaf(start, frames, values, methods, ramps)
+    positions = np.reshape(values, (-1, 3))
+    tr.check_frames(np.asarray(frames, dtype=float), f"{who}: a keyframe list that")
+    if joint is None:
+        far = float(np.max(np.abs(np.vstack([start[None, :], positions]))))
+        if not far <= GEOMETRY_MAX:
+            raise MotionError(
+                f"the root track: a position {magnitude(far)} from the origin is beyond the geometry limit, "
+                f"{magnitude(GEOMETRY_MAX)}"
+            )
+    else:
+        tr.check_angles(np.vstack([start[None, :], positions]), f"{who}: a position that")
+    return tr.Leaf(start, frames, positions, methods, ramps)
 
 
 class Motion:
@@ -117,7 +128,7 @@ class Motion:
     ``n * m`` and the methods below.  All operations return new motions.
     """
 
-    __slots__ = ("_derived", "_expr", "_length", "_open", "_tail", "_tracks")
+    __slots__ = ("_derived", "_expr", "_length", "_open", "_root", "_tail", "_tracks")
 
     def __init__(
         self,
@@ -125,6 +136,7 @@ class Motion:
         expr: tuple,
         length: float | None = None,
         gaps: tuple[Iterable[int], Iterable[int]] = ((), ()),
+        root: tr.Track | None = None,
     ):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
 
@@ -139,11 +151,15 @@ class Motion:
             Joints whose track begins with a time no operand of ``+`` drove
             (its leftmost piece is a ``Const`` that ``+`` may refill), and
             joints whose track ends with such a time (a hold).
+        root : Track, optional
+            The root path (see :mod:`liganimate.runtime.motion.path`).
         """
         self._tracks = dict(sorted(tracks.items()))
+        self._root = root
         self._open = frozenset(gaps[0]) & self._tracks.keys()
         self._tail = frozenset(gaps[1]) & self._tracks.keys()
-        self._length = float(length if length is not None else max((t.end for t in self._tracks.values()), default=0.0))
+        ends = [t.end for t in self._tracks.values()] + ([root.end] if root is not None else [])
+        self._length = float(length if length is not None else max(ends, default=0.0))
         if not math.isfinite(self._length):
             # n * m and SCALE FRAMES multiply lengths; LEN must stay a finite REAL.
             raise MotionError(
@@ -176,17 +192,18 @@ class Motion:
         return out
 
     def __getstate__(self):
-        return (self._tracks, self._length, self._expr, self._open, self._tail)
+        return (self._tracks, self._length, self._expr, self._open, self._tail, self._root)
 
     def __setstate__(self, state):
         self._tracks, self._length, self._expr = state[:3]
-        self._open, self._tail = state[3:] if len(state) > 3 else (frozenset(), frozenset())
+        self._open, self._tail = state[3:5] if len(state) > 3 else (frozenset(), frozenset())
+        self._root = state[5] if len(state) > 5 else None
         self._derived = None
 
     # -- construction -----------------------------------------------------
 
     @classmethod
-    def from_tracks(cls, tracks: Mapping[int, tuple], name: str | None = None) -> Motion:
+    def from_tracks(cls, tracks: Mapping[int, tuple], name: str | None = None, root: tuple | None = None) -> Motion:
         """Build a motion from explicit keyframes.
 
         Parameters
@@ -198,6 +215,10 @@ class Motion:
             fourth element, the LINEAR ramp in frames (default 3).
         name : str, optional
             Shown by :meth:`describe`.
+        root : (start, keyframes), optional
+            The root track, built as a joint's: ``start`` (None for the
+            origin) and keyframes whose positions are displacements of the
+            model's main link in the model's own frame.
 
         Returns
         -------
@@ -213,8 +234,9 @@ class Motion:
         for joint, spec in tracks.items():
             j = _joint_id(joint)
             leaves[j] = _leaf(j, spec)
-        nkeys = sum(len(leaf.frames) for leaf in leaves.values())
-        return cls(leaves, ("keys", name, len(leaves), nkeys))
+        path = None if root is None else _leaf(None, root)
+        nkeys = sum(len(leaf.frames) for leaf in leaves.values()) + (len(path.frames) if path is not None else 0)
+        return cls(leaves, ("keys", name, len(leaves), nkeys), root=path)
 
     @classmethod
     def empty(cls) -> Motion:
@@ -237,6 +259,55 @@ class Motion:
     def joints(self) -> tuple[int, ...]:
         """Driven joint ids, sorted."""
         return tuple(self._tracks)
+
+    @property
+    def root(self) -> tr.Track | None:
+        """The root path, or None for a motion that does not move the figure."""
+        return self._root
+
+    def root_offset(self, times) -> np.ndarray:
+        """The root path's displacement at some times (zero without a path).
+
+        Parameters
+        ----------
+        times : array_like, shape (T,)
+
+        Returns
+        -------
+        ndarray, shape (T, 3)
+            In the model's own units and axes; ``world = placement @
+            Trans(offset) @ pose``.
+        """
+        t = self._times(times)
+        if self._root is None:
+            return np.zeros((len(t), 3))
+        with np.errstate(all="ignore"):  # see evaluate
+            out = self._root.sample_x(t)
+        _finite(out)
+        return out
+
+    def root_keyframes(self, limit: int = DEFAULT_KEYFRAME_LIMIT, with_ramps: bool = False):
+        """The root path written out as one keyframe list (see :meth:`keyframes`).
+
+        Returns
+        -------
+        start : tuple of 3 float
+        keys : list of (frame, (x, y, z), method_name[, ramp])
+
+        Raises
+        ------
+        MotionError
+            If the motion has no root path or the listing would exceed ``limit``.
+        """
+        if self._root is None:
+            raise MotionError("this motion has no root track")
+        try:
+            start, keys = tr.materialize(self._root, limit)
+        except MotionError as exc:
+            raise MotionError(
+                f"the root track: {exc.message}", hint="use describe() to see how the motion is built"
+            ) from None
+        return start, keys if with_ramps else [k[:3] for k in keys]
 
     def track(self, joint: int) -> tr.Track:
         """The track node of one joint (for the runtime and tests).
@@ -322,7 +393,8 @@ class Motion:
                     tb = tr.refill(tb, ta.end_value)
                 ta, tb = tr.join_smoothly(ta, tb, la)
                 tracks[j] = tr.concat(ta, tb, la)
-        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail))
+        root = rp.concat(self._root, la, other._root, lb)
+        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail), root=root)
 
     def repeat(self, n: int) -> Motion:
         """``n`` copies played back to back (the thesis' ``n * motion``).
@@ -352,11 +424,13 @@ class Motion:
 
     def _repeat(self, n: int) -> Motion:
         expr = ("*", n, self._expr)
+        root = self._root
         if n == 0:
-            return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr)
+            still = None if root is None else tr.Const(root.start_value)
+            return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr, root=still)
         gaps = (self._open, self._tail)
         if n == 1 or self._length == 0:
-            return Motion(self._tracks, expr, self._length * n, gaps)
+            return Motion(self._tracks, expr, self._length * n, gaps, root)
         L = self._length
         tracks = {}
         for j, t in self._tracks.items():
@@ -370,7 +444,7 @@ class Motion:
                 tracks[j] = tr.concat(t, rest, L, end=end if end is not None else (n - 1) * L + t.end)
             else:
                 tracks[j] = tr.repeat_smoothly(t, n, L, end)
-        return Motion(tracks, expr, n * L, gaps)
+        return Motion(tracks, expr, n * L, gaps, None if root is None else rp.repeat(root, n, L))
 
     def __mul__(self, n) -> Motion:
         return self.repeat(n)
@@ -398,7 +472,8 @@ class Motion:
         for joint in joints:
             j = self._driven(joint, "the motion being stripped")
             kept[j] = self._tracks[j]
-        return Motion(kept, ("strip", tuple(kept), self._expr), gaps=(self._open, self._tail))
+        # The root path is not a joint: STRIP keeps it.
+        return Motion(kept, ("strip", tuple(kept), self._expr), gaps=(self._open, self._tail), root=self._root)
 
     def scale_frames(self, r: float) -> Motion:
         """Stretch time by ``|r|``; a negative ``r`` also plays the motion backwards.
@@ -428,11 +503,13 @@ class Motion:
         s, L = abs(r), self._length * abs(r)
         memo: dict = {}
         tracks = {j: tr.scale_frames(t, s, memo) for j, t in self._tracks.items()}
+        root = None if self._root is None else tr.scale_frames(self._root, s, memo)
         gaps = (self._open, self._tail)
         if r < 0:
             tracks = {j: tr.reverse(t, L, memo) for j, t in tracks.items()}
             gaps = (self._tail, self._open)  # a trailing hold played backwards is a leading gap
-        return Motion(tracks, ("frames", r, self._expr), L, gaps)
+            root = None if root is None else rp.reverse(root, L, memo)
+        return Motion(tracks, ("frames", r, self._expr), L, gaps, root)
 
     def scale_extremes(self, r: float) -> Motion:
         """Multiply every angle (start and keyframe positions) by ``r``.
@@ -451,7 +528,8 @@ class Motion:
     def _scale_extremes(self, r: float) -> Motion:
         memo: dict = {}
         tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
-        return Motion(tracks, ("extremes", r, self._expr), self._length, (self._open, self._tail))
+        # Positions are not angles: the root path is left as it is.
+        return Motion(tracks, ("extremes", r, self._expr), self._length, (self._open, self._tail), self._root)
 
     def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> Motion:
         """Take the short way round on axes that can turn freely.
@@ -475,7 +553,7 @@ class Motion:
             j = _joint_id(joint)
             if j in tracks and any(axes):
                 tracks[j] = tr.unwrap(tracks[j], tuple(bool(a) for a in axes), memo)
-        return Motion(tracks, ("unwrap", self._expr), self._length, (self._open, self._tail))
+        return Motion(tracks, ("unwrap", self._expr), self._length, (self._open, self._tail), self._root)
 
     # -- evaluation -------------------------------------------------------
 
@@ -594,7 +672,7 @@ class Motion:
         -------
         Footprint
         """
-        return tr.footprint(self._tracks.values())
+        return tr.footprint(list(self._tracks.values()) + ([self._root] if self._root is not None else []))
 
     def describe(self, max_chars: int = 2000) -> str:
         """A compact text of the expression that built this motion.
@@ -729,9 +807,18 @@ def synchronize(*motions: Motion) -> Motion:
     owner: dict[int, int] = {}
     opened: set[int] = set()
     tail: set[int] = set()
+    root, root_owner = None, 0
     for i, m in enumerate(motions, start=1):
         if not isinstance(m, Motion):
             raise MotionError(f"operand {i} of SYNCHRONIZE is not a motion")
+        if m._root is not None:
+            # The same path twice (two STRIPs of one motion) is one path, not two.
+            if root is not None and m._root is not root:
+                raise MotionError(
+                    f"the root track is driven by both operand {root_owner} and operand {i} of SYNCHRONIZE",
+                    hint="a figure travels along one path: build one of them without a ROOT track",
+                )
+            root, root_owner = m._root, i
         for j, t in m._tracks.items():
             if j in owner:
                 raise MotionError(
@@ -742,7 +829,7 @@ def synchronize(*motions: Motion) -> Motion:
             tracks[j] = t
         opened |= m._open
         tail |= m._tail
-    return Motion(tracks, ("sync", tuple(m._expr for m in motions)), gaps=(opened, tail))
+    return Motion(tracks, ("sync", tuple(m._expr for m in motions)), gaps=(opened, tail), root=root)
 
 
 def scale_frames(a: Motion, r: float) -> Motion:

@@ -154,8 +154,12 @@ _registry: dict[str, InterpolationMethod] = dict(_BUILTINS)
 _plugins_loaded = False
 
 
-def _check(method: object) -> InterpolationMethod:
-    """Reject objects that would fail later, deep inside an evaluation."""
+def _check(method: InterpolationMethod) -> InterpolationMethod:
+    """Reject objects that would fail later, deep inside an evaluation.
+
+    The annotation is what :func:`register`'s caller promises; plugins are
+    not type-checked, so every part of the promise is verified here.
+    """
     for attr in ("name", "reverse"):
         if not isinstance(getattr(method, attr, None), str):
             raise TypeError(f"interpolation method {method!r} needs a string attribute {attr!r}")

@@ -74,6 +74,11 @@ class Track:
 
     __slots__ = ("end", "end_value", "min_keys", "start_value")
 
+    end: float
+    start_value: np.ndarray
+    end_value: np.ndarray
+    min_keys: int
+
     def sample(self, t: np.ndarray) -> Samples:
         """Evaluate the track.
 
@@ -124,6 +129,14 @@ class Track:
 
     def _emit(self, out: _Emitter, offset: float) -> None:
         raise NotImplementedError
+
+    # Nodes defined elsewhere (the root path's Shift, liganimate.runtime.motion.path)
+    # take part in smooth junctions through these two.
+    def _edge_leaf(self, side: str) -> Leaf | None:
+        return None
+
+    def _with_edge(self, side: str, edge: Edge) -> Track:
+        raise TypeError(f"track {type(self).__name__} has no edge leaf")  # pragma: no cover
 
 
 # ---------------------------------------------------------------------------
@@ -303,7 +316,7 @@ class Leaf(Track):
         self.end_value = self.values[-1] if k else self.start
         self.min_keys = k
         self.before, self.after = before, after
-        self._prep = None
+        self._prep: _Prepared | None = None
 
     def with_edges(self, before: Edge | None, after: Edge | None) -> Leaf:
         """The same keyframes with other neighbours across junctions.
@@ -394,23 +407,31 @@ class Leaf(Track):
         return self._prep
 
     def sample(self, t: np.ndarray) -> Samples:
-        return self._sample(t, True)
+        out = _empty(len(t))
+        self._fill(self._prepare(), t, out.x, out)
+        return out
 
     def sample_x(self, t: np.ndarray) -> np.ndarray:
-        return self._sample(t, False).x
-
-    def _sample(self, t: np.ndarray, full: bool) -> Samples:
         p = self._prepare()
+        if len(t) > 8 * len(p.T) and (t[1:] >= t[:-1]).all():
+            return self._sample_sorted_x(p, t)
+        x = np.empty((len(t), 3))
+        self._fill(p, t, x, None)
+        return x
+
+    def _fill(self, p: _Prepared, t: np.ndarray, x: np.ndarray, full: Samples | None) -> None:
+        """Write the angles at ``t`` into ``x`` (N, 3), and the derivatives into ``full`` if given.
+
+        ``full``, when given, is the Samples whose ``x`` is ``x``; without it
+        no derivative is computed.
+        """
         K = len(p.T)
-        if not full and len(t) > 8 * K and (t[1:] >= t[:-1]).all():
-            return Samples(self._sample_sorted_x(p, t), None, None)
-        out = _empty(len(t)) if full else Samples(np.empty((len(t), 3)), None, None)
         idx = np.searchsorted(p.F, t, side="right" if self.right else "left")
-        out.x[idx == 0] = self.start
-        out.x[idx > K] = p.V[K]
+        x[idx == 0] = self.start
+        x[idx > K] = p.V[K]
         inside = np.nonzero((idx > 0) & (idx <= K))[0]
         if len(inside) == 0:
-            return out
+            return
         seg = idx[inside] - 1
         for j, m in enumerate(p.kinds):
             sel = p.code[seg] == j
@@ -419,13 +440,12 @@ class Leaf(Track):
             rows, s = inside[sel], seg[sel]
             ts = t[rows]
             if m.name == "LINEAR":
-                x, v, a = _trapezoid(p, s, ts, full)
+                xs, v, a = _trapezoid(p, s, ts, full is not None)
             else:
-                x, v, a = _fixed(p, m, s, ts, full)
-            out.x[rows] = x
-            if full:
-                out.v[rows], out.a[rows] = v, a
-        return out
+                xs, v, a = _fixed(p, m, s, ts, full is not None)
+            x[rows] = xs
+            if full is not None:
+                full.v[rows], full.a[rows] = v, a
 
     def _sample_sorted_x(self, p: _Prepared, t: np.ndarray) -> np.ndarray:
         """Angles at increasing times: each segment's times are one slice, its values scalars.
@@ -492,7 +512,7 @@ class Leaf(Track):
 
     def _emit(self, out, offset):
         for f, v, m, r in zip(self.frames, self.values, self.methods, self.ramps):
-            out.add(offset + f, v, m.name, r)
+            out.add(offset + f, v + out.shift, m.name, r)
 
 
 def _col(a):
@@ -507,7 +527,7 @@ def _gather(p: _Prepared, s, ts: np.ndarray):
     return tau, sig, p.V[s], p.V[s + 1]
 
 
-def _trapezoid(p: _Prepared, s: np.ndarray, ts: np.ndarray, full: bool = True):
+def _trapezoid(p: _Prepared, s: np.ndarray | int, ts: np.ndarray, full: bool = True):
     """LINEAR segments: ramp Vs -> c over r frames, cruise, ramp c -> Ve over r frames.
 
     Returns (x, v, a); v and a are None unless ``full``.
@@ -978,7 +998,7 @@ def edge_leaf(track: Track, side: str) -> Leaf | None:
         if side == "right" and track.end != (track.n - 1) * track.period + track.inner.end:
             return None
         return edge_leaf(track.inner, side)
-    return None
+    return track._edge_leaf(side)
 
 
 def with_edge(track: Track, side: str, edge: Edge) -> Track:
@@ -1013,7 +1033,7 @@ def with_edge(track: Track, side: str, edge: Edge) -> Track:
         if side == "left":
             return concat(with_edge(inner, side, edge), rest, P, track.right, track.end)
         return concat(rest, with_edge(inner, side, edge), (n - 1) * P, track.right, track.end)
-    raise TypeError(f"track {type(track).__name__} has no edge leaf")  # pragma: no cover
+    return track._with_edge(side, edge)
 
 
 def join_smoothly(first: Track, second: Track, pivot: float) -> tuple[Track, Track]:
@@ -1307,6 +1327,8 @@ class _Emitter:
         self.limit = limit
         self.cur = start
         self.last = 0.0
+        # Added to every value emitted: the displacement a root path's Shift nodes carry.
+        self.shift = np.zeros(3)
 
     def add(self, frame, value, method, ramp):
         if len(self.keys) >= self.limit:
@@ -1342,6 +1364,7 @@ class _Emitter:
         """
         if smooth and self.last == frame:
             return
+        start = start + self.shift
         self.hold_until(frame)
         if not (self._at_step() and np.array_equal(self.cur, start)):
             self.add(frame, start, "LINEAR", RAMP)

@@ -171,6 +171,7 @@ class Camera:
         # round differently depending on a point's position in the array, and
         # the rasterizer needs a shared vertex to land on bit-identical pixel
         # coordinates in every triangle that uses it (no cracks along edges).
+        # (The rasterizer repeats this arithmetic on its own array layout.)
         x, y, z = q[..., 0], q[..., 1], q[..., 2]
         return np.stack(
             [

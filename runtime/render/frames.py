@@ -1,21 +1,37 @@
-"""Rendering scenes: batched poses, z-buffered images, files written atomically.
+"""Rendering scenes: batched poses, z-buffered images, frames and movies streamed to their files.
 
 The runtime hands over each tick's drawings; images are gathered in small
 batches so that poses are evaluated for a whole batch of frames at once,
-then the images are rasterized and written by a pool of worker processes
-(several images a task, so the cost of handing work over stays small), or
-in this process for scenes of only a few images.  At most a few batches are
+then the images are rasterized by a pool of worker processes (several
+images a task, so the cost of handing work over stays small), by an
+executor given by the caller (a Dask cluster), or in this process for
+scenes of only a few images.  Each task returns its images, PNG-encoded
+when frames are written and raw when a movie is, and this process writes
+them in order: PNG files, and the frames of the GIF and MP4 streams (whose
+encoders run beside the drawing, :mod:`.video`).  At most a few tasks are
 in flight at once, so memory stays flat however long a scene is.
+
+Durability (:mod:`liganimate.runtime.files`): each frame is written under
+a temporary name and renamed into place, without an ``fsync`` of its own;
+every :data:`SYNC_EVERY` frames, and at the end (finished or interrupted),
+the frames written since are flushed to disk together with their folders.
+A crash of the process leaves only whole frames (numbered without gaps);
+a power loss may in addition lose, or leave empty, the frames written
+since the last flush.  Movies and the pose record are synced before they
+are renamed into place, and exist only once complete.
 
 Faults: the output options are checked and the outputs locked before the
 first image (:mod:`.outputs`); worker processes ignore SIGINT and SIGTERM
 and die with this process; :meth:`Renderer.close` always waits for the
-images being written (bounded), stops the workers and removes temporary
-files, so an interrupted or failed render leaves only whole files.
+images being drawn (bounded), stops the workers, abandons unfinished
+movies and removes temporary files, so an interrupted or failed render
+leaves only whole files.
 """
 
 from __future__ import annotations
 
+import collections
+import contextlib
 import json
 import os
 import signal
@@ -34,25 +50,22 @@ from liganimate.runtime.figure.pose import (
     world_transforms,
     world_triangles,
 )
+from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
-from liganimate.runtime.render.imagefiles import (
-    AtomicWriter,
-    find_ffmpeg,
-    fsync_folder,
-    os_error_words,
-    read_png,
-    write_gif,
-    write_mp4,
-    write_png,
-)
+from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
 from liganimate.runtime.render.outputs import KEYWORD_NAMES, OutputLock, check_outputs
 from liganimate.runtime.render.raster import Framebuffer, rasterize
+from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, GifStream, Mp4Stream
 from liganimate.runtime.values import Graphical, joined_shades
 
 # Images whose poses are evaluated together.
 BATCH = 32
 # Images handed to a worker process in one task.
 CHUNK = 8
+# Frames written between two flushes to disk (see the module's notes).
+SYNC_EVERY = 512
+# Threads writing PNG files.
+WRITERS = 2
 # Bounds of the memory of evaluated joint angles: (model, motion) pairs, frames each.
 _ANGLE_MODELS = 64
 _ANGLE_FRAMES = 4096
@@ -66,8 +79,9 @@ class Renderer:
 
     Parameters
     ----------
-    out_dir : str
-        Frames go to ``out_dir/scene<ID>/<NNNNN>.png``.
+    out_dir : str or None
+        Frames go to ``out_dir/scene<ID>/<NNNNN>.png``; None writes no
+        frames (then ``gif`` or ``mp4`` must be given).
     size : (int, int)
         Image width and height in pixels.
     gif, mp4, poses : str or None
@@ -80,14 +94,18 @@ class Renderer:
         Processes rasterizing in parallel (default: the machine's cores, at
         most 8); 1 draws everything in this process.
     aa : int
-        Anti-aliasing factor, 1 (none, the default) or more: each image is
-        drawn at ``aa`` times its size in each direction and averaged down.
+        Anti-aliasing factor, 1 (none, the default) to 8: each pixel is the
+        mean of ``aa x aa`` samples.
     executor : object or None
         Where images are drawn instead of a pool of local processes: any
         object with ``submit(fn, *args) -> concurrent.futures.Future`` and
         ``shutdown(wait=True, cancel_futures=False)``, such as
         :class:`liganimate.runtime.render.distributed.DaskExecutor`.  The
-        renderer uses it for every image and shuts it down when closed.
+        tasks return their images to this process, which writes every file.
+        The renderer uses it for every image and shuts it down when closed.
+    crf, preset : int, str
+        x264's quality (0 to 51, lower is better and larger) and speed
+        (``ultrafast`` to ``veryslow``) for the MP4 (see :mod:`.video`).
 
     Raises
     ------
@@ -111,18 +129,25 @@ class Renderer:
         progress=None,
         aa=1,
         executor=None,
+        crf=DEFAULT_CRF,
+        preset=DEFAULT_PRESET,
     ):
         try:
-            self._init(out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor)
+            self._init(out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor, crf, preset)
         except BaseException:
             if executor is not None:
                 executor.shutdown(wait=False, cancel_futures=True)
             raise
 
-    def _init(self, out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor) -> None:
+    def _init(self, out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor, crf, preset):
+        from liganimate.runtime.render.video import check_crf, check_preset, find_ffmpeg
+
         self.aa = check_aa(aa, "aa=")
-        self.executor = executor
+        crf, preset = check_crf(crf, "crf="), check_preset(preset, "preset=")
+        if out_dir is None and not (gif or mp4):
+            raise RenderError("out_dir is None and there is no gif= or mp4=: nothing would be written")
         check_outputs(out_dir, gif, mp4, poses, fps, KEYWORD_NAMES, make_poses_folder=True)
+        self.executor = executor
         self.out_dir = out_dir
         self.size = (int(size[0]), int(size[1]))
         self.gif, self.mp4, self.fps = gif, mp4, float(fps)
@@ -133,11 +158,13 @@ class Renderer:
         self.quiet = quiet
         self.workers = workers if workers is not None else min(os.cpu_count() or 1, 8)
         self.pool = None
+        self._worker_procs: list = []
         self.pending: list = []
         self.current = None
         self.images = 0  # images handed over so far, all scenes
-        self.scenes: list = []  # [scene id, images], for the GIF and MP4
-        self.futures: list = []
+        self.written = 0  # images delivered to their files so far
+        self.scenes: list = []  # [scene id, images]
+        self.futures: list = []  # (future, [(scene id, image number)]), in order
         self._chunk: list = []
         self._angles: dict = {}
         self.scene_id = None
@@ -145,33 +172,68 @@ class Renderer:
         self.progress = progress if progress is not None else (not quiet and sys.stderr.isatty())
         self._poses_fh = None
         self._closed = False
+        self._failed = False
+        self._streams: list = []
+        self._synced = SyncBatch(SYNC_EVERY)
+        self._files = None  # threads writing the PNG files, started with the first
+        self._writes: collections.deque = collections.deque()  # (future, path), in order
+        # What the tasks send back: PNG bytes when frames are written, raw images for the movies.
+        self._want = (out_dir is not None, bool(gif or mp4))
         if poses:
             try:
                 os.makedirs(os.path.dirname(os.path.abspath(poses)), exist_ok=True)
             except OSError as exc:
                 raise RenderError(f"cannot create the folder of {poses}: {os_error_words(exc)}") from None
         self.lock = OutputLock(out_dir, (gif, mp4, poses))
-        if poses:
-            try:
+        try:
+            if poses:
                 self._poses_fh = AtomicWriter(poses)
-            except BaseException:
-                self.lock.release()
-                raise
+            if gif:
+                self._streams.append(GifStream(gif, self.fps))
+            if mp4:
+                self._streams.append(Mp4Stream(mp4, self.fps, crf, preset))
+        except BaseException:
+            self._abort_outputs()
+            self.lock.release()
+            raise
 
     # --------------------------------------------------------------- scenes
     def begin_scene(self, scene_id) -> None:
         self.scene_id = scene_id
         self.scene_total = 0
         self.scenes.append([scene_id, 0])
-        os.makedirs(os.path.join(self.out_dir, f"scene{scene_id}"), exist_ok=True)
+        if self.out_dir is not None:
+            os.makedirs(os.path.join(self.out_dir, f"scene{scene_id}"), exist_ok=True)
 
     def end_scene(self) -> None:
-        if self.current is not None:
-            self.pending.append(self.current)
-            self.current = None
-        self.flush()
+        """Hand over the scene's last images.
+
+        Called from a ``finally`` block: after a failure or an interruption
+        inside the renderer it does nothing, so no image is written after
+        one that was lost (frames stay numbered without gaps).
+        """
+        if self._failed:
+            return
+        with self._failing():
+            if self.current is not None:
+                self.pending.append(self.current)
+                self.current = None
+            self.flush()
+
+    @contextlib.contextmanager
+    def _failing(self):
+        """Note any exception (an interruption, a full disk) passing through, then let it go on."""
+        try:
+            yield
+        except BaseException:
+            self._failed = True
+            raise
 
     def add_tick(self, state, rt) -> None:
+        with self._failing():
+            self._add_tick(state)
+
+    def _add_tick(self, state) -> None:
         tick, k = state.tick, state.sameframe
         image = tick // k
         self.scene_total = -(-state.length // k)
@@ -240,8 +302,7 @@ class Renderer:
                     for o, (name, _posed) in enumerate(drawn):
                         angles, X, fig = results[(i, j, o, "pose")]
                         self._write_pose(img["scene"], tick, img["image"], name, fig, angles, X)
-            path = os.path.join(self.out_dir, f"scene{img['scene']}", f"{img['image']:05d}.png")
-            self._submit(path, draws)
+            self._submit((img["scene"], img["image"]), draws)
         self.pending = []
 
     def _joint_angles(self, fig, motion, frames: list) -> np.ndarray:
@@ -282,8 +343,9 @@ class Renderer:
         rec = {"scene": scene, "tick": tick, "image": image, "model": name, "joints": joints, "segments": segments}
         self._poses_fh.write((json.dumps(rec, separators=(", ", ": ")) + "\n").encode("utf-8"))
 
-    def _submit(self, path, draws) -> None:
-        self._chunk.append((path, draws))
+    def _submit(self, name, draws) -> None:
+        """Queue one image, ``name`` = (scene id, image number), for drawing."""
+        self._chunk.append((name, draws))
         self.images += 1
         self.scenes[-1][1] += 1
         if len(self._chunk) >= CHUNK:
@@ -295,29 +357,78 @@ class Renderer:
         chunk, self._chunk = self._chunk, []
         if not chunk:
             return
+        names = [name for name, _ in chunk]
+        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want)
         if self.pool is None and self.executor is not None:
             self.pool = self.executor
-            self._worker_procs = []
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
             self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init, initargs=(os.getpid(),))
-            self._worker_procs: list = []
             # The first submit forks the workers.  With SIGINT and SIGTERM blocked
             # meanwhile, a signal cannot reach a worker before it has set itself to
             # ignore them; this process receives it once the mask is restored.
             old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
             try:
-                self.futures.append(self.pool.submit(draw_images, self.size, chunk, self.aa))
+                self.futures.append((self.pool.submit(draw_images, *args), names))
                 self._worker_procs = list((getattr(self.pool, "_processes", None) or {}).values())
             finally:
                 signal.pthread_sigmask(signal.SIG_SETMASK, old)
             return
         if self.pool is None:
-            draw_images(self.size, chunk, self.aa)
+            self._deliver(names, draw_images(*args))
             return
-        self.futures.append(self.pool.submit(draw_images, self.size, chunk, self.aa))
-        # Enough in flight to keep every worker busy, no more (memory stays flat).
-        while len(self.futures) > 2 * max(self.workers, 2):
-            _result(self.futures.pop(0))
+        self.futures.append((self.pool.submit(draw_images, *args), names))
+        # Enough in flight to keep every worker busy, no more (memory stays flat);
+        # results are taken in order as soon as they are ready.
+        limit = 2 * max(int(getattr(self.pool, "workers", 0) or self.workers), 2)
+        while self.futures and (len(self.futures) > limit or self.futures[0][0].done()):
+            self._take()
+
+    def _take(self) -> None:
+        future, names = self.futures.pop(0)
+        self._deliver(names, _result(future))
+
+    def _deliver(self, names, images) -> None:
+        """Write the images of one task, in order: PNG files, then frames of the movies."""
+        for (scene_id, number), (png, raw) in zip(names, images):
+            if png is not None:
+                folder = os.path.join(self.out_dir, f"scene{scene_id}")
+                path = os.path.join(folder, f"{number:05d}.png")
+                self._write(path, png)
+            if raw is not None:
+                for stream in self._streams:
+                    stream.add(raw)
+            self.written += 1
+
+    def _write(self, path, png) -> None:
+        """Write one PNG file in a helper thread: creating and renaming files waits on the file system.
+
+        The threads overlap that wait with the work of this process (the
+        system calls release the interpreter lock).  Files are noted for
+        the next flush to disk in order, as their writes complete.
+        """
+        if self._files is None:
+            self._files = ThreadPoolExecutor(max_workers=WRITERS, thread_name_prefix="liganimate-png")
+        self._writes.append((self._files.submit(write_png_bytes, path, png, fsync=False), path))
+        while self._writes and (len(self._writes) > 8 * WRITERS or self._writes[0][0].done()):
+            self._written()
+
+    def _written(self) -> None:
+        future, path = self._writes.popleft()
+        future.result()
+        self._synced.add(path)
+
+    def _stop_writes(self) -> None:
+        """Wait for every PNG being written (each is then whole, and none is missing before it)."""
+        files, self._files = self._files, None
+        if files is None:
+            return
+        try:
+            while self._writes:
+                future, path = self._writes.popleft()
+                if future.exception() is None:
+                    self._synced.add(path)
+        finally:
+            files.shutdown(wait=True)
 
     def _show_progress(self) -> None:
         if self.progress:
@@ -327,42 +438,63 @@ class Renderer:
 
     # ---------------------------------------------------------------- finish
     def finish(self) -> None:
-        """Wait for every image, then write the GIF, MP4 and pose record."""
+        """Wait for every image and write it, then finish the GIF, MP4 and pose record."""
+        with self._failing():
+            self._finish()
+
+    def _finish(self) -> None:
         self._send()
         while self.futures:
-            _result(self.futures.pop(0))
+            self._take()
+        while self._writes:
+            self._written()
         if self.progress and self.images:
             sys.stderr.write("\n")
+        self._synced.sync()
         if self._poses_fh is not None:
             self._poses_fh.commit()
             self._poses_fh = None
-        if self.gif and self.images:
-            write_gif(self.gif, self._frames(), self.fps)
-        if self.mp4 and self.images:
-            write_mp4(self.mp4, self._frames(), self.fps)
+        streams, self._streams = self._streams, []
+        try:
+            while streams:
+                stream = streams[0]
+                if stream.frames:
+                    stream.commit()
+                else:
+                    stream.abort()  # no image at all: no movie, as no frame
+                streams.pop(0)
+        finally:
+            for stream in streams:
+                stream.abort()
         self._sync_folders()
 
     def _sync_folders(self) -> None:
-        """Each file was synced before its rename; syncing the folders makes the renames durable too."""
-        folders = {os.path.join(self.out_dir, f"scene{scene_id}") for scene_id, _ in self.scenes}
-        folders |= {os.path.dirname(os.path.abspath(p)) for p in (self.gif, self.mp4, self.poses_path) if p}
-        for folder in sorted(folders) + [self.out_dir]:
-            fsync_folder(folder)
+        """Make the renames of the movies and pose record durable (each file was synced before its rename)."""
+        folders = {os.path.dirname(os.path.abspath(p)) for p in (self.gif, self.mp4, self.poses_path) if p}
+        for folder in sorted(folders):
+            self._synced.add_folder(folder)
+        if self.out_dir is not None:
+            self._synced.add_folder(self.out_dir)
+        self._synced.sync()
 
-    def _frames(self):
-        """Every image written, in order, read back one at a time."""
-        for scene_id, count in self.scenes:
-            for i in range(count):
-                yield read_png(os.path.join(self.out_dir, f"scene{scene_id}", f"{i:05d}.png"))
+    def _abort_outputs(self) -> None:
+        """Remove the unfinished pose record and movies."""
+        if self._poses_fh is not None:
+            self._poses_fh.abort()
+            self._poses_fh = None
+        streams, self._streams = self._streams, []
+        for stream in streams:
+            stream.abort()
 
     def close(self) -> None:
         """Stop the workers and release everything; after an error or an interruption, leave only whole files.
 
         Images already being drawn are waited for (at most ``_CLOSE_WAIT``
-        seconds, then their workers are killed), images not started are
-        dropped, the unfinished pose record and any temporary file are
-        removed, and the outputs' locks are released.  Safe to call more
-        than once; each step runs even if an earlier one fails.
+        seconds, then their workers are killed) and dropped, images not
+        started are dropped, the unfinished pose record and movies and any
+        temporary file are removed, the frames written are flushed to disk,
+        and the outputs' locks are released.  Safe to call more than once;
+        each step runs even if an earlier one fails.
         """
         if self._closed:
             return
@@ -371,9 +503,8 @@ class Renderer:
             self._stop_pool()
         finally:
             try:
-                if self._poses_fh is not None:
-                    self._poses_fh.abort()
-                    self._poses_fh = None
+                self._stop_writes()
+                self._abort_outputs()
                 self.lock.sweep(self.out_dir, (self.gif, self.mp4, self.poses_path))
                 self._sync_folders()  # the frames of an interrupted run survive a power loss too
             finally:
@@ -384,8 +515,8 @@ class Renderer:
         futures, self.futures, self._chunk = self.futures, [], []
         executor, self.executor = self.executor, None
         if executor is not None:
-            # Not started: dropped; being drawn: waited for, so every file is whole.
-            for f in futures:
+            # Not started: dropped; being drawn: waited for (their images are not written).
+            for f, _ in futures:
                 f.cancel()
             executor.shutdown(wait=True, cancel_futures=True)
             return
@@ -398,7 +529,7 @@ class Renderer:
             p.join(max(0.0, deadline - time.monotonic()))
         for p in procs:
             if p.is_alive():
-                p.kill()  # stuck (a hung disk?): its temporary file is swept afterwards
+                p.kill()  # stuck: nothing of it is written
                 p.join(5.0)
 
 
@@ -449,34 +580,20 @@ def _worker_init(parent: int) -> None:
     mallopt(M_TRIM_THRESHOLD, 256 << 20)
 
 
-def draw_images(size, chunk, aa=1) -> None:
-    """Draw and write several images: ``chunk`` is a list of (path, draws) (a worker's task).
+def draw_images(size, draws_list, aa=1, png=True, raw=False) -> list:
+    """Draw several images (a worker's task): ``draws_list`` holds each image's draws (see :func:`draw`).
 
-    Each image is encoded and written by a helper thread while the next one
-    is drawn: writing waits for the disk (``fsync``), and zlib and numpy
-    release the interpreter lock, so the wait overlaps with drawing.  Every
-    file is complete when this returns.
+    Returns
+    -------
+    list of (bytes or None, ndarray or None)
+        For each image, its PNG file's bytes if ``png``, and the image
+        itself, shape (H, W) or (H, W, 3), uint8, if ``raw``.
     """
-    writer = _writer()
-    writes = []
-    try:
-        for path, draws in chunk:
-            writes.append(writer.submit(write_png, path, draw(size, draws, aa)))
-    finally:
-        for w in writes:
-            w.result()
-
-
-_WRITER: tuple = (None, None)  # (process id, executor): a forked child makes its own
-
-
-def _writer() -> ThreadPoolExecutor:
-    global _WRITER
-    pid, ex = _WRITER
-    if ex is None or pid != os.getpid():
-        ex = ThreadPoolExecutor(max_workers=1, thread_name_prefix="liganimate-writer")
-        _WRITER = (os.getpid(), ex)
-    return ex
+    out = []
+    for draws in draws_list:
+        image = draw(size, draws, aa)
+        out.append((encode_png(image) if png else None, image if raw else None))
+    return out
 
 
 def draw_image(path, size, draws, aa=1) -> None:
@@ -507,19 +624,14 @@ def draw(size, draws, aa=1) -> np.ndarray:
         # The usual case: a fresh image, whose depth buffer need only cover what is drawn.
         camera, parts = merged[0]
         tris, grey, cull = _joined(parts)
-        image = rasterize(tris, grey, _camera(camera, size), 255, cull, **_aa(aa))
+        image = rasterize(tris, grey, _camera(camera, size), 255, cull, aa=aa)
     else:
-        fb = Framebuffer(size, 255, **_aa(aa))
+        fb = Framebuffer(size, 255, aa=aa)
         for camera, parts in merged:
             tris, grey, cull = _joined(parts)
             fb.draw(tris, grey, _camera(camera, size), cull)
         image = fb.image
     return image
-
-
-def _aa(aa) -> dict:
-    """The anti-aliasing keyword for the rasterizer: none at factor 1, so any rasterizer draws plain images."""
-    return {} if aa == 1 else {"aa": aa}
 
 
 MAX_AA = 8

@@ -64,8 +64,9 @@ def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None,
 
     Parameters
     ----------
-    out_dir : str
-        The frames folder; it may not exist yet (it is created with its parents).
+    out_dir : str or None
+        The frames folder; it may not exist yet (it is created with its
+        parents).  None: no frames are written.
     gif, mp4, poses : str or None
         Extra output files; each must name a file (not a folder) in a folder that exists.
     fps : float
@@ -84,7 +85,8 @@ def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None,
     """
     names = names or KEYWORD_NAMES
     check_fps(fps, names["fps"])
-    _check_folder(os.fspath(out_dir), names["out"])
+    if out_dir is not None:
+        _check_folder(os.fspath(out_dir), names["out"])
     seen: dict = {}
     for key, path in (("gif", gif), ("mp4", mp4), ("poses", poses)):
         if path is None:
@@ -97,7 +99,7 @@ def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None,
         else:
             _check_file(path, opt, out_dir)
         real = os.path.realpath(path)
-        if real == os.path.realpath(out_dir):
+        if out_dir is not None and real == os.path.realpath(out_dir):
             raise RenderError(f"{opt} {path} is the frames folder ({names['out']} {out_dir}); give another file name")
         if real in seen:
             raise RenderError(f"{opt} and {seen[real]} both name {path}; give each its own file")
@@ -132,7 +134,7 @@ def _check_file(path: str, opt: str, out_dir) -> None:
         raise RenderError(f"{opt} {path} exists and is not a regular file")
     folder = os.path.dirname(os.path.abspath(path))
     shown = os.path.dirname(path) or "."
-    if folder == os.path.abspath(out_dir) and not os.path.lexists(folder):
+    if out_dir is not None and folder == os.path.abspath(out_dir) and not os.path.lexists(folder):
         return  # in the frames folder, which the render creates (and _check_folder has vetted)
     if not os.path.isdir(folder):
         what = "is not a folder" if os.path.lexists(folder) else "does not exist"
@@ -152,14 +154,15 @@ def lock_targets(out_dir, files) -> list:
     """(lock path, what it guards as the user wrote it, is it the folder) for a render's outputs.
 
     An output file inside the frames folder is guarded by the folder's lock.
+    ``out_dir`` None: no frames folder.
     """
-    out_real = os.path.realpath(out_dir)
-    targets = [(lock_path_of(os.fspath(out_dir), True), os.fspath(out_dir), True)]
+    out_real = os.path.realpath(out_dir) if out_dir is not None else None
+    targets = [(lock_path_of(os.fspath(out_dir), True), os.fspath(out_dir), True)] if out_dir is not None else []
     for f in files:
         if f is None:
             continue
         f = os.fspath(f)
-        if os.path.realpath(f).startswith(out_real + os.sep):
+        if out_real is not None and os.path.realpath(f).startswith(out_real + os.sep):
             continue
         targets.append((lock_path_of(f, False), f, False))
     return targets
@@ -221,8 +224,8 @@ class OutputLock:
 
     Parameters
     ----------
-    out_dir : str
-        The frames folder.
+    out_dir : str or None
+        The frames folder (None: no frames are written).
     files : iterable of str or None
         The GIF, MP4 and pose record paths (None for those not asked for).
 
@@ -235,11 +238,12 @@ class OutputLock:
 
     def __init__(self, out_dir, files=()):
         self.held: list = []  # (lock path, descriptor, key in _HELD)
-        out_dir = os.fspath(out_dir)
+        out_dir = os.fspath(out_dir) if out_dir is not None else None
         files = [os.fspath(f) for f in files if f is not None]
-        created = not os.path.isdir(out_dir)
+        created = out_dir is not None and not os.path.isdir(out_dir)
         try:
-            os.makedirs(out_dir, exist_ok=True)
+            if out_dir is not None:
+                os.makedirs(out_dir, exist_ok=True)
         except OSError as exc:
             raise RenderError(f"cannot create the folder {out_dir}: {_words(exc)}") from None
         try:
@@ -291,10 +295,10 @@ class OutputLock:
         belong to a write in progress elsewhere.
         """
         removed = []
-        out_dir = os.fspath(out_dir)
         folders = []
-        with contextlib.suppress(OSError), os.scandir(out_dir) as it:
-            folders = [e.path for e in it if e.name.startswith("scene") and e.is_dir(follow_symlinks=False)]
+        if out_dir is not None:
+            with contextlib.suppress(OSError), os.scandir(os.fspath(out_dir)) as it:
+                folders = [e.path for e in it if e.name.startswith("scene") and e.is_dir(follow_symlinks=False)]
         for folder in folders:
             with contextlib.suppress(OSError), os.scandir(folder) as it:
                 removed += [e.path for e in it if _FRAME_TMP.fullmatch(e.name)]

@@ -13,7 +13,7 @@ import io
 import numpy as np
 
 from liganimate.runtime.errors import LigError
-from liganimate.runtime.render.imagefiles import AtomicWriter
+from liganimate.runtime.files import AtomicWriter
 
 # Samples across the whole motion: enough for smooth curves over a few
 # hundred frames, bounded so that ``1000000000 * WALK`` still plots at once.

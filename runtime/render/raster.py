@@ -1,6 +1,7 @@
-"""A vectorized z-buffer rasterizer for flat-shaded triangles.
+"""A vectorized z-buffer rasterizer for flat-shaded triangles, grey or RGB, with optional supersampling.
 
-No Python loop runs per triangle, row or pixel.  The pipeline:
+No Python loop runs per triangle, row or pixel (only per band of rows, a
+handful per frame).  The pipeline:
 
 1. to camera space; back faces dropped where ``cull`` allows;
 2. clipping against the near plane (a triangle with one vertex behind it
@@ -9,12 +10,17 @@ No Python loop runs per triangle, row or pixel.  The pipeline:
 3. projection; each triangle splits at its middle vertex into two
    trapezoids, and each trapezoid gives one span per pixel row, bounded by
    its two edges' crossings of the row's centre line;
-4. spans expand to fragments (pixels) with ``np.repeat``; each fragment
+4. on frames above ``_ONE_BAND_PIXELS``, trapezoids are cut at the edges
+   of bands of rows (about ``_BAND_PIXELS`` pixels each) and drawn band by
+   band, so a band's depth keys stay in the cache and no pass ever runs
+   over the whole frame: the cost grows with the pixels drawn, not faster;
+5. spans expand to fragments (pixels) with ``np.repeat``; each fragment
    gets an int64 key: the upper 32 bits of the float64 ``1/z`` (sign,
    exponent and 20 mantissa bits, so keys order like depths to about 1e-6
    relative) above the triangle's number.  One ``np.maximum.at`` then does
    the depth test *and* the tie rule: nearer wins, and at equal depth the
-   higher triangle number wins.
+   higher triangle number wins.  The fragments whose key is still there
+   afterwards paint their triangle's grey level or colour.
 
 Coverage rule: a pixel belongs to a triangle when its centre lies inside it;
 a centre exactly on an edge belongs to the triangle to its right, or below it
@@ -23,12 +29,19 @@ therefore never both cover, nor both miss, a pixel along it: the crossing
 point of a shared edge is computed from the same two vertices in the same
 order in both triangles, so it is bit-identical.
 
-Speed notes (measured with callgrind and wall time; see
+Anti-aliasing (``aa=N``) draws the same triangles with a camera of N times
+the resolution in each direction (:meth:`Camera.supersampled`), so each
+pixel gets N x N samples on a regular grid, then :func:`downsample` takes
+each block's mean rounded half up, in integers: the bytes are exact.
+
+Speed notes (measured with callgrind and CPU time; see
 ``benchmarks/raster.py``): ``np.repeat`` costs a few instructions per element
 where a gather (``np.take``, fancy indexing) costs 15-30, so per-span values
-reach fragments by repeating, never by gathering with a span index.  With
-EMPTY = 0 a new depth buffer is ``np.zeros``, whose pages the kernel supplies
-zeroed on first touch: cheaper than keeping a buffer and clearing it.
+reach fragments by repeating, never by gathering with a span index.  With a
+few hundred triangles a frame costs mostly numpy calls (about a microsecond
+each), so the per-triangle steps work on whole (k, N) blocks.  The algorithm
+before bands is kept in ``tests/runtime/render/raster_reference.py``; the
+tests check this one against it byte for byte.
 """
 
 from __future__ import annotations
@@ -65,7 +78,10 @@ _CHUNK = 1 << 18
 # Spans are drawn in bands of whole rows of about this many pixels, one band
 # at a time: the band's depth keys (8 bytes a pixel) then stay in the L2
 # cache, and no pass ever runs over the whole frame's depth buffer.
-_BAND_PIXELS = 1 << 17
+_BAND_PIXELS = 1 << 16
+# ...except in frames of at most this many pixels, drawn as one band: a band
+# costs a few dozen numpy calls, more than the cache saves on a small frame.
+_ONE_BAND_PIXELS = 1 << 19
 
 
 def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: int = 1) -> np.ndarray:
@@ -109,7 +125,7 @@ def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: i
         a whole number from 1 to ``MAX_AA``.
     """
     aa = _aa(aa)
-    tris, shade = _check(triangles, shade, cull)
+    tris, shade, cull = _check(triangles, shade, cull)
     bg = _background(background)
     shade, bg = _same_kind(shade, bg)
     cam = camera.supersampled(aa)
@@ -142,9 +158,16 @@ def downsample(img, aa: int) -> np.ndarray:
     """
     if aa == 1:
         return img
-    H, W = img.shape[0] // aa, img.shape[1] // aa
-    blocks = img.reshape((H, aa, W, aa) + img.shape[2:])
-    total = blocks.sum(axis=(1, 3), dtype=np.uint32)
+    # Sums of aa columns, then of aa rows of those, over strided views: a
+    # few contiguous passes, where a reduction over two axes of a
+    # (H, aa, W, aa) view runs an order of magnitude slower.  uint16 holds
+    # 64 * 255.
+    cols = img[:, 0::aa].astype(np.uint16)
+    for b in range(1, aa):
+        cols += img[:, b::aa]
+    total = cols[0::aa].copy()
+    for a in range(1, aa):
+        total += cols[a::aa]
     n = aa * aa
     total += n // 2
     total //= n
@@ -220,7 +243,7 @@ class Framebuffer:
         cull : array_like of bool, shape (N,), optional
             See :func:`rasterize`.
         """
-        tris, shade = _check(triangles, shade, cull)
+        tris, shade, cull = _check(triangles, shade, cull)
         if shade.ndim == 2 and self.samples.ndim == 2:
             self.samples = np.repeat(self.samples[:, :, None], 3, axis=2)
         elif shade.ndim == 1 and self.samples.ndim == 3:
@@ -230,9 +253,7 @@ class Framebuffer:
             raise RenderError(
                 f"The camera's image size {W}x{H} does not match the {self.size[0]}x{self.size[1]} image being drawn into."
             )
-        self.count = rasterize_into(
-            self.zbuf, self.samples, tris, shade, camera.supersampled(self.aa), cull, self.count
-        )
+        self.count = _draw(self.zbuf, self.samples, tris, shade, camera.supersampled(self.aa), cull, self.count)
 
     def depth(self) -> np.ndarray:
         """The depth of the visible surface at each sample.
@@ -287,7 +308,7 @@ def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first
         )
     if not (img.flags.c_contiguous and zbuf.flags.c_contiguous and zbuf.dtype == np.int64 and img.dtype == np.uint8):
         raise RenderError("The image and depth buffer must be C-contiguous uint8 and int64 arrays.")
-    tris, shade = _check(triangles, shade, cull)
+    tris, shade, cull = _check(triangles, shade, cull)
     if (shade.ndim == 2) != (img.ndim == 3) or img.ndim not in (2, 3) or img.shape[2:] not in ((), (3,)):
         raise RenderError("Colours need an RGB image, and grey levels a grey one.")
     return _draw(zbuf, img, tris, shade, camera, cull, first_index)
@@ -297,19 +318,20 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
     n = len(tris)
     if first_index + n >= _MAX_TRIANGLES:
         raise RenderError(f"Too many triangles in one image (more than {_MAX_TRIANGLES - 1}).")
-    W = camera.size[0]
-    spans = _spans(tris, cull, camera, first_index, max(1, _BAND_PIXELS // W)) if n else None
+    W, H = camera.size
+    band_rows = None if W * H <= _ONE_BAND_PIXELS else max(1, _BAND_PIXELS // W)
+    spans = _spans(tris, cull, camera, first_index, band_rows) if n else None
     if spans is None:
         return first_index + n
     offset, wstart, step, tag, count, bounds = spans
     flat_img = img.reshape((-1,) + img.shape[2:])
     flat_z = None if zbuf is None else zbuf.reshape(-1)
     if len(bounds) == 2:
-        # One band (the usual case below about 1080p): no per-band slicing.
-        lo = int(offset.min())
-        hi = int((offset + count).max())
+        lo = int(np.minimum.reduce(offset))
+        hi = int(np.maximum.reduce(offset + count))
         zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
-        _band(zb, flat_img[lo:hi], offset - lo, wstart, step, tag, count, shade, first_index)
+        offset -= lo
+        _band(zb, flat_img[lo:hi], offset, wstart, step, tag, count, shade, first_index, flat_z is None)
         return first_index + n
     starts = bounds[:-1]
     los = np.minimum.reduceat(offset, starts).tolist()
@@ -326,21 +348,46 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
             zb = scratch[: hi - lo]
             if i:
                 zb.fill(EMPTY)
-        _band(zb, flat_img[lo:hi], offset[sl] - lo, wstart[sl], step[sl], tag[sl], count[sl], shade, first_index)
+        _band(
+            zb,
+            flat_img[lo:hi],
+            offset[sl] - lo,
+            wstart[sl],
+            step[sl],
+            tag[sl],
+            count[sl],
+            shade,
+            first_index,
+            flat_z is None,
+        )
     return first_index + n
 
 
-def _band(zb, im, offset, wstart, step, tag, count, shade, first_index):
-    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range)."""
-    ends = np.cumsum(count)
+def _band(zb, im, offset, wstart, step, tag, count, shade, first_index, fresh):
+    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range).
+
+    ``fresh``: the depth keys were all EMPTY before this draw.
+    """
+    ends = count.cumsum()
     if ends[-1] <= _CHUNK:
         pix, key = _expand(offset, wstart, step, tag, count, ends)
         np.maximum.at(zb, pix, key)
-        won = zb[pix] == key
+        if fresh:
+            # Every key in the buffer is this draw's: each fragment may
+            # paint its pixel's winner (some pixels several times, alike).
+            key = zb.take(pix)
+            key &= _INDEX_MASK
+            key -= first_index
+            im[pix] = shade.take(key, axis=0)
+            return
+        won = (zb.take(pix) == key).nonzero()[0]
         # A pixel is won by at most one fragment (keys are unique per
         # triangle, and a triangle covers a pixel at most once), so this
         # assignment has no repeated indices.
-        im[pix[won]] = shade[(key[won] & _INDEX_MASK) - first_index]
+        key = key.take(won)
+        key &= _INDEX_MASK
+        key -= first_index
+        im[pix.take(won)] = shade.take(key, axis=0)
         return
     # Too many fragments for one go (deep overlap): depth-test chunk by
     # chunk, then find this draw's winners by scanning the band.
@@ -352,8 +399,8 @@ def _band(zb, im, offset, wstart, step, tag, count, shade, first_index):
             np.maximum.at(zb, pix, key)
             lo = hi
     num = zb & _INDEX_MASK
-    sel = np.flatnonzero((zb != EMPTY) & (num >= first_index))
-    im[sel] = shade[num[sel] - first_index]
+    sel = ((zb != EMPTY) & (num >= first_index)).nonzero()[0]
+    im[sel] = shade.take(num.take(sel) - first_index, axis=0)
 
 
 # Shared read-only aranges, grown as needed (replaced, never modified, so
@@ -375,22 +422,22 @@ def _aranges(n: int):
 def _expand(offset, wstart, step, tag, count, ends):
     """Spans (P,) to fragments: pixel numbers (F,) and depth keys (F,)."""
     if ends is None:
-        ends = np.cumsum(count)
+        ends = count.cumsum()
     n = int(ends[-1])
     iar, far = _aranges(n)
     starts = ends - count
-    pix = np.repeat(offset - starts, count)
+    pix = (offset - starts).repeat(count)
     pix += iar[:n]
     # 1/z = wstart + (i - start) * step for fragment i.  Anchoring the
     # ramp at fragment 0 instead saves two passes; its extra rounding is
     # about 1e-16 * start * |step| (start < _CHUNK + W, and |step| at most
     # the triangle's 1/z range), far below the key's 1e-6 resolution.
-    w = np.repeat(step, count)
+    w = step.repeat(count)
     w *= far[:n]
-    w += np.repeat(wstart - starts * step, count)
+    w += (wstart - starts * step).repeat(count)
     key = w.view(np.int64)
     key &= _DEPTH_MASK
-    key += np.repeat(tag, count)
+    key += tag.repeat(count)
     return pix, key
 
 
@@ -455,9 +502,11 @@ def _check(triangles, shade, cull):
             what = "Colour components" if s.ndim == 2 else "Grey levels"
             raise RenderError(f"{what} must be whole numbers from 0 to 255.")
         s = s.astype(np.uint8)
-    if cull is not None and np.shape(cull) != (len(tris),):
-        raise RenderError(f"Expected {len(tris)} cull flags, one per triangle, got shape {np.shape(cull)}.")
-    return tris, s
+    if cull is not None:
+        cull = np.asarray(cull, dtype=bool)
+        if cull.shape != (len(tris),):
+            raise RenderError(f"Expected {len(tris)} cull flags, one per triangle, got shape {cull.shape}.")
+    return tris, s, cull
 
 
 def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None = None):
@@ -470,127 +519,198 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     B + 1 int) splits them into bands: spans ``bounds[k]:bounds[k + 1]`` lie
     in rows ``[b * band_rows, (b + 1) * band_rows)`` for some band ``b``
     that grows with ``k``.  ``band_rows`` None means one band.
+
+    Every step works on whole (k, N) or (k, P) blocks: with a few hundred
+    triangles, the cost of a frame is mostly the number of numpy calls.
     """
     W, H = camera.size
-    v0 = tris[:, 0]
-    # Facing is decided in world space (camera space is left-handed).
-    a, b = tris[:, 1] - v0, tris[:, 2] - v0
-    c = camera.point - v0
-    front = (
-        (a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]) * c[:, 0]
-        + (a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]) * c[:, 1]
-        + (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) * c[:, 2]
-    ) > 0.0
+    # Component-major from here on, v[i, k] being coordinate k of vertex i
+    # of every triangle: numpy's loops over a last axis of length 3 cost
+    # more per element than the arithmetic.
+    n = len(tris)
+    v = np.ascontiguousarray(tris.reshape(n, 9).T).reshape(3, 3, n)
+    # Facing is decided in world space (camera space is left-handed): the
+    # sign of ((v1 - v0) x (v2 - v0)) . (eye - v0), cross product
+    # component k being a[k+1] b[k+2] - a[k+2] b[k+1].
+    a, b = v[1] - v[0], v[2] - v[0]
+    cross = a.take(_NEXT, axis=0) * b.take(_AFTER, axis=0)
+    cross -= a.take(_AFTER, axis=0) * b.take(_NEXT, axis=0)
+    cross *= camera.point[:, None] - v[0]
+    front = cross[0] + cross[1]
+    front += cross[2]
+    front = front > 0.0
     src = None  # the triangle each drawn one comes from; None for "itself"
     if cull is not None:
-        keep = front | ~np.asarray(cull, dtype=bool)
-        if not keep.all():
-            src = np.flatnonzero(keep)
-            tris = tris[src]
-    cam, src = _clip_near(camera.to_camera(tris), src, camera.near)
-    m = len(cam)
+        keep = front | ~cull
+        if not np.logical_and.reduce(keep):
+            src = keep.nonzero()[0]
+            v = v.take(src, axis=2)
+    # To camera space as Camera.to_camera: component k is
+    # x a[k, 0] + y a[k, 1] + z a[k, 2], added in that order.
+    q = v - camera.point[:, None]
+    axes = camera.axes[:, :, None, None]
+    cam = q[:, 0] * axes[:, 0]  # (3 components, 3 vertices, n)
+    cam += q[:, 1] * axes[:, 1]
+    cam += q[:, 2] * axes[:, 2]
+    if cam.shape[2] and np.minimum.reduce(cam[2], axis=None) < camera.near:
+        clipped, src = _clip_near(cam.transpose(2, 1, 0), src, camera.near)
+        cam = np.ascontiguousarray(clipped.transpose(2, 1, 0))
+    m = cam.shape[2]
     if m == 0:
         return None
 
-    scr = camera.camera_to_pixels(cam)  # (m, 3, 3): x, y, depth
-    # Sorting vertices by y fixes the orientation of every edge (top end
-    # first), which is what makes shared edges bit-identical.
-    order = np.argsort(scr[:, :, 1], axis=1, kind="stable")
-    order += np.arange(0, 3 * m, 3)[:, None]
-    scr = np.take(scr.reshape(-1, 3), order.reshape(-1), axis=0).reshape(m, 3, 3)
-    xs, ys = scr[:, :, 0], scr[:, :, 1]
-    x0, x1, x2 = xs[:, 0], xs[:, 1], xs[:, 2]
-    y0, y1, y2 = ys[:, 0], ys[:, 1], ys[:, 2]
-    w = 1.0 / scr[:, :, 2]
-    w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
+    # Projection to pixels (as Camera.camera_to_pixels), then the vertices
+    # of each triangle sorted by y: that fixes the orientation of every edge
+    # (top end first), which is what makes shared edges bit-identical.
+    xyw = np.empty((3, 3, m))  # x, y and 1/z of each vertex
+    s = camera.focal / cam[2]
+    y = np.multiply(cam[1], s, out=xyw[1])
+    np.subtract(0.5 * H, y, out=y)
+    x = np.multiply(cam[0], s, out=xyw[0])
+    x += 0.5 * W
+    np.divide(1.0, cam[2], out=xyw[2])
+    # A stable sort of three (a bubble sort, swapping only on a strict <).
+    for i, j in ((0, 1), (1, 2), (0, 1)):
+        swap = xyw[1, j] < xyw[1, i]
+        if np.logical_or.reduce(swap):
+            was = xyw[:, i].copy()
+            np.copyto(xyw[:, i], xyw[:, j], where=swap)
+            np.copyto(xyw[:, j], was, where=swap)
+    x, y, w = xyw
+    x0, y0, w0 = x[0], y[0], w[0]
 
     # Each triangle is two trapezoids: rows whose centre r + 0.5 lies in
     # [y0, y1) are bounded by the long edge 0-2 and the upper edge 0-1,
     # rows in [y1, y2) by the long edge and the lower edge 1-2.
     # Trapezoids are numbered upper ones first, then lower ones.
-    r = np.ceil(ys - 0.5)
-    np.clip(r, 0, H, out=r)
+    r = y - 0.5
+    np.ceil(r, out=r)
+    np.maximum(r, 0, out=r)
+    np.minimum(r, H, out=r)
     r = r.astype(np.int64)
-    det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
-    visible = (det != 0.0) & (xs.max(axis=1) > 0.5 - 1e-9) & (xs.min(axis=1) < W - 0.5 + 1e-9)
-    rows = np.diff(r, axis=1)  # (m, 2): rows of the upper and the lower trapezoid
-    rows *= visible[:, None]
-    nrows = rows.T.reshape(-1)
-    total = int(nrows.sum())
+    dx, dy, dw = x[1:] - x[0], y[1:] - y[0], w[1:] - w[0]  # vertices 1, 2 minus vertex 0
+    det = dx[0] * dy[1]
+    det -= dx[1] * dy[0]
+    visible = det != 0.0
+    visible &= np.maximum(np.maximum(x0, x[1]), x[2]) > 0.5 - 1e-9
+    visible &= np.minimum(np.minimum(x0, x[1]), x[2]) < W - 0.5 + 1e-9
+    rows = r[1:] - r[:2]  # (2, m): rows of the upper and the lower trapezoid
+    rows *= visible
+    nrows = rows.reshape(-1)
+    total = int(np.add.reduce(nrows))
     if total == 0:
         return None
 
-    # An edge's crossing with row centre cy is x = xtop + (cy - ytop) * s,
-    # from the edge's top vertex: the same numbers, in the same order, for
-    # every triangle sharing the edge.
+    # A table of per-trapezoid values, one row per quantity (see _TABLE);
+    # a triangle's two trapezoids share the long edge, the plane, the depth
+    # range and the tag.  An edge's crossing with row centre cy is
+    # x = xtop + (cy - ytop) * slope, from the edge's top vertex: the same
+    # numbers, in the same order, for every triangle sharing the edge.
+    table = np.empty((13, 2, m))
+    upper = table[:, 0]
+    table[0] = x0
+    table[1] = x[:2]
+    table[2] = y0
+    table[3] = y[:2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        s_long = (x2 - x0) / (y2 - y0)
-        s_short = np.diff(xs, axis=1) / np.diff(ys, axis=1)
+        np.divide(dx[1], dy[1], out=upper[4])
+        np.subtract(x[1:], x[:2], out=table[5])
+        table[5] /= y[1:] - y[:2]
         # 1/z is affine in screen space: 1/z = wc + gx x + gy y.
-        gx = ((w1 - w0) * (y2 - y0) - (w2 - w0) * (y1 - y0)) / det
-        gy = ((x1 - x0) * (w2 - w0) - (x2 - x0) * (w1 - w0)) / det
-        wc = w0 - gx * x0 - gy * y0
-    wmin, wmax = w.min(axis=1), w.max(axis=1)
-    if not front.all():
-        scale = np.where(front if src is None else front[src], 1.0, 1.0 - _BACK_BIAS)
-        wc, gx, gy, wmin, wmax = wc * scale, gx * scale, gy * scale, wmin * scale, wmax * scale
-    tag = first_index + (np.arange(m) if src is None else src)
+        gx, gy, wc = upper[6], upper[8], upper[7]
+        np.multiply(dw[0], dy[1], out=gx)
+        gx -= dw[1] * dy[0]
+        gx /= det
+        np.multiply(dx[0], dw[1], out=gy)
+        gy -= dx[1] * dw[0]
+        gy /= det
+        np.multiply(gx, x0, out=wc)
+        np.subtract(w0, wc, out=wc)
+        wc -= gy * y0
+    np.minimum(np.minimum(w0, w[1]), w[2], out=upper[9])
+    np.maximum(np.maximum(w0, w[1]), w[2], out=upper[10])
+    faces = front if src is None else front.take(src)
+    if not np.logical_and.reduce(faces):
+        upper[6:11] *= np.where(faces, 1.0, 1.0 - _BACK_BIAS)
+    table[[4, 6, 7, 8, 9, 10], 1] = upper[[4, 6, 7, 8, 9, 10]]
+    table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
+    table = table.reshape(13, 2 * m)
+    first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
 
-    # A table of per-trapezoid values, one row per quantity: the long edge,
-    # the plane and the depth range (shared by a triangle's two
-    # trapezoids), the short edge, and (row 11, filled below) the first
-    # row's centre minus the number of rows before it.
-    table = np.empty((12, 2, m))
-    table[:8] = np.stack([x0, y0, s_long, gx, wc, gy, wmin, wmax])[:, None]
-    table[8] = xs[:, :2].T
-    table[9] = ys[:, :2].T
-    table[10] = s_short.T
-    table = table.reshape(12, 2 * m)
-    tags = np.concatenate([tag, tag])
-    first_row = r[:, :2].T.reshape(-1)
     bounds = [0, total]
     if band_rows is not None and band_rows < H:
         # Cut trapezoids at band boundaries, and order the pieces by band.
-        live = np.flatnonzero(nrows)
-        top_band = first_row[live] // band_rows
-        pieces = (first_row[live] + nrows[live] - 1) // band_rows - top_band + 1
-        trap = np.repeat(live, pieces)
-        band = np.repeat(top_band - (np.cumsum(pieces) - pieces), pieces) + np.arange(len(trap))
-        order = np.argsort(band, kind="stable")
-        trap, band = trap[order], band[order]
-        start = np.maximum(first_row[trap], band * band_rows)
-        nrows = np.minimum(first_row[trap] + nrows[trap], (band + 1) * band_rows) - start
+        live = nrows.nonzero()[0]
+        top_band = first_row.take(live) // band_rows
+        pieces = (first_row.take(live) + nrows.take(live) - 1) // band_rows - top_band + 1
+        trap = live.repeat(pieces)
+        band = (top_band - (pieces.cumsum() - pieces)).repeat(pieces)
+        band += _aranges(len(trap))[0][: len(trap)]
+        order = band.argsort(kind="stable")
+        trap, band = trap.take(order), band.take(order)
+        start = np.maximum(first_row.take(trap), band * band_rows)
+        nrows = np.minimum(first_row.take(trap) + nrows.take(trap), (band + 1) * band_rows) - start
         first_row = start
-        table, tags = table[:, trap], tags[trap]
-        ends = np.cumsum(nrows)
-        bounds = [0] + ends[np.flatnonzero(np.diff(band))].tolist() + [total]
+        table = table.take(trap, axis=1)
+        ends = nrows.cumsum()
+        bounds = [0] + ends.take((band[1:] != band[:-1]).nonzero()[0]).tolist() + [total]
     else:
-        ends = np.cumsum(nrows)
-    table[11] = first_row - (ends - nrows) + 0.5
+        ends = nrows.cumsum()
+    # Row 12: the trapezoid's first row centre minus the number of spans before it.
+    first_row -= ends
+    first_row += nrows
+    np.add(first_row, 0.5, out=table[12])
 
     # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
     # spreads per-trapezoid values over them: it costs a few instructions
     # per element where a gather (np.take, fancy indexing) costs 15-30.
-    t = np.repeat(table, nrows, axis=1)
-    cy = _aranges(total)[1][:total] + t[11]
-    xa = t[0] + (cy - t[1]) * t[2]
-    xb = t[8] + (cy - t[9]) * t[10]
-    c0 = np.minimum(np.maximum(np.ceil(np.minimum(xa, xb) - 0.5), 0), W)
-    c1 = np.minimum(np.maximum(np.ceil(np.maximum(xa, xb) - 0.5), 0), W)
-    count = (c1 - c0).astype(np.int64)
-    if not (count > 0).any():
+    t = table.repeat(nrows, axis=1)
+    cy = np.add(_aranges(total)[1][:total], t[12])
+    # Crossings of the long and the short edge (rows 0 and 1 of xab), then
+    # the first and one past the last pixel column (rows 0 and 1 of cols).
+    xab = np.subtract(cy, t[2:4])
+    xab *= t[4:6]
+    xab += t[0:2]
+    cols = np.empty((2, total))
+    np.minimum(xab[0], xab[1], out=cols[0])
+    np.maximum(xab[0], xab[1], out=cols[1])
+    cols -= 0.5
+    np.ceil(cols, out=cols)
+    np.maximum(cols, 0, out=cols)
+    np.minimum(cols, W, out=cols)
+    length = cols[1] - cols[0]
+    count = length.astype(np.int64)
+    if np.maximum.reduce(count) <= 0:
         return None
 
     # 1/z at the first and last pixel centre, clamped to the triangle's range
     # so that a sliver's ill-conditioned plane cannot produce a wild depth.
     # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
-    wrow = t[4] + cy * t[5]
-    wstart = np.fmin(np.fmax(wrow + (c0 + 0.5) * t[3], t[6]), t[7])
-    wend = np.fmin(np.fmax(wrow + (c1 - 0.5) * t[3], t[6]), t[7])
-    step = (wend - wstart) / np.maximum(count - 1, 1)
+    wrow = cy * t[8]
+    wrow += t[7]
+    ws = cols + _CENTRES
+    ws *= t[6]
+    ws += wrow
+    np.fmax(ws, t[9], out=ws)
+    np.fmin(ws, t[10], out=ws)
+    step = ws[1] - ws[0]
+    length -= 1
+    step /= np.maximum(length, 1, out=length)  # (as floats: exact, and no int-to-float pass)
     # Spans of no pixels stay: np.repeat skips them at no cost.
-    offset = ((cy - 0.5) * W + c0).astype(np.int64)
-    return offset, wstart, step, np.repeat(tags, nrows), count, bounds
+    cy -= 0.5
+    cy *= W
+    cy += cols[0]
+    return cy.astype(np.int64), ws[0], step, t[11].astype(np.int64), count, bounds
+
+
+# Rows of _spans' table: 0-1 x of the top of the long and the short edge,
+# 2-3 their y, 4-5 their slopes dx/dy, 6-8 gx, wc, gy of the plane
+# 1/z = wc + gx x + gy y, 9-10 the least and greatest 1/z, 11 the tag,
+# 12 first row centre minus the number of spans before.
+_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
+
+# From the first and one-past-last pixel column to the first and last centre.
+_CENTRES = np.array([[0.5], [-0.5]])
 
 
 def _clip_near(cam, src, near: float):

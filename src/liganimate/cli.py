@@ -3,8 +3,9 @@
 Every user error is printed as a diagnostic (``file:line:col``, the line, a
 caret, a sentence, a hint) and the command exits with status 1; no Python
 traceback reaches the user, and nothing is written when a program is wrong.
-Output options (``-o``, ``--gif``, ``--mp4``, ``--poses``, ``--fps``) are
-checked before the program is compiled.  SIGINT and SIGTERM stop a command
+Output options (``-o``, ``--gif``, ``--mp4``, ``--poses``, ``--fps``,
+``--aa``, ``--crf``, ``--preset``, ``--scheduler``) are checked before the
+program is compiled.  SIGINT and SIGTERM stop a command
 cleanly (exit status 130 and 143), leaving only whole files.
 """
 
@@ -50,10 +51,27 @@ def load_program(path: str):
 
 
 def _add_render_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("-o", "--out", metavar="DIR", help="folder for the frames (default: <stem>_frames)")
+    p.add_argument(
+        "-o",
+        "--out",
+        metavar="DIR",
+        help="folder for the PNG frames (default: <stem>_frames, or none when --gif or --mp4 is given)",
+    )
     p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="image size (default 640x480)")
-    p.add_argument("--gif", metavar="FILE", help="also write an animated GIF")
-    p.add_argument("--mp4", metavar="FILE", help="also write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)")
+    p.add_argument("--gif", metavar="FILE", help="write an animated GIF")
+    p.add_argument("--mp4", metavar="FILE", help="write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)")
+    p.add_argument(
+        "--crf",
+        default=None,
+        metavar="N",
+        help="MP4 quality, 0 (lossless) to 51 (default 20); lower is better and larger",
+    )
+    p.add_argument(
+        "--preset",
+        default=None,
+        metavar="NAME",
+        help="MP4 encoding speed, ultrafast to veryslow (default superfast); slower makes smaller files",
+    )
     p.add_argument("--poses", metavar="FILE", help="write the pose record (JSON Lines, see docs/poses.md)")
     p.add_argument("--fps", default="24", help="frame rate of the GIF and MP4, 0.01 to 1000 (default 24)")
     p.add_argument(
@@ -69,24 +87,27 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
 
 
 def _check_render_options(args, stem: str) -> str:
-    """Refuse output options that cannot be honoured, before compiling; return the frames folder.
+    """Refuse output options that cannot be honoured, before compiling; return the frames folder (or None).
 
     Nothing is written here: the folder and lock files are made when
     rendering starts.  An output another run is writing is refused now too.
     """
     from liganimate.runtime.errors import RenderError
     from liganimate.runtime.render.frames import check_aa
-    from liganimate.runtime.render.imagefiles import find_ffmpeg
     from liganimate.runtime.render.outputs import (
         CLI_NAMES,
         check_fps,
         check_outputs,
         refuse_if_locked,
     )
+    from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, check_crf, check_preset, find_ffmpeg
 
-    out = args.out if args.out is not None else f"{stem}_frames"
+    # A movie alone writes no PNG frames; -o adds them.
+    out = args.out if args.out is not None or args.gif or args.mp4 else f"{stem}_frames"
     args.fps = check_fps(args.fps, "--fps")
     args.aa = check_aa(args.aa, "--aa")
+    args.crf = check_crf(args.crf if args.crf is not None else DEFAULT_CRF, "--crf")
+    args.preset = check_preset(args.preset if args.preset is not None else DEFAULT_PRESET, "--preset")
     if args.scheduler is None:
         args.scheduler = os.environ.get("LIGANIMATE_SCHEDULER") or None
     if args.scheduler is not None and not args.scheduler.strip():
@@ -139,13 +160,14 @@ def _render(program, warnings, args, out: str) -> int:
     warnings_run = _checked(program, args.quiet)
     _print_diagnostics(warnings_run)
     options = dict(size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps, quiet=args.quiet)
-    if args.aa != 1:
-        options["aa"] = args.aa
+    options.update(aa=args.aa, crf=args.crf, preset=args.preset)
     if args.scheduler is not None:
         options["executor"] = _dask_executor(args.scheduler)
     program.render(out, checked=True, **options)
     if not args.quiet:
-        sys.stderr.write(f"frames written to {out}\n")
+        written = [f"frames written to {out}"] if out is not None else []
+        written += [f"{what} written to {path}" for what, path in (("GIF", args.gif), ("MP4", args.mp4)) if path]
+        sys.stderr.write("; ".join(written) + "\n")
     return 0
 
 
@@ -171,7 +193,7 @@ def _guarded(fn):
     from liganimate.lang.diagnostics import LigDiagnostics
     from liganimate.lang.display import escape_text
     from liganimate.runtime.errors import LigError
-    from liganimate.runtime.render.imagefiles import os_error_words
+    from liganimate.runtime.files import os_error_words
 
     try:
         return fn()
@@ -261,7 +283,7 @@ def cmd_check(args) -> int:
 def cmd_compile(args) -> int:
     def go():
         from liganimate.compiler import compile_file
-        from liganimate.runtime.render.imagefiles import AtomicWriter
+        from liganimate.runtime.files import AtomicWriter
 
         compiled = compile_file(args.file)
         _print_diagnostics(compiled.warnings)
@@ -278,7 +300,7 @@ def cmd_archive(args) -> int:
         from liganimate.compiler import compile_source
         from liganimate.compiler.archive import archive_text
         from liganimate.lang.source import prepare
-        from liganimate.runtime.render.imagefiles import AtomicWriter
+        from liganimate.runtime.files import AtomicWriter
 
         out = args.output or os.path.splitext(os.path.basename(args.file))[0] + "_lib.lig"
         text = archive_text(args.file, out)

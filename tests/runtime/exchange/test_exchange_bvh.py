@@ -124,13 +124,10 @@ def test_round_trip_of_a_rerooted_travelling_figure_keeps_every_joint_in_place(t
         expected = np.array(
             [seg[j.id][:3, :3] @ (j.loc2 / fig.links[j.secondary].scale) + seg[j.id][:3, 3] for j in fig.joints]
         )
-        # The imported figure: each BVH joint's segment has its origin at the joint, plus the root path.
+        # The imported figure: each BVH joint's segment has its origin at the joint; ANIMATE
+        # carries the figure along the ROOT track, so the path is in the poses already.
         got = np.array(
-            [
-                np.array(s["matrix"]).reshape(4, 4)[:3, 3] + path[t]
-                for s in rb["segments"]
-                if s["joint"] not in (None, 1)
-            ]
+            [np.array(s["matrix"]).reshape(4, 4)[:3, 3] for s in rb["segments"] if s["joint"] not in (None, 1)]
         )
         assert len(got) == len(expected)
         # Each original joint is met by its own imported joint (some of the humanoid's joints coincide,
@@ -138,9 +135,11 @@ def test_round_trip_of_a_rerooted_travelling_figure_keeps_every_joint_in_place(t
         d = np.linalg.norm(expected[:, None, :] - got[None, :, :], axis=2)
         rows, cols = linear_sum_assignment(d)
         assert d[rows, cols].max() <= 1e-6 * 1.78, (t, d[rows, cols].max())
-        # The root (the main link R_FOOT) is where the placement puts it.
-        root = np.array(rb["segments"][1]["matrix"]).reshape(4, 4)[:3, 3] + path[t]
+        # The root (the main link R_FOOT) is where the placement puts it, the imported ROOT track's value.
+        root = np.array(rb["segments"][1]["matrix"]).reshape(4, 4)[:3, 3]
         np.testing.assert_allclose(root, seg[33][:3, 3], atol=1e-6)
+        np.testing.assert_allclose(root, path[t], atol=1e-6)
+    assert np.linalg.norm(path[-1] - path[0]) > 0.3  # the figure travels: the test sees the path
 
 
 # -- a file written by another implementation ----------------------------------------
@@ -254,14 +253,16 @@ def test_import_of_a_bvhio_file_puts_every_joint_where_the_capture_has_it(tmp_pa
     frames = expected.shape[0]
     records = pose_records(load_program(_player(tmp_path, lib, "CAPTURE_FIGURE", "CAPTURE", frames))[0], tmp_path)
     assert len(records) == frames
-    path = X.read_root_path(lib)
+    assert "ROOT PATH" not in Path(lib).read_text()  # the path is a ROOT track, not a comment table
     size = np.ptp(expected[0], axis=0).max()
     worst = 0.0
     for t, rec in enumerate(records):
+        # ANIMATE follows the imported ROOT track: the poses hold the travelling root, nothing added.
         by_joint = {s["joint"]: np.array(s["matrix"]).reshape(4, 4) for s in rec["segments"]}
-        got = np.array([by_joint[j + 1][:3, 3] for j in range(len(names))]) + path[t]
+        got = np.array([by_joint[j + 1][:3, 3] for j in range(len(names))])
         worst = max(worst, np.abs(got - expected[t]).max())
     assert worst <= 1e-6 * size, worst
+    assert np.linalg.norm(expected[-1, 0] - expected[0, 0]) > 0.2 * size  # the capture's root does travel
 
 
 def test_import_converts_other_orders_through_matrices(tmp_path):
@@ -332,7 +333,7 @@ def test_an_imported_motion_is_an_ordinary_motion(tmp_path):
       LEGS = STRIP M, 2, 3
       INITIALIZE SCENE 1
       STARTSCENE LENGTH 60
-        ANIMATE W FROM 0 TO 59 USING (SYNCHRONIZE LEGS, (STRIP BOTH, 7)) REPEAT
+        ANIMATE W FROM 0 TO 59 USING (SYNCHRONIZE LEGS, (STRIP M, 7)) + BOTH REPEAT
       ENDSCENE
       SHOOTSCENES
 """,

@@ -67,14 +67,12 @@ EDGES = """\
 
 WALKING_HUMANOID = """\
       LOAD HUMANOID, WALK FROM 'humanoid'
-      VECTOR P
       INITIALIZE SCENE 1
         VIEW POINT = (0.0, 1.0, 5.0)
-        P = (-1.0, 0.972, 0.0)
       STARTSCENE LENGTH 30
         ANIMATE HUMANOID FROM 0 TO 29 USING WALK REPEAT
-        HUMANOID :- HUMANOID <TRANS (P)>
-        P = P + (0.05, 0.0, 0.0)
+C       WALK's ROOT track carries the body forward; the scene places its start.
+        HUMANOID :- HUMANOID <TRANS (-1.0, 0.972, 0.0)>
       ENDSCENE
       SHOOTSCENES
 """

@@ -597,3 +597,98 @@ def test_a_one_link_figure_can_only_translate_and_no_goals_is_nothing_to_do():
     assert still.status == "stalled" and still.residuals[0] == pytest.approx(np.sqrt(14))
     idle = solve_pose(chain(2), [], start=np.full((2, 3), 10.0))
     assert idle.converged and np.all(idle.angles == 10.0)
+
+
+# ------------------------------------------------------------------ the solver registry
+
+
+def test_the_solver_registry_is_the_one_table_of_names_words_and_limits():
+    from liganimate.runtime.ik import solvers as S
+    from liganimate.runtime.ik.reach import DEFAULT_MAX_ITERATIONS
+
+    assert S.SOLVER_NAMES == tuple(SOLVERS)
+    assert dict(S.SOLVER_KEYWORDS) == {"DLS": "dls", "TRANSPOSE": "transpose", "CCD": "ccd"}
+    assert DEFAULT_MAX_ITERATIONS == {name: spec.max_iterations for name, spec in S.SOLVERS.items()}
+    assert DEFAULT_MAX_ITERATIONS == {"dls": 200, "transpose": 5000, "ccd": 500}
+    assert not S.SOLVERS["ccd"].jacobian and S.SOLVERS["dls"].jacobian
+    assert S.DEFAULT_SOLVER == "dls" and S.DEFAULT_SOLVER in S.SOLVERS
+    with pytest.raises(TypeError):
+        S.SOLVERS["newton"] = S.SOLVERS["dls"]  # read-only: one table, not a copy per reader
+
+
+def test_the_solver_names_load_without_the_figure_code():
+    """The compiler imports the registry for the solver names; that must not load the kinematics."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS; "
+        "print(sorted(m for m in sys.modules if m.startswith('liganimate.runtime.') and 'ik.solvers' not in m))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "['liganimate.runtime.ik']"
+
+
+def test_the_stopping_rules_say_the_same_for_one_solve_and_for_a_batch():
+    """The rules both DLS loops call (solvers._step_status, _progress, _damping, ...) give, on one
+    solve's Python scalars, what they give element by element on a batch's arrays."""
+    from liganimate.runtime.ik import solvers as S
+
+    rng = np.random.default_rng(11)
+    n = 1500
+    status = rng.choice([S.RUNNING, S.CONVERGED, S.STALLED], size=n, p=[0.8, 0.1, 0.1])
+    k = rng.integers(1, 40, size=n)
+    f = rng.choice([1e-12, 1e-3, 0.5], size=n) * rng.uniform(0.5, 1.5, size=n)
+    window_f = f * rng.choice([1.0, 1 + 1e-7, 2.0], size=n)
+    fast_f = f * rng.choice([1.5, 3.0], size=n)
+    may = rng.uniform(size=n) < 0.5
+    conv = rng.uniform(size=n) < 0.2
+    accept = rng.uniform(size=n) < 0.7
+    gain = f * rng.choice([1e-10, 1e-3, 0.5], size=n)
+    step = rng.choice([1e-12, 1e-3], size=n)
+    size = rng.uniform(0.1, 3.0, size=n)
+    mu = rng.choice([1e-3, 1e20], size=n)
+    curv = rng.choice([0.0, 1.0, 30.0], size=n)
+    nu = rng.choice([2.0, 8.0], size=n)
+    rho = rng.uniform(-0.5, 1.5, size=n)
+    spent = S._damping_spent(np.where, mu, curv)
+    batched = (
+        S._step_status(np.where, conv, accept, gain, f, step, size, spent),
+        *S._progress(np.where, status, k, f, window_f, fast_f, 30, may, 1e-6),
+        *S._damping(np.where, mu, nu, accept, rho),
+        *S._first_damping(np.where, status, curv)[:2],
+    )
+    for i in range(n):
+        one = (
+            S._step_status(
+                S._pick,
+                bool(conv[i]),
+                bool(accept[i]),
+                float(gain[i]),
+                float(f[i]),
+                float(step[i]),
+                float(size[i]),
+                S._damping_spent(S._pick, float(mu[i]), float(curv[i])),
+            ),
+            *S._progress(
+                S._pick,
+                int(status[i]),
+                int(k[i]),
+                float(f[i]),
+                float(window_f[i]),
+                float(fast_f[i]),
+                30,
+                bool(may[i]),
+                1e-6,
+            ),
+            *S._damping(S._pick, float(mu[i]), float(nu[i]), bool(accept[i]), float(rho[i])),
+            *S._first_damping(S._pick, int(status[i]), float(curv[i]))[:2],
+        )
+        many = tuple(np.asarray(b)[i] if np.ndim(b) else b for b in batched)
+        # Statuses and flags exactly; the damping up to rounding (a scalar's
+        # ** 3 and an array's round differently in the last bit).
+        assert one[:5] == many[:5] and one[7] == many[7], i
+        np.testing.assert_allclose(one[5:7] + one[8:], many[5:7] + many[8:], rtol=1e-15, atol=0)
+    # Every outcome is exercised.
+    assert {S.CONVERGED, S.STALLED, S.RUNNING} <= set(batched[0]) and S.LIMIT in set(batched[1])
+    assert batched[4].any()  # some attempts given up

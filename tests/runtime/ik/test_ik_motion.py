@@ -160,3 +160,39 @@ def test_unmet_goals_become_one_sentence_each():
     assert lines[1].startswith("goal 3: the axis of THIGH stays") and lines[1].endswith("degrees from its direction.")
     assert len(lines) == 2
     assert residual_warnings(fig, [GOAL], solve_pose(fig, [GOAL])) == []
+
+
+def test_reach_returns_unmet_goals_as_data_with_the_warnings_own_text():
+    from liganimate.runtime.ik.reach import AxisGoal, PlaneGoal, UnmetGoal, residual_warnings
+
+    fig = body()
+    goals = [
+        PointGoal("HAND", (3.0, -3.0, 0.0), point=(0, -0.2, 0)),
+        PlaneGoal("FORE", (0, 0, 0), (0, 1, 0), weight=0),
+        AxisGoal("THIGH", (0, -1, 0), (0, 1, 0)),
+    ]
+    r = reach(fig, goals, 12)
+    assert [u.index for u in r.unmet] == [0, 2]
+    assert [u.distance for u in r.unmet] == [r.residuals[0], r.residuals[2]]
+    assert r.unmet[0].sentence == f"the point of HAND stays {r.residuals[0]:.4g} from its target."
+    assert r.unmet[1].sentence.startswith("the axis of THIGH stays")
+    # The sentences users see are these, prefixed by the goal's number.
+    assert [str(u) for u in r.unmet] == residual_warnings(fig, goals, r.solution)
+    assert str(r.unmet[1]) == "goal 3: " + r.unmet[1].sentence
+    assert r.limit_warning is None  # stalled, not stopped by the limit
+    with pytest.raises(AttributeError):
+        r.unmet[0].index = 1  # frozen: data, not a message to edit
+    assert isinstance(r.unmet[0], UnmetGoal)
+    assert reach(fig, [GOAL], 12).unmet == ()
+
+
+def test_a_solve_cut_short_by_its_iteration_limit_says_so_beside_its_unmet_goals():
+    from liganimate.runtime.ik.reach import residual_warnings
+
+    fig = body()
+    r = reach(fig, [GOAL], 12, max_iterations=1)
+    assert r.solution.status == "limit" and len(r.unmet) == 1
+    assert r.limit_warning == "the solver stopped at its iteration limit (1) before settling."
+    assert residual_warnings(fig, [GOAL], r.solution) == [str(r.unmet[0]), r.limit_warning]
+    batch = reach_keyframes(fig, [PointGoal("HAND", np.stack([TARGET, TARGET]), point=(0, -0.2, 0))], [5, 10])
+    assert batch.unmet is None and batch.limit_warning is None  # a batch reports through solution.met

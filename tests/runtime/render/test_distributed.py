@@ -2,12 +2,11 @@
 
 The cluster is a :class:`distributed.LocalCluster` of two worker processes
 (one thread each), started once for the module: its workers are real
-processes that can be killed, on this machine, so they share its folders.
+processes, which can be killed.
 """
 
 from __future__ import annotations
 
-import contextlib
 import os
 import pathlib
 import signal
@@ -26,7 +25,7 @@ from test_render import PROGRAM  # noqa: E402
 from liganimate.compiler import load_program  # noqa: E402
 from liganimate.runtime.errors import RenderError  # noqa: E402
 from liganimate.runtime.render import distributed as dask_render  # noqa: E402
-from liganimate.runtime.render.distributed import MARKER, DaskExecutor  # noqa: E402
+from liganimate.runtime.render.distributed import DaskExecutor  # noqa: E402
 
 TICKS = 40
 SIZE = (96, 72)
@@ -73,48 +72,51 @@ def liganimate(*args, cwd, env=None):
 
 def test_frames_drawn_on_the_cluster_are_the_bytes_of_a_local_run(cluster, local_frames, tmp_path):
     out = tmp_path / "frames"
-    render(tmp_path, out, executor=DaskExecutor(cluster, folder=out))
+    render(tmp_path, out, executor=DaskExecutor(cluster))
     assert files(out) == local_frames  # also: no marker, lock or temporary file left behind
 
 
 def test_the_command_renders_on_the_scheduler_given_by_option_or_environment(cluster, local_frames, tmp_path):
+    # Relative output names, and the workers' current folder is not this one: they write nothing themselves.
     program = swing(tmp_path)
     size = f"{SIZE[0]}x{SIZE[1]}"
+    address = cluster.scheduler_address
     by_option = liganimate(
-        "run",
-        str(program),
-        "-o",
-        str(tmp_path / "a"),
-        "--size",
-        size,
-        "--quiet",
-        "--scheduler",
-        cluster.scheduler_address,
-        cwd=tmp_path,
+        "run", program.name, "-o", "a", "--size", size, "--quiet", "--scheduler", address, cwd=tmp_path
     )
     assert by_option.returncode == 0, by_option.stderr
-    env = dict(os.environ, LIGANIMATE_SCHEDULER=cluster.scheduler_address)
-    by_env = liganimate(
-        "run", str(program), "-o", str(tmp_path / "b"), "--size", size, "--quiet", cwd=tmp_path, env=env
-    )
+    env = dict(os.environ, LIGANIMATE_SCHEDULER=address)
+    by_env = liganimate("run", program.name, "-o", "b", "--size", size, "--quiet", cwd=tmp_path, env=env)
     assert by_env.returncode == 0, by_env.stderr
     assert files(tmp_path / "a") == local_frames
     assert files(tmp_path / "b") == local_frames
 
 
+def test_gif_and_mp4_made_on_the_cluster_are_the_bytes_of_a_local_run(cluster, tmp_path):
+    pytest.importorskip("imageio_ffmpeg")  # the MP4's ffmpeg comes with the test extra
+    movies = {}
+    for where, options in (("local", {}), ("dask", {"executor": DaskExecutor(cluster)})):
+        gif, mp4 = tmp_path / f"{where}.gif", tmp_path / f"{where}.mp4"
+        program, _ = load_program(str(swing(tmp_path)))
+        program.render(None, size=SIZE, quiet=True, gif=str(gif), mp4=str(mp4), **options)
+        movies[where] = (gif.read_bytes(), mp4.read_bytes())
+    assert movies["dask"] == movies["local"]
+    assert movies["local"][0][:6] == b"GIF89a" and b"ftyp" in movies["local"][1][:16]
+
+
 def _hook(flag: str):
-    """A task that, the first time any worker runs it, writes half its images and waits to be killed.
+    """A task that, the first time any worker runs it, draws half its images and waits to be killed.
 
     Made inside a function so that it is pickled by value: the workers
     need not import this test module.
     """
 
-    def hook(fn, size, chunk, *rest):
+    def hook(fn, size, draws_list, *rest):
         try:
             fd = os.open(flag, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
         except FileExistsError:
-            return fn(size, chunk, *rest)
-        fn(size, chunk[: len(chunk) // 2], *rest)
+            return fn(size, draws_list, *rest)
+        fn(size, draws_list[: len(draws_list) // 2], *rest)
         os.write(fd, f"{os.getpid()}\n".encode())
         os.close(fd)
         time.sleep(60)  # the test kills this process meanwhile
@@ -154,48 +156,13 @@ def test_a_worker_killed_mid_task_is_survived_and_every_frame_is_whole(cluster, 
     watcher.start()
     out = tmp_path / "frames"
     started = time.monotonic()
-    render(tmp_path, out, executor=HookedExecutor(cluster, folder=out, hook=_hook(str(flag))))
+    render(tmp_path, out, executor=HookedExecutor(cluster, hook=_hook(str(flag))))
     watcher.join(5)
     assert killed, "no task reached the hook"
     assert time.monotonic() - started < 60  # the killed task was retried, not waited out
     with pytest.raises(ProcessLookupError):
         os.kill(killed[0], 0)
-    assert files(out) == local_frames  # complete, whole, and no temporary file of the dead task left
-
-
-def test_a_worker_that_does_not_see_the_output_folder_stops_the_render_with_a_message(cluster, tmp_path):
-    class Unshared(DaskExecutor):
-        def _write_marks(self):
-            # As if the workers wrote to a folder of their own at the same path: the marker is not in it.
-            marks = super()._write_marks()
-            for folder, name, _token in marks:
-                with contextlib.suppress(FileNotFoundError):
-                    os.unlink(os.path.join(folder, name))
-            return marks
-
-    out = tmp_path / "frames"
-    with pytest.raises(RenderError) as err:
-        render(tmp_path, out, executor=Unshared(cluster, folder=out, retries=0))
-    assert f"does not see the output folder {out}" in err.value.message
-    assert list(out.rglob("*.png")) == []
-
-
-def test_the_worker_check_finds_the_marker_and_refuses_a_folder_without_it(tmp_path):
-    (tmp_path / f"{MARKER}.abc").write_text("abc")
-    dask_render._check_folder(str(tmp_path), f"{MARKER}.abc", "abc")
-    with pytest.raises(RenderError, match="does not see the output folder"):
-        dask_render._check_folder(str(tmp_path), f"{MARKER}.abc", "another run")
-    with pytest.raises(RenderError, match="does not see the output folder"):
-        dask_render._check_folder(str(tmp_path / "elsewhere"), f"{MARKER}.abc", "abc")
-
-
-def test_markers_of_a_killed_run_are_removed_and_this_run_removes_its_own(cluster, tmp_path):
-    (tmp_path / f"{MARKER}.0123456789abcdef").write_text("stale")
-    ex = DaskExecutor(cluster, folder=tmp_path)
-    assert ex.submit(abs, -3).result() == 3
-    assert [p.name for p in tmp_path.iterdir()] == [f"{MARKER}.{ex._token}"]
-    ex.shutdown()
-    assert list(tmp_path.iterdir()) == []
+    assert files(out) == local_frames  # complete, in order, whole
 
 
 def _free_port() -> int:
@@ -245,7 +212,7 @@ def test_shutdown_drops_tasks_not_started_and_waits_for_those_running(cluster, t
     ex = DaskExecutor(cluster)
     task = _slow_writer(str(tmp_path))
     futures = [ex.submit(task, i) for i in range(12)]
-    time.sleep(0.1)  # the scheduler hands the first tasks to the workers
+    _wait_for(lambda: dask_render._processing(ex.client))  # the scheduler has handed the first tasks out
     ex.shutdown(wait=True, cancel_futures=True)
     ran = sorted(p.name for p in tmp_path.iterdir())
     assert 0 < len(ran) < 12
@@ -277,6 +244,133 @@ def test_a_worker_process_sets_up_its_allocator_once_before_its_first_task(monke
     calls = []
     monkeypatch.setattr(dask_render, "_keep_freed_memory", lambda: calls.append(os.getpid()))
     monkeypatch.setattr(dask_render, "_TUNED", [])
-    assert dask_render._call(abs, (), -2) == 2
-    assert dask_render._call(abs, (), -3) == 3
+    assert dask_render._call(abs, -2) == 2
+    assert dask_render._call(abs, -3) == 3
     assert calls == [os.getpid()]
+
+
+class _Answers:
+    """A client whose workers answer ``run`` with the given results (what a real cluster returns)."""
+
+    def __init__(self, answers):
+        self.answers = answers
+
+    def run(self, fn, on_error):
+        assert on_error == "return"
+        return self.answers
+
+
+def test_workers_without_liganimate_or_with_other_versions_are_refused_before_any_task():
+    mine = dask_render._environment()
+    dask_render._check_workers(_Answers({"tcp://w1:1": mine, "tcp://w2:1": [list(p) for p in mine]}))
+    missing = Exception("ModuleNotFoundError(\"No module named 'liganimate'\")")
+    with pytest.raises(RenderError, match=r"^the Dask worker at tcp://w2:1 cannot import liganimate"):
+        dask_render._check_workers(_Answers({"tcp://w1:1": mine, "tcp://w2:1": missing}))
+    older = tuple((name, "0.0.1") if name == "numpy" else (name, v) for name, v in mine)
+    with pytest.raises(RenderError, match=r"^the Dask worker at tcp://w1:1 has numpy 0\.0\.1, this machine "):
+        dask_render._check_workers(_Answers({"tcp://w1:1": older}))
+
+
+# Loaded by the workers' Python at start-up (sitecustomize on PYTHONPATH): liganimate is not installed there.
+_NO_LIGANIMATE = """\
+import sys
+
+
+class _Hide:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] == "liganimate":
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+        return None
+
+
+sys.meta_path.insert(0, _Hide())
+"""
+
+
+def test_a_cluster_whose_workers_lack_liganimate_is_refused_in_words(tmp_path, monkeypatch):
+    (tmp_path / "sitecustomize.py").write_text(_NO_LIGANIMATE)
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))  # read by the worker processes when they start
+    with distributed.LocalCluster(
+        n_workers=1, processes=True, threads_per_worker=1, dashboard_address=":0", silence_logs=50
+    ) as bare:
+        with pytest.raises(RenderError) as err:
+            DaskExecutor(bare)
+    assert err.value.message.endswith("cannot import liganimate; install the same liganimate on every worker")
+
+
+def _wait_for(predicate, seconds: float = 60.0):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError("timed out")
+
+
+def test_a_scheduler_lost_mid_render_is_one_sentence_and_the_frames_before_are_whole(tmp_path, capfd):
+    # A scheduler of its own, in a process that can be killed (a LocalCluster's lives in this one).
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    dask = [sys.executable, "-m", "dask"]
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    scheduler = subprocess.Popen([*dask, "scheduler", "--port", str(port), "--dashboard-address", ":0"], **quiet)
+    worker = None
+    try:
+        _wait_for(lambda: _listening(port))
+        worker = subprocess.Popen([*dask, "worker", address, "--nworkers", "1", "--nthreads", "1"], **quiet)
+        flag = tmp_path / "drawing"
+
+        def kill_scheduler():
+            _wait_for(flag.exists, 120)
+            scheduler.kill()
+
+        killer = threading.Thread(target=kill_scheduler, daemon=True)
+        killer.start()
+        out = tmp_path / "frames"
+        program, _ = load_program(str(swing(tmp_path, ticks=400)))
+        executor = HookedExecutor(address, hook=_mark_then_draw(str(flag)), worker_wait=60)
+        capfd.readouterr()
+        with pytest.raises(RenderError) as err:
+            program.render(str(out), size=SIZE, quiet=True, executor=executor)
+        killer.join(5)
+    finally:
+        scheduler.kill()
+        if worker is not None:
+            worker.kill()
+            worker.wait(30)
+        scheduler.wait(30)
+    assert err.value.message.startswith(f"the connection to the Dask scheduler at {address} was lost while drawing")
+    assert "Traceback" not in capfd.readouterr().err  # Dask's reconnection attempts are not printed
+    names = sorted(p.name for p in (out / "scene1").iterdir())
+    assert names == [f"{i:05d}.png" for i in range(len(names))] and len(names) < 400  # whole, no gaps
+
+
+def _listening(port: int) -> bool:
+    with socket.socket() as s:
+        return s.connect_ex(("127.0.0.1", port)) == 0
+
+
+def _mark_then_draw(flag: str):
+    """A task that says drawing has begun, then draws slowly enough for the render to be cut off midway."""
+
+    def hook(fn, *args):
+        time.sleep(0.05)
+        with open(flag, "a") as f:
+            f.write("x")
+        return fn(*args)
+
+    return hook
+
+
+def test_dask_logging_is_silenced_while_the_executor_is_open_and_restored_after(cluster):
+    import logging
+
+    client_log = logging.getLogger("distributed.client")
+    before = client_log.level
+    ex = DaskExecutor(cluster)
+    assert not client_log.isEnabledFor(logging.CRITICAL)
+    ex.shutdown()
+    assert client_log.level == before
+    DaskExecutor(cluster, silence_logs=False).shutdown()
+    assert client_log.level == before

@@ -96,7 +96,26 @@ def test_aa_reaches_the_rasterizer(monkeypatch):
     part = (np.zeros((1, 3, 3)), np.zeros(1, np.uint8), np.zeros(1, bool))
     frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 3)
     frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 1)
-    assert seen == [{"aa": 3}, {}]
+    assert seen == [{"aa": 3}, {"aa": 1}]
+
+
+def test_run_with_aa_smooths_the_edges(tmp_path):
+    src = program(tmp_path, 2)
+    for aa in ("1", "3"):
+        r = subprocess.run(
+            [sys.executable, "-m", "liganimate", "run", str(src), "-o", f"aa{aa}", "--size", "64x48", "--aa", aa],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+        )
+        assert r.returncode == 0, r.stderr
+    from liganimate.runtime.render.imagefiles import read_png
+
+    plain = read_png(tmp_path / "aa1" / "scene1" / "00000.png")
+    smooth = read_png(tmp_path / "aa3" / "scene1" / "00000.png")
+    # Edge pixels take levels between the surfaces' own: more distinct levels, same picture overall.
+    assert len(set(smooth.ravel().tolist())) > len(set(plain.ravel().tolist())) + 3
+    assert abs(smooth.astype(int) - plain).mean() < 8
 
 
 def run_env(tmp_path, *args, env):

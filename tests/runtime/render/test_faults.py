@@ -124,13 +124,13 @@ def test_the_library_refuses_the_same_options_by_their_keyword_names(tmp_path):
 # in the command's own process, then runs the command.
 _ENOSPC_POSES = """
 import errno, os, sys
-from liganimate.runtime.render import imagefiles
+from liganimate.runtime import files
 real = os.write
 def write(fd, data):
     if ".poses.jsonl." in os.readlink(f"/proc/self/fd/{fd}"):
         raise OSError(errno.ENOSPC, "No space left on device")
     return real(fd, data)
-imagefiles.os.write = write
+files.os.write = write
 from liganimate.cli import main
 sys.exit(main(sys.argv[1:]))
 """
@@ -289,7 +289,7 @@ def test_locks_exclude_within_one_process_and_are_released(tmp_path):
 
 
 def test_errno_words_keep_unknown_errors_readable():
-    from liganimate.runtime.render.imagefiles import os_error_words
+    from liganimate.runtime.files import os_error_words
 
     assert os_error_words(OSError(errno.ENOSPC, "No space left on device")) == "no space left on device"
     assert os_error_words(OSError(errno.ENXIO, "No such device or address")) == "no such device or address"

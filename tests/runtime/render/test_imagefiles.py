@@ -1,4 +1,4 @@
-"""PNG, GIF and MP4 writers: round trips, determinism, atomicity, errors."""
+"""PNG, GIF and MP4 writers (imagefiles, video) and atomic files (runtime/files.py): round trips, determinism, atomicity, errors."""
 
 from __future__ import annotations
 
@@ -12,9 +12,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from liganimate.runtime import files
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.render import imagefiles
-from liganimate.runtime.render.imagefiles import encode_png, read_png, write_gif, write_mp4, write_png
+from liganimate.runtime.render import video
+from liganimate.runtime.render.imagefiles import encode_png, read_png, write_png
+from liganimate.runtime.render.video import write_gif, write_mp4
 
 
 def frames(n, shape=(48, 64), seed=0):
@@ -82,7 +84,7 @@ def test_png_write_is_atomic(tmp_path, monkeypatch):
     def fail(fd):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(imagefiles.os, "fsync", fail)
+    monkeypatch.setattr(files.os, "fsync", fail)
     with pytest.raises(RenderError, match=f"^no space left on device while writing {path}$"):
         write_png(path, np.full((4, 4), 255, np.uint8))
     assert path.read_bytes() == old  # the old file is intact
@@ -96,7 +98,12 @@ def test_png_write_is_atomic(tmp_path, monkeypatch):
 
 
 def test_png_rejects_bad_images(tmp_path):
-    for bad in [np.zeros((4, 4), np.float64), np.zeros((4, 4, 3), np.uint8), np.zeros((0, 4), np.uint8)]:
+    for bad in [
+        np.zeros((4, 4), np.float64),
+        np.zeros((4, 4, 2), np.uint8),
+        np.zeros((4, 4, 4), np.uint8),
+        np.zeros((0, 4), np.uint8),
+    ]:
         with pytest.raises(RenderError):
             write_png(tmp_path / "x.png", bad)
     assert os.listdir(tmp_path) == []
@@ -172,7 +179,7 @@ needs_ffmpeg = pytest.mark.skipif(
 
 
 def decode_mp4(path, shape):
-    exe = imagefiles.find_ffmpeg()
+    exe = video.find_ffmpeg()
     out = subprocess.run(
         [exe, "-loglevel", "error", "-i", str(path), "-f", "rawvideo", "-pix_fmt", "gray", "pipe:1"],
         capture_output=True,
@@ -216,7 +223,7 @@ def test_mp4_without_ffmpeg_says_how_to_get_it(tmp_path, monkeypatch):
         raise RuntimeError("no ffmpeg")
 
     monkeypatch.setattr(imageio_ffmpeg, "get_ffmpeg_exe", missing)
-    monkeypatch.setattr(imagefiles.shutil, "which", lambda name: None)
+    monkeypatch.setattr(video.shutil, "which", lambda name: None)
     with pytest.raises(RenderError) as err:
         write_mp4(tmp_path / "a.mp4", frames(2), fps=10)
     assert "ffmpeg" in err.value.message
@@ -225,7 +232,7 @@ def test_mp4_without_ffmpeg_says_how_to_get_it(tmp_path, monkeypatch):
 
 
 def test_mp4_ffmpeg_failure_is_a_render_error(tmp_path, monkeypatch):
-    monkeypatch.setattr(imagefiles, "find_ffmpeg", lambda: "false")  # exits 1 at once
+    monkeypatch.setattr(video, "find_ffmpeg", lambda: "false")  # exits 1 at once
     path = tmp_path / "a.mp4"
     path.write_bytes(b"old")
     with pytest.raises(RenderError, match="ffmpeg"):
@@ -239,8 +246,8 @@ def test_mp4_ffmpeg_failure_is_a_render_error(tmp_path, monkeypatch):
 
 
 def _failing_at(monkeypatch, name, when=1, err=errno.ENOSPC):
-    """Make imagefiles' os.<name> raise OSError(err) on its ``when``-th call (1-based) from now on."""
-    real = getattr(imagefiles.os, name)
+    """Make os.<name> (as runtime/files.py calls it) raise OSError(err) on its ``when``-th call (1-based) from now on."""
+    real = getattr(files.os, name)
     calls = []
 
     def fake(*args, **kw):
@@ -249,7 +256,7 @@ def _failing_at(monkeypatch, name, when=1, err=errno.ENOSPC):
             raise OSError(err, os.strerror(err))
         return real(*args, **kw)
 
-    monkeypatch.setattr(imagefiles.os, name, fake)
+    monkeypatch.setattr(files.os, name, fake)
     return calls
 
 
@@ -258,7 +265,7 @@ def test_atomic_writer_cleans_up_whatever_step_fails(tmp_path, monkeypatch, step
     path = tmp_path / "poses.jsonl"
     path.write_bytes(b"old")
     calls = _failing_at(monkeypatch, step)
-    with pytest.raises(RenderError) as info, imagefiles.AtomicWriter(path, buffer=4) as f:
+    with pytest.raises(RenderError) as info, files.AtomicWriter(path, buffer=4) as f:
         f.write(b"0123456789" * 100)
     assert calls, f"os.{step} was never called"
     assert info.value.message == f"no space left on device while writing {path}"
@@ -279,9 +286,9 @@ def test_atomic_writer_unlinks_before_closing(tmp_path, monkeypatch):
         real_close(fd)
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    writer = imagefiles.AtomicWriter(tmp_path / "a.gif")
+    writer = files.AtomicWriter(tmp_path / "a.gif")
     writer.write(b"x" * 10)
-    monkeypatch.setattr(imagefiles.os, "close", close)
+    monkeypatch.setattr(files.os, "close", close)
     writer.abort()
     writer.abort()  # idempotent
     assert seen == [[]]
@@ -292,8 +299,8 @@ def test_atomic_writer_interrupted_leaves_nothing(tmp_path, monkeypatch):
     def interrupt(fd, data):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(imagefiles.os, "write", interrupt)
-    with pytest.raises(KeyboardInterrupt), imagefiles.AtomicWriter(tmp_path / "a.png") as f:
+    monkeypatch.setattr(files.os, "write", interrupt)
+    with pytest.raises(KeyboardInterrupt), files.AtomicWriter(tmp_path / "a.png") as f:
         f.write(b"data")
     assert os.listdir(tmp_path) == []
 
@@ -328,7 +335,7 @@ import numpy as np
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
 resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.render.imagefiles import write_gif
+from liganimate.runtime.render.video import write_gif
 rng = np.random.default_rng(0)
 try:
     write_gif({str(tmp_path / "big.gif")!r}, (rng.integers(0, 256, (64, 64), dtype=np.uint8) for _ in range(40)), 10)

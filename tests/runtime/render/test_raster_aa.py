@@ -164,3 +164,20 @@ def test_bad_colours(shade):
     tris, _ = soup(9, 2)
     with pytest.raises(RenderError):
         rasterize(tris, shade, CAM)
+
+
+def test_rgb_in_bands_and_chunks(monkeypatch):
+    from liganimate.runtime.render import raster
+
+    tris, shade = soup(10, 120)
+    want = [rasterize(tris, shade[:, k], CAM, background=bg, aa=2) for k, bg in enumerate((3, 4, 5))]
+    monkeypatch.setattr(raster, "_ONE_BAND_PIXELS", 0)
+    monkeypatch.setattr(raster, "_BAND_PIXELS", 500)
+    monkeypatch.setattr(raster, "_CHUNK", 200)
+    img = rasterize(tris, shade, CAM, background=(3, 4, 5), aa=2)
+    for k in range(3):
+        np.testing.assert_array_equal(img[:, :, k], want[k])
+    fb = Framebuffer(CAM.size, background=(3, 4, 5), aa=2)
+    fb.draw(tris[:60], shade[:60], CAM)
+    fb.draw(tris[60:], shade[60:], CAM)
+    np.testing.assert_array_equal(fb.image, img)

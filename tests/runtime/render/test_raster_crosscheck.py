@@ -73,6 +73,7 @@ def test_narrow_bands_change_nothing(monkeypatch, band_pixels):
     cam = camera(rng, (120, 90))
     want = ref.rasterize(tris, shade, cam)
     monkeypatch.setattr(raster, "_BAND_PIXELS", band_pixels)
+    monkeypatch.setattr(raster, "_ONE_BAND_PIXELS", 0)
     np.testing.assert_array_equal(raster.rasterize(tris, shade, cam), want)
     fb = raster.Framebuffer(cam.size)
     for part in np.array_split(np.arange(len(tris)), 3):
@@ -88,6 +89,7 @@ def test_deep_overlap_in_chunks(monkeypatch):
     want = ref.rasterize(tris, shade, cam)
     monkeypatch.setattr(raster, "_CHUNK", 500)
     monkeypatch.setattr(raster, "_BAND_PIXELS", 4000)
+    monkeypatch.setattr(raster, "_ONE_BAND_PIXELS", 0)
     np.testing.assert_array_equal(raster.rasterize(tris, shade, cam), want)
 
 

@@ -23,7 +23,7 @@ from PIL import Image
 
 from liganimate.cli import load_program
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.render import imagefiles
+from liganimate.runtime.render import imagefiles, video
 from liganimate.runtime.render.imagefiles import read_png
 from liganimate.runtime.values import _solid_orientation, polygons_to_graphical
 
@@ -83,7 +83,7 @@ def pngs(folder: pathlib.Path) -> list:
 
 def have_ffmpeg() -> bool:
     try:
-        imagefiles.find_ffmpeg()
+        video.find_ffmpeg()
         return True
     except RenderError:
         return False
@@ -134,7 +134,7 @@ def test_run_writes_gif_and_mp4(tmp_path):
             np.testing.assert_array_equal(np.asarray(gif.convert("L")), frame)  # 256 greys: exact
     raw = subprocess.run(
         [
-            imagefiles.find_ffmpeg(),
+            video.find_ffmpeg(),
             "-loglevel",
             "error",
             "-i",

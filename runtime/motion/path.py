@@ -1,0 +1,266 @@
+"""Root paths: the optional track of a motion that carries the figure along.
+
+A root path is a track (see :mod:`liganimate.runtime.motion.track`) whose
+three values are a displacement of the model's current main link, in the
+model's own frame, not angles.  Its algebra differs from a joint's in one
+way: a path *continues*.  ``a + b`` plays ``b``'s displacement from where
+``a`` ended, ``n * a`` walks on copy after copy, and reversal walks back
+from where it starts.  Two lazy nodes do it without copying keyframes:
+:class:`Shift` (a track moved by a constant) and :class:`Drift` (``n``
+copies, each moved by the displacement of the ones before).  The laws are
+written out in ``docs/semantics-motion.md``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import track as tr
+
+__all__ = ["Drift", "Shift", "concat", "repeat", "reverse", "shift"]
+
+
+class Shift(tr.Track):
+    """A track moved by a constant displacement.
+
+    Parameters
+    ----------
+    inner : Track
+    d : array_like, shape (3,)
+    """
+
+    __slots__ = ("d", "inner")
+
+    def __init__(self, inner: tr.Track, d):
+        self.inner = inner
+        self.d = tr._frozen(d).reshape(3)
+        self.end = inner.end
+        self.start_value = inner.start_value + self.d
+        self.end_value = inner.end_value + self.d
+        self.min_keys = inner.min_keys
+
+    def children(self):
+        return (self.inner,)
+
+    def sample(self, t):
+        x, v, a = self.inner.sample(t)
+        return tr.Samples(x + self.d, v, a)
+
+    def sample_x(self, t):
+        return self.inner.sample_x(t) + self.d
+
+    def _reversed(self, length, memo):
+        return Shift(tr.reverse(self.inner, length, memo), self.d)
+
+    def _scaled_frames(self, r, memo):
+        return Shift(tr.scale_frames(self.inner, r, memo), self.d)
+
+    def _mapped(self, m, memo):  # pragma: no cover - angle maps never reach a root path
+        raise TypeError("a root path has no angles to map")
+
+    def _emit(self, out, offset):
+        saved = out.shift
+        out.shift = saved + self.d
+        self.inner._emit(out, offset)
+        out.shift = saved
+
+    def _edge_leaf(self, side):
+        return tr.edge_leaf(self.inner, side)
+
+    def _with_edge(self, side, edge):
+        return Shift(tr.with_edge(self.inner, side, edge), self.d)
+
+
+def shift(track: tr.Track, d) -> tr.Track:
+    """``track`` moved by ``d`` (shape (3,)); shifts of shifts fold into one node.
+
+    Parameters
+    ----------
+    track : Track
+    d : array_like, shape (3,)
+
+    Returns
+    -------
+    Track
+    """
+    d = np.asarray(d, dtype=float).reshape(3)
+    if not d.any():
+        return track
+    if isinstance(track, Shift):
+        return Shift(track.inner, track.d + d)
+    if isinstance(track, tr.Const):
+        return tr.Const(track.value + d, track.end)
+    return Shift(track, d)
+
+
+class Drift(tr.Track):
+    """``n`` copies of a path, one every ``period`` frames, copy ``k`` moved by ``k * step``.
+
+    Parameters
+    ----------
+    inner : Track
+        ``inner.end <= period``.
+    n : int
+        >= 2.
+    period : float
+        > 0.
+    step : array_like, shape (3,)
+        The displacement of one copy (its end value less its start value).
+    end : float, optional
+        Defaults to ``(n - 1) * period + inner.end``.
+    """
+
+    __slots__ = ("rep", "step")
+
+    def __init__(self, inner: tr.Track, n: int, period: float, step, end: float | None = None):
+        # The plain repeat settles which copy shows at each time; this node adds the drift.
+        self.rep = tr.Repeat(inner, n, period, True, end)
+        self.step = tr._frozen(step).reshape(3)
+        self.end = self.rep.end
+        self.start_value = inner.start_value
+        self.end_value = inner.end_value + (self.rep.n - 1) * self.step
+        self.min_keys = self.rep.min_keys
+
+    @property
+    def inner(self) -> tr.Track:
+        """The repeated path."""
+        return self.rep.inner
+
+    def children(self):
+        return (self.rep.inner,)
+
+    def _copies(self, t):
+        local = self.rep._local(t)
+        k = np.rint((t - local) / self.rep.period)
+        return local, k[:, None] * self.step
+
+    def sample(self, t):
+        local, d = self._copies(t)
+        x, v, a = self.rep.inner.sample(local)
+        return tr.Samples(x + d, v, a)
+
+    def sample_x(self, t):
+        local, d = self._copies(t)
+        return self.rep.inner.sample_x(local) + d
+
+    def _reversed(self, length, memo):
+        # As Repeat's: the last copy (holding what follows) first, then n-1 mirrored periods
+        # walking back, each one step behind the previous.
+        n, P, inner = self.rep.n, self.rep.period, self.rep.inner
+        split = P + (length - n * P)
+        first = shift(tr.reverse(inner, split, memo), (n - 1) * self.step)
+        one = tr.reverse(inner, P, memo)
+        rest = (
+            shift(one, (n - 2) * self.step) if n == 2 else Drift(shift(one, (n - 2) * self.step), n - 1, P, -self.step)
+        )
+        return tr.concat(first, rest, split, end=length)
+
+    def _scaled_frames(self, r, memo):
+        return Drift(tr.scale_frames(self.rep.inner, r, memo), self.rep.n, self.rep.period * r, self.step, self.end * r)
+
+    def _mapped(self, m, memo):  # pragma: no cover - angle maps never reach a root path
+        raise TypeError("a root path has no angles to map")
+
+    def _emit(self, out, offset):
+        P, inner = self.rep.period, self.rep.inner
+        saved = out.shift
+        for k in range(self.rep.n):
+            out.shift = saved + k * self.step
+            if k:
+                out.junction(offset + k * P, inner.start_value, False)
+            inner._emit(out, offset + k * P)
+        out.shift = saved
+
+
+def _join(first: tr.Track, second: tr.Track, pivot: float) -> tuple[tr.Track, tr.Track]:
+    """Share the velocity across a junction: a path always meets itself, so only the ends must be leaves."""
+    if first.end != pivot:
+        return first, second
+    a, b = tr.edge_leaf(first, "right"), tr.edge_leaf(second, "left")
+    if a is None or b is None:
+        return first, second
+    ea, eb = a._prepare().last, b._prepare().first
+    if ea is None or eb is None or not tr._changes(ea, eb):
+        return first, second
+    return tr.with_edge(first, "right", eb), tr.with_edge(second, "left", ea)
+
+
+def concat(a: tr.Track | None, la: float, b: tr.Track | None, lb: float) -> tr.Track | None:
+    """The root path of ``a + b``, for motions of lengths ``la`` and ``lb``.
+
+    Parameters
+    ----------
+    a, b : Track or None
+        The operands' paths; None for a motion without one, which stands
+        still (at the other's end or start, as a joint it does not drive).
+    la, lb : float
+
+    Returns
+    -------
+    Track or None
+        ``a`` until ``la``, then ``b`` moved so that it starts where ``a``
+        ended; None if neither operand has a path.
+    """
+    if b is None:
+        return None if a is None else tr.pad(a, la + lb)
+    if a is None:
+        return b if la == 0 else tr.concat(tr.Const(b.start_value), b, la)
+    moved = shift(b, a.end_value - b.start_value)
+    first, second = _join(a, moved, la)
+    return tr.concat(first, second, la)
+
+
+def repeat(a: tr.Track, n: int, period: float) -> tr.Track:
+    """The root path of ``n * m`` (``n >= 2``), ``period`` being ``m``'s length.
+
+    Parameters
+    ----------
+    a : Track
+    n : int
+    period : float
+        > 0.
+
+    Returns
+    -------
+    Track
+        Copy ``k`` shows ``a`` moved by ``k * (a.end_value - a.start_value)``;
+        where ``a`` lasts the whole period the copies share their velocity at
+        each junction, as a cycle's joints do.
+    """
+    step = a.end_value - a.start_value
+    end = n * period if a.end == period else None
+    plain = Drift(a, n, period, step, end)
+    if a.end != period:
+        return plain
+    last, first = tr.edge_leaf(a, "right"), tr.edge_leaf(a, "left")
+    if last is None or first is None:
+        return plain
+    last_seg, first_seg = last._prepare().last, first._prepare().first
+    if last_seg is None or first_seg is None or not tr._changes(last_seg, first_seg):
+        return plain
+    head = tr.with_edge(a, "right", first_seg)
+    tail = shift(tr.with_edge(a, "left", last_seg), (n - 1) * step)
+    if n == 2:
+        return tr.concat(head, tail, period, end=plain.end)
+    middle = tr.with_edge(head, "left", last_seg)
+    mids = shift(middle if n == 3 else Drift(middle, n - 2, period, step), step)
+    return tr.concat(tr.concat(head, mids, period), tail, (n - 1) * period, end=plain.end)
+
+
+def reverse(a: tr.Track, length: float, memo: dict | None = None) -> tr.Track:
+    """The path played backwards over ``length`` frames: ``a'(t) = a(length - t) - a(length) + a(0)``.
+
+    Parameters
+    ----------
+    a : Track
+    length : float
+        >= ``a.end``.
+    memo : dict, optional
+        Shared with :func:`liganimate.runtime.motion.track.reverse`.
+
+    Returns
+    -------
+    Track
+        Starts where ``a`` starts and walks back: a reversed walk walks backwards.
+    """
+    return shift(tr.reverse(a, length, memo), a.start_value - a.end_value)
