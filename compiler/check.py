@@ -729,9 +729,14 @@ class Checker(NodeVisitor):
         if self.primitive is None:
             self.err(s, "DRAW belongs in a PRIMITIVE")
         for m in s.modifiers:
-            if m.kind != DRAW_WITH.kind:
-                self.err(m, f"DRAW WITH takes <{DRAW_WITH.label} l>")
-            self._want_number(m.arg, "a lightness")
+            spec = next((d for d in DRAW_WITH if d.kind == m.kind), None)
+            if spec is None:
+                self.err(m, f"DRAW WITH takes {' or '.join(f'<{d.label} ...>' for d in DRAW_WITH)}")
+                self.expr(m.arg)
+                continue
+            got = self.expr(m.arg)
+            if got is not None and got not in spec.accepts:
+                self.err(m.arg, f"{spec.label} needs {spec.accepts_noun}, not {T.NOUN[got]}")
 
     def _s_DrawPoly(self, s, context):
         if self.primitive is None:

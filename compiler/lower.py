@@ -478,7 +478,8 @@ class Lowerer(NodeVisitor):
 
     def s_DrawWith(self, s, where):
         for m in s.modifiers:
-            self.emit(f"_g.lightness({self.expr(m.arg)})")
+            # The canvas has one setter per DRAW WITH modifier, named by its kind.
+            self.emit(f"_g.{m.kind}({self.expr(m.arg)})")
 
     def s_DrawPoly(self, s, where):
         pts = "".join(self.expr(p) + ", " for p in s.points)

@@ -151,7 +151,7 @@ class Neg(Node):
 class Modifier(Node):
     """One entry of a ``< ... >`` list."""
 
-    kind: str  # trans_joints trans rot scale_model scale_extremes scale_frames scale lightness
+    kind: str  # a key of lang.vocabulary.MODIFIERS
     arg: Node
     axis: str | None = None
 

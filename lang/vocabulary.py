@@ -89,11 +89,12 @@ MODIFIERS = {
         Modifier("scale_frames", "SCALE FRAMES", (MOTION,), _NUMBER, "a number", nonzero=True),
         Modifier("scale", "SCALE", (GRAPHICAL, MODEL), _NUMBER + (VECTOR,), "a number or a vector", nonzero=True),
         Modifier("lightness", "LIGHTNESS", (GRAPHICAL,), _NUMBER, "a number"),
+        Modifier("colour", "COLOUR", (GRAPHICAL,), (VECTOR,), "a colour (r, g, b), each 0 to 100"),
     )
 }
 
-#: The one modifier DRAW WITH takes inside a PRIMITIVE.
-DRAW_WITH = MODIFIERS["lightness"]
+#: The modifiers DRAW WITH takes inside a PRIMITIVE: they set what the next polygons are drawn with.
+DRAW_WITH = (MODIFIERS["lightness"], MODIFIERS["colour"])
 
 
 # ----------------------------------------------------- built-in functions

@@ -314,6 +314,10 @@ class Runtime(Arithmetic):
         """``g <LIGHTNESS l>``."""
         return g.with_lightness(lightness)
 
+    def graphical_colour(self, g: Graphical, colour, at) -> Graphical:
+        """``g <COLOUR (r, g, b)>`` (an extension): the colour its LIGHTNESS lights."""
+        return g.with_colour(colour)
+
     def _transform(self, g: Graphical, matrix, at) -> Graphical:
         g = self._guard(at, g.transformed, matrix)
         self._guard(at, limits.check_graphical, g, "the transformed object")

@@ -168,6 +168,12 @@ def colour_levels(lightness, colour) -> np.ndarray:
     return grey_levels(l * c / 100.0)
 
 
+def rgb_levels(shade) -> np.ndarray:
+    """Shades as RGB levels, shape (N, 3): grey levels (N,) become three equal channels."""
+    shade = np.asarray(shade, dtype=np.uint8)
+    return np.repeat(shade[:, None], 3, axis=1) if shade.ndim == 1 else shade
+
+
 def joined_shades(shades) -> np.ndarray:
     """Concatenate per-triangle shades, grey (N,) and RGB (N, 3) alike.
 
@@ -177,7 +183,7 @@ def joined_shades(shades) -> np.ndarray:
     shades = list(shades)
     if all(s.ndim == 1 for s in shades):
         return np.concatenate(shades) if shades else np.zeros(0, dtype=np.uint8)
-    return np.concatenate([np.repeat(s[:, None], 3, axis=1) if s.ndim == 1 else s for s in shades])
+    return np.concatenate([rgb_levels(s) for s in shades])
 
 
 MAX_TRIANGLES = 10_000_000

@@ -42,10 +42,16 @@ def _selected(images: list) -> list:
 
 
 def _diff_image(expected: np.ndarray, actual: np.ndarray, path: pathlib.Path) -> None:
+    # Both (H, W, 3): expected, actual, and actual dimmed with the differing pixels in red.
     path.parent.mkdir(parents=True, exist_ok=True)
-    rgb = np.stack([actual] * 3, axis=-1).astype(np.uint8) // 2 + 64
-    rgb[expected != actual] = (255, 0, 0)
-    Image.fromarray(np.concatenate([np.stack([expected] * 3, -1), np.stack([actual] * 3, -1), rgb], axis=1)).save(path)
+    rgb = actual // 2 + 64
+    rgb[(expected != actual).any(axis=-1)] = (255, 0, 0)
+    Image.fromarray(np.concatenate([expected, actual, rgb], axis=1)).save(path)
+
+
+def _mode(path: pathlib.Path) -> str:
+    with Image.open(path) as im:
+        return im.mode
 
 
 @pytest.mark.parametrize("path", example_files(), ids=lambda p: p.stem)
@@ -70,10 +76,14 @@ def test_example_matches_golden_frames(path, tmp_path, regen_golden):
     assert stored, f"no golden images for {path.name}; run with --regen-golden and look at them"
     assert [str(p) for p in stored] == [str(p) for p in chosen], "the set of images changed"
     for rel in stored:
-        expected = read_png(golden_dir / rel)
-        actual = read_png(out / rel)
+        # A grey frame stays grey and a colour frame stays in colour; pixels are compared in RGB.
+        assert _mode(out / rel) == _mode(golden_dir / rel), (
+            f"{path.stem}/{rel}: the image changed between grey and colour"
+        )
+        expected = read_png(golden_dir / rel, colour=True)
+        actual = read_png(out / rel, colour=True)
         assert expected.shape == actual.shape
-        differing = np.count_nonzero(expected != actual) / expected.size
+        differing = np.count_nonzero((expected != actual).any(axis=-1)) / (expected.shape[0] * expected.shape[1])
         if differing > GOLDEN_TOLERANCE:
             diff = FAILURES / path.stem / rel
             _diff_image(expected, actual, diff)

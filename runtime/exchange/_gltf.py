@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure.pose import static_triangles
 from liganimate.runtime.render.camera import Camera
-from liganimate.runtime.values import Graphical, grey_levels
+from liganimate.runtime.values import Graphical, rgb_levels
 
 from ._rotations import (
     continuous_quaternions,
@@ -126,15 +126,18 @@ class _Builder:
         return hit
 
     # -- looks ----------------------------------------------------------------
-    def _material(self, grey: int, double: bool) -> int:
-        key = (grey, double)
+    def _material(self, rgb: int, double: bool) -> int:
+        # rgb packs the three 8-bit levels as r << 16 | g << 8 | b.
+        key = (rgb, double)
         hit = self.materials.get(key)
         if hit is None:
-            c = float(_linear_from_grey(grey))
+            levels = [(rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255]
+            r, g, b = (float(c) for c in _linear_from_grey(np.array(levels)))
+            look = f"grey {levels[0]}" if len(set(levels)) == 1 else "colour {} {} {}".format(*levels)
             m = G.Material(
-                name=f"grey {grey}" + (" two-sided" if double else ""),
+                name=look + (" two-sided" if double else ""),
                 pbrMetallicRoughness=G.PbrMetallicRoughness(
-                    baseColorFactor=[c, c, c, 1.0], metallicFactor=0.0, roughnessFactor=1.0
+                    baseColorFactor=[r, g, b, 1.0], metallicFactor=0.0, roughnessFactor=1.0
                 ),
                 doubleSided=double,
                 extensions={"KHR_materials_unlit": {}},
@@ -143,14 +146,19 @@ class _Builder:
             hit = self.materials[key] = len(self.doc.materials) - 1
         return hit
 
-    def _mesh(self, key, name, triangles, grey, closed):
-        """A mesh of flat triangles, one primitive per material; None when there are none."""
+    def _mesh(self, key, name, triangles, shade, closed):
+        """A mesh of flat triangles, one primitive per material; None when there are none.
+
+        ``shade`` is per triangle: grey levels (M,) or RGB levels (M, 3).
+        """
         if key is not None and key in self.meshes:
             return self.meshes[key]
         index = None
         if len(triangles):
             prims = []
-            mat = np.asarray(grey, dtype=np.int64) * 2 + (~np.asarray(closed, dtype=bool))
+            rgb = rgb_levels(shade).astype(np.int64)
+            packed = rgb[:, 0] << 16 | rgb[:, 1] << 8 | rgb[:, 2]
+            mat = packed * 2 + (~np.asarray(closed, dtype=bool))
             for m in np.unique(mat):
                 tris = np.asarray(triangles)[mat == m].reshape(-1, 3)
                 acc = self._accessor(tris, G.VEC3, 0, True)
@@ -169,7 +177,7 @@ class _Builder:
         g = link.shape
         if not isinstance(g, Graphical) or len(g) == 0:
             return None
-        return self._mesh(("link", id(g)), link.label, g.triangles, grey_levels(g.lightness), g.closed)
+        return self._mesh(("link", id(g)), link.label, g.triangles, g.shades(), g.closed)
 
     # -- nodes ----------------------------------------------------------------
     def _node(self, **kw) -> int:
@@ -294,12 +302,10 @@ class _Builder:
 
     def _background(self, take, n, obj, ticks, anim, all_ticks) -> int:
         if isinstance(obj, Graphical):
-            mesh = self._mesh(
-                ("link", id(obj)), f"background {n + 1}", obj.triangles, grey_levels(obj.lightness), obj.closed
-            )
+            mesh = self._mesh(("link", id(obj)), f"background {n + 1}", obj.triangles, obj.shades(), obj.closed)
         else:
-            tris, grey, closed = static_triangles(obj)
-            mesh = self._mesh(("figure", id(obj)), f"background {n + 1}", tris, grey, closed)
+            tris, shade, closed = static_triangles(obj)
+            mesh = self._mesh(("figure", id(obj)), f"background {n + 1}", tris, shade, closed)
         node = self._node(name=f"scene {take.id} background {n + 1}", mesh=mesh)
         if len(ticks) < len(all_ticks):
             scale = np.ones((len(ticks), 3))

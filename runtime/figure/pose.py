@@ -14,7 +14,7 @@ import numpy as np
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.motion.algebra import Motion
-from liganimate.runtime.values import Graphical, grey_levels
+from liganimate.runtime.values import Graphical, joined_shades
 
 # (id(motion), id(joints)) -> (motion, joints, bound); the stored objects keep
 # the ids valid. Bounded so a long program cannot grow it without limit.
@@ -92,12 +92,16 @@ class MeshTable:
     ----------
     triangles : ndarray, shape (M, 3, 3)
     link : ndarray of int, shape (M,)
-    grey : ndarray of uint8, shape (M,)
+    lightness : ndarray, shape (M,)
+    colour : ndarray, shape (M, 3), or None
+        None when no link's shape has a COLOUR.
+    shade : ndarray of uint8, shape (M,) or (M, 3)
+        What the rasterizer draws: grey levels, or RGB when any link has a colour.
     closed : ndarray of bool, shape (M,)
     """
 
     def __init__(self, fig: F.Figure):
-        tris, link, light, closed = [], [], [], []
+        tris, link, light, closed, shapes = [], [], [], [], []
         for i, l in enumerate(fig.links):
             g = l.shape
             if not isinstance(g, Graphical) or len(g) == 0:
@@ -111,17 +115,21 @@ class MeshTable:
             link.append(np.full(len(g), i))
             light.append(g.lightness)
             closed.append(c)
+            shapes.append(g)
+        self.colour = None
         if tris:
             self.triangles = np.concatenate(tris)
             self.link = np.concatenate(link)
             self.lightness = np.concatenate(light)
-            self.grey = grey_levels(self.lightness)
+            if any(g.colour is not None for g in shapes):
+                self.colour = np.concatenate([g.colours() for g in shapes])
+            self.shade = joined_shades(g.shades() for g in shapes)
             self.closed = np.concatenate(closed)
         else:
             self.triangles = np.zeros((0, 3, 3))
             self.link = np.zeros(0, dtype=int)
             self.lightness = np.zeros(0)
-            self.grey = np.zeros(0, dtype=np.uint8)
+            self.shade = np.zeros(0, dtype=np.uint8)
             self.closed = np.zeros(0, dtype=bool)
 
 
@@ -204,7 +212,7 @@ def static_triangles(fig: F.Figure):
 
     Returns
     -------
-    (triangles (M, 3, 3), grey (M,), closed (M,))
+    (triangles (M, 3, 3), shade (M,) or (M, 3), closed (M,))
     """
     J = fig.n_joints
     angles = K.clamp(fig, np.zeros((1, J, 3)))
@@ -212,7 +220,7 @@ def static_triangles(fig: F.Figure):
     table = mesh_table(fig)
     return (
         world_triangles(table, X)[0],
-        table.grey,
+        table.shade,
         table.closed & (np.linalg.det(np.asarray(fig.placement)[:3, :3]) > 0),
     )
 
@@ -242,4 +250,4 @@ def posed_graphical(fig: F.Figure, motion: Motion | None, frame: float) -> Graph
     X = world_transforms(fig, angles, rooted_placements(placement[None], motion, np.array([float(frame)])))
     table = mesh_table(fig)
     closed = table.closed & (np.linalg.det(placement[:3, :3]) > 0)
-    return Graphical(world_triangles(table, X)[0], table.lightness, closed)
+    return Graphical(world_triangles(table, X)[0], table.lightness, closed, table.colour)

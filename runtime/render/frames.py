@@ -56,7 +56,7 @@ from liganimate.runtime.render.imagefiles import encode_png, write_png, write_pn
 from liganimate.runtime.render.outputs import KEYWORD_NAMES, OutputLock, check_outputs
 from liganimate.runtime.render.raster import Framebuffer, rasterize
 from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, GifStream, Mp4Stream
-from liganimate.runtime.values import Graphical, grey_levels
+from liganimate.runtime.values import Graphical, joined_shades
 
 # Images whose poses are evaluated together.
 BATCH = 32
@@ -259,7 +259,7 @@ class Renderer:
         for item in state.background:
             if isinstance(item, Graphical):
                 if len(item):
-                    parts.append((item.triangles, grey_levels(item.lightness), item.closed))
+                    parts.append((item.triangles, item.shades(), item.closed))
             else:
                 parts.append(static_triangles(item))
         return (camera, parts)
@@ -291,7 +291,7 @@ class Renderer:
             mirrored = np.linalg.det(placements[:, :3, :3]) < 0
             for n, r in enumerate(reqs):
                 cull = table.closed if not mirrored[n] else np.zeros(len(table.closed), dtype=bool)
-                results[(r[0], r[1], r[2])] = (tris[n], table.grey, cull)
+                results[(r[0], r[1], r[2])] = (tris[n], table.shade, cull)
                 if self._poses_fh is not None:
                     results[(r[0], r[1], r[2], "pose")] = (angles[n], X[n], fig)
         for i, img in enumerate(self.pending):
@@ -652,12 +652,12 @@ def check_aa(aa, name: str = "--aa") -> int:
 
 
 def _joined(parts):
-    """One (triangles, grey, cull) from several."""
+    """One (triangles, shade, cull) from several; grey shades become RGB if any part is in colour."""
     if len(parts) == 1:
         return parts[0]
     return (
         np.concatenate([p[0] for p in parts]),
-        np.concatenate([p[1] for p in parts]),
+        joined_shades(p[1] for p in parts),
         np.concatenate([p[2] for p in parts]),
     )
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from liganimate import __version__
 from liganimate.runtime.figure.pose import mesh_table
+from liganimate.runtime.values import rgb_levels
 from liganimate.runtime.view import Blob, asset, fill, inline_code, json_for_script
 
 from ._generator import POPULATION
@@ -71,7 +72,7 @@ def studio_page(generator, title: str) -> str:
         "mesh": {
             "pos": blob.add(table.triangles.reshape(-1), np.float32),
             "link": blob.add(table.link, np.uint16 if fig.n_links < 65536 else np.uint32),
-            "grey": blob.add(table.grey, np.uint8),
+            "rgb": blob.add(rgb_levels(table.shade), np.uint8),
         },
         # Candidates reach further than the standing figure: room for them.
         "bounds": [float(c) for c in centre] + [radius * 2.0],

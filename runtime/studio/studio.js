@@ -12,7 +12,7 @@
   var bytes = LigGL.decodeBase64(el('lig-blob').textContent);
   var mesh = {
     local: LigGL.view(bytes, manifest.mesh.pos), link: LigGL.view(bytes, manifest.mesh.link),
-    grey: LigGL.view(bytes, manifest.mesh.grey)
+    rgb: LigGL.view(bytes, manifest.mesh.rgb)
   };
   var L = manifest.links.length, N = manifest.population;
   var cam = { eye: manifest.camera.eye.slice(), target: manifest.camera.target.slice(), k: manifest.camera.k };
@@ -49,11 +49,12 @@
     if (!mats) return;
     LigGL.transform(v.pos, 0, mesh.local, mesh.link, mats, v.index * L * 12);
     var col = v.col, o = 0, frozen = state.frozen;
-    for (var t = 0; t < mesh.grey.length; t++) {
-      var g = mesh.grey[t], l = mesh.link[t], tint = null;
+    for (var t = 0; t < mesh.link.length; t++) {
+      var l = mesh.link[t], tint = null;
+      var r = mesh.rgb[3 * t], gg = mesh.rgb[3 * t + 1], b = mesh.rgb[3 * t + 2];
       if (hover.view === v.index && hover.link === l) tint = HOVER;
       else if (manifest.jointOfLink[l] >= 0 && frozen[manifest.jointOfLink[l]]) tint = FROZEN;
-      var r = tint ? (g + tint[0]) >> 1 : g, gg = tint ? (g + tint[1]) >> 1 : g, b = tint ? (g + tint[2]) >> 1 : g;
+      if (tint) { r = (r + tint[0]) >> 1; gg = (gg + tint[1]) >> 1; b = (b + tint[2]) >> 1; }
       for (var k = 0; k < 3; k++) { col[o++] = r; col[o++] = gg; col[o++] = b; }
     }
     v.renderer.draw({ pos: v.pos, col: v.col, ranges: [{ first: 0, count: v.pos.length / 3, cam: cam }] },

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from liganimate.runtime.figure.pose import mesh_table, static_triangles, world_transforms
-from liganimate.runtime.values import Graphical, grey_levels
+from liganimate.runtime.values import Graphical, rgb_levels
 
 __all__ = ["Blob", "scene_manifest"]
 
@@ -114,7 +114,7 @@ def _model_entry(take, blob: Blob, extent: list) -> dict:
         "mesh": {
             "pos": blob.add(table.triangles.reshape(-1), np.float32),
             "link": blob.add(table.link, np.uint16 if L < 65536 else np.uint32),
-            "grey": blob.add(table.grey, np.uint8),
+            "rgb": blob.add(rgb_levels(table.shade), np.uint8),
         },
         "ticks": blob.add(take.ticks, np.int32),
         "matrices": blob.add(X[:, :, :3, :], np.float32),
@@ -126,15 +126,15 @@ def _background_entry(obj, ticks, blob: Blob, extent: list):
     if isinstance(obj, Graphical):
         if len(obj) == 0:
             return None
-        tris, grey = obj.triangles, grey_levels(obj.lightness)
+        tris, shade = obj.triangles, obj.shades()
     else:
-        tris, grey, _ = static_triangles(obj)
+        tris, shade, _ = static_triangles(obj)
         if len(tris) == 0:
             return None
     extent.append(np.asarray(tris).reshape(-1, 3))
     return {
         "pos": blob.add(np.asarray(tris).reshape(-1), np.float32),
-        "grey": blob.add(grey, np.uint8),
+        "rgb": blob.add(rgb_levels(shade), np.uint8),
         "ticks": blob.add(ticks, np.int32),
     }
 

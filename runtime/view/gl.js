@@ -1,7 +1,7 @@
 /* LIG GL: draws what the liganimate runtime computed, shaded like its rasterizer.
  *
- * Triangles come in segment coordinates with one grey level each (the
- * rasterizer's flat shading: LIGHTNESS 0..100 -> grey 0..255, no lighting);
+ * Triangles come in segment coordinates with one colour each (the
+ * rasterizer's flat shading: LIGHTNESS 0..100 -> 0..255, times COLOUR; no lighting);
  * segment matrices come from the runtime, one 3x4 row-major block per
  * segment.  This file only multiplies vertices by those matrices: it never
  * turns joint angles into transforms.
@@ -84,14 +84,15 @@ var LigGL = (function () {
     return o;
   }
 
-  /* Per-vertex colours: the grey of each triangle, or mixed with a tint where
+  /* Per-vertex colours: each triangle's colour (rgb holds three levels a
+   * triangle, grey ones as three equal levels), or mixed with a tint where
    * tintLink (a segment index, -1 for none) matches the triangle's segment. */
-  function colours(out, o, grey, link, tintLink, tint) {
-    var n = grey.length;
+  function colours(out, o, rgb, link, tintLink, tint) {
+    var n = rgb.length / 3;
     for (var t = 0; t < n; t++) {
-      var g = grey[t], r = g, gg = g, bb = g;
+      var r = rgb[3 * t], gg = rgb[3 * t + 1], bb = rgb[3 * t + 2];
       if (link !== null && link[t] === tintLink) {
-        r = (g + tint[0]) >> 1; gg = (g + tint[1]) >> 1; bb = (g + tint[2]) >> 1;
+        r = (r + tint[0]) >> 1; gg = (gg + tint[1]) >> 1; bb = (bb + tint[2]) >> 1;
       }
       for (var v = 0; v < 3; v++) { out[o++] = r; out[o++] = gg; out[o++] = bb; }
     }

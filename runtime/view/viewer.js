@@ -32,7 +32,7 @@
       for (var r = 0; r < ticks.length; r++) if (ticks[r] >= 0 && ticks[r] < s.length) rowOf[ticks[r]] = r;
       return {
         name: m.name, links: m.links, jointOfLink: m.jointOfLink, joints: m.joints,
-        local: V(m.mesh.pos), link: V(m.mesh.link), grey: V(m.mesh.grey),
+        local: V(m.mesh.pos), link: V(m.mesh.link), rgb: V(m.mesh.rgb),
         rowOf: rowOf, matrices: V(m.matrices), angles: V(m.angles), L: m.links.length, J: m.joints.length
       };
     });
@@ -40,14 +40,14 @@
       var shown = new Uint8Array(s.length);
       var t = V(b.ticks);
       for (var i = 0; i < t.length; i++) if (t[i] >= 0 && t[i] < s.length) shown[t[i]] = 1;
-      return { pos: V(b.pos), grey: V(b.grey), shown: shown };
+      return { pos: V(b.pos), rgb: V(b.rgb), shown: shown };
     });
     var k = Math.max(1, s.sameframe);
     var most = 0;
     for (var t = 0; t < s.length; t++) {
       var n = 0;
       models.forEach(function (m) { if (m.rowOf[t] >= 0) n += m.link.length; });
-      backgrounds.forEach(function (b) { if (b.shown[t]) n += b.grey.length; });
+      backgrounds.forEach(function (b) { if (b.shown[t]) n += b.rgb.length / 3; });
       most = Math.max(most, n);
     }
     return {
@@ -93,7 +93,7 @@
       if (!b.shown[tr[0]]) return;
       var first = o / 3;
       pos.set(b.pos, o); o += b.pos.length;
-      oc = LigGL.colours(col, oc, b.grey, null, -1, TINT);
+      oc = LigGL.colours(col, oc, b.rgb, null, -1, TINT);
       add(first, cam0);
     });
     for (var t = tr[0]; t <= tr[1]; t++) {
@@ -104,7 +104,7 @@
         var first = o / 3;
         o = LigGL.transform(pos, o, m.local, m.link, m.matrices, row * m.L * 12);
         var tint = mark && mark.model === mi && mark.tick === t ? mark.link : -1;
-        oc = LigGL.colours(col, oc, m.grey, m.link, tint, TINT);
+        oc = LigGL.colours(col, oc, m.rgb, m.link, tint, TINT);
         spans.push({ first: first, count: o / 3 - first, model: mi, tick: t, row: row, cam: cam });
         add(first, cam);
       }

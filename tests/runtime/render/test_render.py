@@ -508,7 +508,7 @@ def test_culling_leaves_the_appendix_a_picture_unchanged(tmp_path):
     angles = pose.joint_angles(human, rt._motion(rt.variables["SQUAT"], 0), np.arange(6.0))
     X = pose.world_transforms(human, angles, np.broadcast_to(np.eye(4), (6, 4, 4)))
     tris = pose.world_triangles(table, X).reshape(-1, 3, 3)
-    grey = np.tile(table.grey, 6)
+    grey = np.tile(table.shade, 6)
     for eye in [(0.0, 0.0, 4.0), (3.0, 2.0, 2.0), (-1.0, -3.0, 2.5)]:
         cam = Camera(eye, 3.0, (200, 150))
         culled = rasterize(tris, grey, cam, cull=np.ones(len(tris), dtype=bool))

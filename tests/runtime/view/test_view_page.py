@@ -109,7 +109,8 @@ def test_page_holds_the_runtimes_own_segment_matrices(tmp_path):
     take = X.collect(program)[0].models[0]
     table = mesh_table(take.figure)
     assert np.array_equal(_array(blob, model["mesh"]["pos"]), table.triangles.reshape(-1).astype(np.float32))
-    assert np.array_equal(_array(blob, model["mesh"]["grey"]), table.grey)
+    # Three levels a triangle (grey ones as three equal channels), as gl.js reads them.
+    assert np.array_equal(_array(blob, model["mesh"]["rgb"]).reshape(-1, 3), np.repeat(table.shade[:, None], 3, axis=1))
     assert np.array_equal(_array(blob, model["mesh"]["link"]), table.link)
     cams = _array(blob, scene["cameras"]).reshape(-1, 4)
     assert np.allclose(cams[0], [*take_camera(program)], rtol=1e-6)
