@@ -128,7 +128,8 @@ def _scan_loads(source: Source, path: str, stack: tuple, opened: dict | None = N
     from . import library
 
     opened = {} if opened is None else opened
-    names, failed = set(), []
+    names: set[str] = set()
+    failed: list = []
     for lib_name, wanted, pos in source.load_requests():
         lib = library.open_library(lib_name, path, stack, opened)
         if isinstance(lib, Exception):

@@ -109,7 +109,7 @@ def is_path(name: str) -> bool:
     return "/" in name or "\\" in name or name.lower().endswith(".lig")
 
 
-def resolve(name: str, loading_file: str) -> str:
+def resolve(name: str, loading_file: str | None) -> str:
     """The absolute path of the library ``name`` loaded from ``loading_file``.
 
     A path may be relative (to the loading file's folder) or absolute, and
@@ -407,7 +407,7 @@ def failure(exc: Exception, name: str) -> tuple:
         )
     if isinstance(exc, LigDiagnostics):
         return f"the library '{name}' has errors (shown above)", None, list(exc.diagnostics)
-    return f"the library '{name}' cannot be read: {exc.strerror or exc}", None, []
+    return f"the library '{name}' cannot be read: {getattr(exc, 'strerror', None) or exc}", None, []
 
 
 # What a LOAD reports at its own line (see failure); anything else is a bug.

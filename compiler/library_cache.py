@@ -113,7 +113,8 @@ def _private_file(fd: int, size: int | None = None) -> bool:
 
 
 def _read_all(fd: int, limit: int) -> bytes | None:
-    chunks, total = [], 0
+    chunks: list[bytes] = []
+    total = 0
     while True:
         chunk = os.read(fd, min(1 << 20, limit + 1 - total))
         if not chunk:

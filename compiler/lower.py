@@ -104,7 +104,7 @@ class Lowerer(NodeVisitor):
     def emit(self, text: str) -> None:
         self.lines.append("    " * self.indent + text)
 
-    def type_of(self, e) -> str:
+    def type_of(self, e) -> str | None:
         return expr_type(self.c.types, e)
 
     # ------------------------------------------------------------- module
@@ -183,7 +183,8 @@ class Lowerer(NodeVisitor):
         self.emit('    """The program variables: LIG names are upper case, generated names are not."""')
         self.emit('    return {k: v for k, v in globals().items() if k.isupper() and not k.startswith("_")}')
         self.emit("")
-        chunks, start = [], len(self.lines)
+        chunks: list[str] = []
+        start = len(self.lines)
         self.indent += 1
         inits = [f"{name} = {_ZERO[t]}" for name, t in sorted(self.c.main.types.items())]
 
@@ -203,7 +204,11 @@ class Lowerer(NodeVisitor):
             cut(CHUNK_LINES)
         cut(1)
         self.indent -= 1
-        for k, text in enumerate(chunks):
+        # Popped from the end, so each chunk's text is freed once it is in self.lines.
+        count = len(chunks)
+        chunks.reverse()
+        for k in range(count):
+            text = chunks.pop()
             self.emit(f"def _main_{k}(rt):")
             # Every upper-case word of the chunk that is a variable: a chunk
             # that assigns one without `global` would make it its own local.
@@ -211,11 +216,10 @@ class Lowerer(NodeVisitor):
             if names:
                 self.emit(f"    global {', '.join(sorted(names))}")
             self.lines.append(text)
-            chunks[k] = None
             self.emit("")
         self.emit("def _main(rt):")
         self.emit("    " + repr(f"The main program of {self.doc_name}."))
-        for k in range(len(chunks)):
+        for k in range(count):
             self.emit(f"    _main_{k}(rt)")
         self.emit("    return _variables()")
         self.emit("")

@@ -34,7 +34,9 @@ from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 #: How often a long scene reports its progress while it is checked, in ticks.
 PROGRESS_TICKS = 4096
 
-_StopProgram = type("_StopProgram", (Exception,), {})
+
+class _StopProgram(Exception):
+    """STOP: ends the main program; the variables are handed over before it is raised."""
 
 
 class Posed:

@@ -107,7 +107,7 @@ def apply(m: KeyframeEdits) -> Motion:
     if m._cache is not None:
         return m._cache
     edits = []
-    node = m
+    node: KeyframeEdits | None = m
     while node is not None:
         edits.append(node.edit)
         node = node.parent
