@@ -1,6 +1,19 @@
-"""Shared test options: --regen-golden rewrites golden images and compiled modules on purpose."""
+"""Shared test options: --regen-golden rewrites golden images and compiled modules on purpose.
+
+Property tests are derandomized: Hypothesis draws the same examples on every
+run and keeps no example database, so CI and a laptop test the same cases
+and a failure is reproduced by running the test again. Set
+LIGANIMATE_HYPOTHESIS=explore to draw fresh examples when hunting for bugs.
+"""
+
+import os
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("reproducible", derandomize=True, database=None)
+settings.register_profile("explore", database=None)
+settings.load_profile("explore" if os.environ.get("LIGANIMATE_HYPOTHESIS") == "explore" else "reproducible")
 
 
 def pytest_addoption(parser):
