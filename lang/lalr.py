@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 from operator import itemgetter
 
+from lark import Lark
 from lark.exceptions import UnexpectedToken
 from lark.lexer import Token
 from lark.parse_tree_builder import ChildFilterLALR_NoPlaceholders, ExpandSingleChild
@@ -75,7 +76,7 @@ class Driver:
         callbacks produce the values).
     """
 
-    def __init__(self, lark):
+    def __init__(self, lark: Lark) -> None:
         lalr = lark.parser.parser
         table = lalr._parse_table
         callbacks = lalr.parser.callbacks
@@ -144,11 +145,14 @@ class Driver:
         line, line_start = 1, 0
         tok = None
         spellings: dict = {}
+        ttype: str | None  # None only between a missed operator choice and _operator
         while True:
             # ------------------------------------------------ next token
             m = scan(text, pos)
-            k = m.lastindex if m is not None else None
-            if not k:
+            if m is None:
+                scanner.unexpected_character(text, pos, line, state)
+            k = m.lastindex
+            if not k:  # never: a match always ends in one of the groups; this narrows k for mypy
                 scanner.unexpected_character(text, pos, line, state)
             start = m.start(k)
             if start != pos:

@@ -24,11 +24,13 @@ own loop.
 from __future__ import annotations
 
 import re
+from collections.abc import Collection
 from operator import itemgetter
+from typing import NoReturn
 
 from lark import Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedToken
-from lark.lexer import Lexer
+from lark.lexer import Lexer, TerminalDef
 
 _SKIP = r"(?:[ \t\f\r\n]+|\{[^}]*\})*"
 SCAN = re.compile(
@@ -76,7 +78,7 @@ _NOT_BEFORE_ASSIGN = re.compile(r"\s*(:-|:=|=|\[)")
 class GrammarTables:
     """What the lexer needs to know about the grammar's terminals, read once."""
 
-    def __init__(self, terminals):
+    def __init__(self, terminals: Collection[TerminalDef]) -> None:
         self.names = {t.name for t in terminals}
         # Priority-2 word terminals: (terminal, set of upper-case words, needs lookahead)
         self.strong: dict = {}
@@ -178,11 +180,11 @@ class Scanner:
     previous token left.
     """
 
-    def __init__(self, terminals, states):
+    def __init__(self, terminals: Collection[TerminalDef], states: dict) -> None:
         self.tables = GrammarTables(terminals)
         self.states = states
         self._accepts: dict = {}  # parser state -> frozenset of terminal names
-        self._choice: dict = {}  # (state, word or operator) -> token type
+        self._choice: dict[tuple[object, str], str] = {}  # (state, word or operator) -> token type
 
     def accepted(self, state) -> frozenset:
         """The symbols parser state ``state`` accepts."""
@@ -204,10 +206,13 @@ class Scanner:
         keywords = tables.keywords
         choice = self._choice
         count = text.count
+        ttype: str | None  # None only between a missed operator choice and _operator
         while True:
             m = scan(text, pos)
-            k = m.lastindex if m is not None else None
-            if not k:
+            if m is None:
+                self.unexpected_character(text, pos, line, stack[-1])
+            k = m.lastindex
+            if not k:  # never: a match always ends in one of the groups; this narrows k for mypy
                 self.unexpected_character(text, pos, line, stack[-1])
             start = m.start(k)
             if start != pos:
@@ -252,9 +257,11 @@ class Scanner:
             ttype = self._pick(candidates, state, cache=None if word in self.tables.contextual else key)
         return ttype
 
-    def unexpected_character(self, text: str, pos: int, line: int, state):
+    def unexpected_character(self, text: str, pos: int, line: int, state) -> NoReturn:
         """Raise UnexpectedCharacters for the first character after ``pos`` that starts no token."""
-        skipped = re.compile(_SKIP).match(text, pos).end()
+        blank = re.compile(_SKIP).match(text, pos)
+        assert blank is not None  # _SKIP matches the empty string, so it matches anywhere
+        skipped = blank.end()
         line += text.count(_NEWLINE, pos, skipped)
         line_start = text.rfind(_NEWLINE, 0, skipped) + 1
         raise UnexpectedCharacters(text, skipped, line, skipped - line_start + 1, allowed=self.accepted(state))
@@ -270,7 +277,7 @@ class Scanner:
             self._choice[cache] = c
         return c
 
-    def _operator(self, greedy: str, start: int, state):
+    def _operator(self, greedy: str, start: int, state) -> tuple[str, str, int]:
         """The token for the operator ``greedy`` (the longest spelling) at ``start``.
 
         The longest spelling the state accepts wins; a choice for the whole

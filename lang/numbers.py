@@ -120,9 +120,9 @@ def literal(text: str) -> int | float:
     digits = text.lstrip("0")
     if len(digits) <= 19 and int(text) <= INT_MAX:
         return int(text)
-    bad = BadInteger(0)
-    bad.text = text
-    return bad
+    too_big = BadInteger(0)
+    too_big.text = text
+    return too_big
 
 
 def shown(text: str, width: int = 24) -> str:

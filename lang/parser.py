@@ -266,7 +266,26 @@ def _line_col(text: str, offset: int):
 
 
 def _token_pos(tok: Token) -> A.Pos:
-    return A.Pos(tok.line, tok.column, tok.end_line or tok.line, tok.end_column or tok.column + 1)
+    line, column = tok.line, tok.column
+    # Every token a syntax error carries has a line and column (see _start).
+    assert line is not None and column is not None
+    return A.Pos(line, column, tok.end_line or line, tok.end_column or column + 1)
+
+
+def _start(tok: Token) -> int:
+    """``tok.start_pos``, which Lark types Optional as a Token may be made without one.
+
+    Every token that reaches a message has it: Tok.as_lark's, Lark's ``$END``
+    (borrowed from the last token, or made at offset 0) and _word_taken_as_name's.
+    """
+    assert tok.start_pos is not None
+    return tok.start_pos
+
+
+def _end(tok: Token) -> int:
+    """``tok.end_pos``, for a token that is not ``$END`` (see :func:`_start`)."""
+    assert tok.end_pos is not None
+    return tok.end_pos
 
 
 def _word_taken_as_name(tok: Token, text: str, expected: set):
@@ -284,7 +303,7 @@ def _word_taken_as_name(tok: Token, text: str, expected: set):
     if tok.type == "$END":
         start = tok.start_pos
     else:
-        before = _blanked(text, tok.start_pos).rstrip()
+        before = _blanked(text, _start(tok)).rstrip()
         m = _LAST_WORD.search(before, max(0, len(before) - 40))
         if m is None:
             return None
@@ -305,7 +324,7 @@ def _stray_diagnostic(tok: Token, text: str, source: Source, as_name: bool):
     """``ENDMOTION without STARTMOTION`` and its kind, at the stray word, or None if it is not stray."""
     word = tok.value.upper()
     pos = _token_pos(tok)
-    if not as_name and _ASSIGNED.match(text, tok.end_pos):
+    if not as_name and _ASSIGNED.match(text, _end(tok)):
         return Diagnostic(
             source.filename,
             pos,
@@ -322,7 +341,7 @@ def _stray_diagnostic(tok: Token, text: str, source: Source, as_name: bool):
             source=source.text,
         )
     opener_text, openers = _STRAY[word]
-    stack, closed = _scan_blocks(text, tok.start_pos)
+    stack, closed = _scan_blocks(text, _start(tok))
     if any(w in openers for w, _ in stack):
         return None  # its block is open: the word is misplaced, not stray
     others = [b for b in stack if b[0] != "JOINT"]
@@ -359,7 +378,9 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
     line, col = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
     hint = None
     if isinstance(exc, UnexpectedCharacters):
-        ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        at = exc.pos_in_stream
+        assert at is not None  # Optional on UnexpectedInput; UnexpectedCharacters always sets it
+        ch = text[at] if at < len(text) else ""
         if ch == "$":
             message = "names beginning with $ are reserved for liganimate"
             hint = "rename it; only PRINT $model uses a $"

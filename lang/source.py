@@ -121,12 +121,12 @@ def read_source_bytes(path: str, *, follow_symlinks: bool = True) -> bytes:
     return b"".join(chunks)
 
 
-def _line_col(data: bytes, offset: int) -> tuple:
+def _line_col(data: bytes, offset: int) -> tuple[int, int]:
     start = data.rfind(b"\n", 0, offset) + 1
     return data.count(b"\n", 0, offset) + 1, len(data[start:offset].decode("utf-8", errors="replace")) + 1
 
 
-def _text_line_col(text: str, offset: int) -> tuple:
+def _text_line_col(text: str, offset: int) -> tuple[int, int]:
     return text.count("\n", 0, offset) + 1, offset - (text.rfind("\n", 0, offset) + 1) + 1
 
 
@@ -142,18 +142,18 @@ def lig_text(data: bytes, path: str) -> str:
         Not UTF-8, or holding control characters other than tab, line feed,
         form feed and carriage return.
     """
-    bad = _CONTROL_BYTES.search(data)
-    if bad is not None:
-        line, col = _line_col(data, bad.start())
+    bad_byte = _CONTROL_BYTES.search(data)
+    if bad_byte is not None:
+        line, col = _line_col(data, bad_byte.start())
         raise SourceFileError(f"not LIG text (a control character at line {line}, column {col})", path)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line, col = _line_col(data, exc.start)
         raise SourceFileError(f"not UTF-8 text (a bad byte at line {line}, column {col})", path) from None
-    bad = _CONTROL_CHARS.search(text)
-    if bad is not None:
-        line, col = _text_line_col(text, bad.start())
+    bad_char = _CONTROL_CHARS.search(text)
+    if bad_char is not None:
+        line, col = _text_line_col(text, bad_char.start())
         raise SourceFileError(f"not LIG text (a control character at line {line}, column {col})", path)
     return text.removeprefix("\ufeff")
 
@@ -261,13 +261,13 @@ def load(path: str, display_name: str | None = None) -> Source:
     """
     data = read_source_bytes(path)
     name = display_name or path
-    bad = _CONTROL_BYTES.search(data)
-    if bad is not None:
-        raise _binary(name, *_line_col(data, bad.start()), data[bad.start()])
+    bad_byte = _CONTROL_BYTES.search(data)
+    if bad_byte is not None:
+        raise _binary(name, *_line_col(data, bad_byte.start()), data[bad_byte.start()])
     text = decode(data, name)
-    bad = _CONTROL_CHARS.search(text)
-    if bad is not None:
-        raise _binary(name, *_text_line_col(text, bad.start()), ord(bad.group()))
+    bad_char = _CONTROL_CHARS.search(text)
+    if bad_char is not None:
+        raise _binary(name, *_text_line_col(text, bad_char.start()), ord(bad_char.group()))
     return prepare(text, name)
 
 

@@ -95,7 +95,7 @@ def _canonical(table: dict) -> dict:
     symbol = {name: i for i, name in enumerate(names)}
     old_names = table["tokens"]
     states = table["states"]
-    order = {}
+    order: dict[int, int] = {}  # old state number -> new
     queue = list(table["start_states"].values())
     for s in queue:
         order.setdefault(s, len(order))

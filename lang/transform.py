@@ -18,10 +18,13 @@ from .vocabulary import MODIFIERS
 TOKENS = (Token, Tok)
 
 
-def _tpos(tok: Token) -> A.Pos:
+def _tpos(tok: Token | Tok) -> A.Pos:
     if type(tok) is Tok:
         return A.token_pos(tok[3], tok[4], tok[5])
-    return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column)
+    # Lark types a Token's positions Optional, as a Token may be made without
+    # them; the Tokens that reach here come from Tok.as_lark (LigLexer) or
+    # Lark's own lexer, which set all four. Checking would cost every token.
+    return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column)  # type: ignore[arg-type]
 
 
 def _pos_of(x) -> A.Pos | None:
@@ -64,9 +67,10 @@ def span(children) -> A.Pos:
             if isinstance(last, A.Node):
                 return start.to(last.pos)
     first = _pos_of(children)
-    last = _last_pos_of(children)
     if first is None:
         return A.NOWHERE
+    last = _last_pos_of(children)
+    assert last is not None  # the scan from the front found a position, so the one from the back does
     return first.to(last)
 
 
