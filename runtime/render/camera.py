@@ -95,16 +95,7 @@ class Camera:
                 f"The VIEW WIDTH must be a positive number, not {width!r}.",
                 hint="VIEW WIDTH is the width of the visible region around the origin, in world units.",
             )
-        try:
-            W, H = (int(s) for s in size)
-            ok = W > 0 and H > 0 and (W, H) == tuple(size)
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise RenderError(
-                f"The image size must be two positive whole numbers, not {size!r}.",
-                hint="For example 640 by 480.",
-            )
+        W, H = image_size(size)
         forward = -p / distance
         up_hint = np.array([0.0, 1.0, 0.0])
         if np.linalg.norm(np.cross(forward, up_hint)) < _PARALLEL_SINE:
@@ -219,3 +210,24 @@ class Camera:
             direction (positive in front of the eye).
         """
         return self.camera_to_pixels(self.to_camera(points))
+
+
+def image_size(size) -> tuple[int, int]:
+    """``size`` as (width, height) in pixels, checked: two positive whole numbers.
+
+    Raises
+    ------
+    RenderError
+        Anything else (zero, negative, fractional, not a pair).
+    """
+    try:
+        W, H = (int(s) for s in size)
+        ok = W > 0 and H > 0 and (W, H) == tuple(size)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise RenderError(
+            f"The image size must be two positive whole numbers, not {size!r}.",
+            hint="For example 640 by 480.",
+        )
+    return W, H

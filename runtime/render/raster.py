@@ -49,7 +49,7 @@ from __future__ import annotations
 import numpy as np
 
 from liganimate.runtime.errors import RenderError
-from liganimate.runtime.render.camera import Camera
+from liganimate.runtime.render.camera import Camera, image_size
 
 # The depth buffer's "nothing drawn here".  Every fragment's key is
 # positive (it starts with the bits of a positive float64).
@@ -204,13 +204,7 @@ class Framebuffer:
     """
 
     def __init__(self, size, background=255, aa: int = 1):
-        try:
-            W, H = (int(s) for s in size)
-            ok = W > 0 and H > 0 and (W, H) == tuple(size)
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise RenderError(f"The image size must be two positive whole numbers, not {size!r}.")
+        W, H = image_size(size)
         self.aa = _aa(aa)
         self.size = (W, H)
         bg = _background(background)
