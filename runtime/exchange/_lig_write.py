@@ -263,27 +263,11 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
         parts.append(start)
         if moving[j]:
             rows = np.arange(1, F) if keep is None else keep[j][keep[j] > 0]
-            table = np.column_stack([frames[rows - 1], angles[rows, j]])
-            parts.append(
-                format_rows(
-                    table,
-                    [0, DECIMALS, DECIMALS, DECIMALS],
-                    columns_prefix=["          FRAME", " POSITION", ",", ","],
-                    suffix="\n",
-                )
-            )
+            parts.append(_keyframe_rows(frames[rows - 1], angles[rows, j]))
     if path is not None:
         parts.append(format_rows(path[:1], DECIMALS, sep=",", prefix="        ROOT POSITION", suffix="\n"))
         if F > 1 and (path != path[:1]).any():
-            table = np.column_stack([frames, path[1:]])
-            parts.append(
-                format_rows(
-                    table,
-                    [0, DECIMALS, DECIMALS, DECIMALS],
-                    columns_prefix=["          FRAME", " POSITION", ",", ","],
-                    suffix="\n",
-                )
-            )
+            parts.append(_keyframe_rows(frames, path[1:]))
     parts.append(b"      ENDMOTION\n")
     return b"".join(parts)
 
@@ -395,3 +379,13 @@ def _linear_keep(v: np.ndarray, tol: float) -> np.ndarray:
             break
         kept = new
     return kept
+
+
+def _keyframe_rows(frames: np.ndarray, values: np.ndarray) -> bytes:
+    """``FRAME f POSITION x, y, z`` lines: ``frames`` shape (K,), ``values`` shape (K, 3) (a joint's or the ROOT's)."""
+    return format_rows(
+        np.column_stack([frames, values]),
+        [0, DECIMALS, DECIMALS, DECIMALS],
+        columns_prefix=["          FRAME", " POSITION", ",", ","],
+        suffix="\n",
+    )
