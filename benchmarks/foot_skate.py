@@ -3,8 +3,12 @@
 For each locomotion motion of the standard library (humanoid WALK and RUN),
 the HUMANOID is posed at every frame of two cycles, exactly as
 ``liganimate run --poses`` poses it (clamped angles, world link
-transforms), and moved along +X at the body speed of the scene-level
-translation the examples use (``<TRANS (v * T, 0, 0)>``). For each foot:
+transforms), and carried by the motion's ROOT track as ANIMATE carries it
+(a motion without one would be moved along +X at the body speed of the
+scene-level translation the examples use, ``<TRANS (v * T, 0, 0)>``).
+The other walk of the library, ROBOT_WALK, is the thesis' section 4.3 walk
+*on the spot*, kept as the thesis wrote it: its robot has no feet and does
+not travel, so it has no planted foot to measure. For each foot:
 
 * *planted* frames are those whose ankle (the foot link's origin) is
   within 1 cm of its lowest height over the cycles, as issue 9 measured;
