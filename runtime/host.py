@@ -476,68 +476,38 @@ class Runtime(Arithmetic):
     # ------------------------------------------------------------- REACH
     def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
         """A STARTREACH block: (the motion to the solved pose, the solved translation)."""
-        from liganimate.runtime.ik import reach as R
+        from liganimate.runtime.ik import language as RL
 
         fig = self._model(model, at, "the model of a REACH")
         start_motion = self._motion(start, at) if start is not None else None
-        if frames < 0:
-            self.fail(at, f"the solved pose's frame cannot be negative ({frames:g})")
+        self._guard(at, RL.check_frames, frames)
         built = []
         for g in goals:
-            kind, link, point, target, normal, weight, gat = g.kind, g.link, g.point, g.target, g.normal, g.weight, g.at
-            # The goal's link is settled here, so that an unknown or ambiguous
-            # name is reported at its own GOAL line.
-            if link is None:
-                link = self._guard(gat, fig.joint, int(g.joint)).secondary
-            else:
-                link, ambiguous = self._guard(gat, R.resolve_link, fig, link)
-                if ambiguous:
-                    self.warn(gat, _sentence(ambiguous))
-            w = 1.0 if weight is None else float(weight)
-            p = (0.0, 0.0, 0.0) if point is None else tuple(point)
-            if kind == "point":
-                built.append(R.PointGoal(link, tuple(target), p, w))
-            elif kind == "plane":
-                built.append(R.PlaneGoal(link, tuple(target), tuple(normal), p, w))
-            else:
-                built.append(R.AxisGoal(link, tuple(normal), tuple(target), w))
-        if movable is not None:
-            movable = list(movable[1]) if movable[0] == "joints" else int(movable[1])
-        result = self._guard(
+            # One call per GOAL line, so that an unknown or ambiguous link is reported at its own line.
+            goal, ambiguous = self._guard(
+                g.at, RL.language_goal, fig, g.kind, g.link, g.joint, g.point, g.target, g.normal, g.weight
+            )
+            if ambiguous:
+                self.warn(g.at, _sentence(ambiguous))
+            built.append(goal)
+        block = self._guard(
             at,
-            lambda: R.reach(
+            lambda: RL.reach_block(
                 fig,
                 built,
-                float(frames),
+                frames,
                 method,
                 start=start_motion,
                 movable=movable,
-                translate=bool(translate),
+                translate=translate,
                 solver=solver,
                 tolerance=tolerance,
-                max_iterations=iterations,
+                iterations=iterations,
             ),
         )
-        # Unmet goals, in the solver's own words and by its own test of "met",
-        # each shown at its GOAL line.
-        t = np.asarray(result.translation, dtype=float).reshape(3)
-        if not np.all(np.abs(t) <= N.GEOMETRY_MAX):
-            self.fail(
-                at,
-                "the solved translation is not within the geometry limit",
-                "the goals may be too far away for the model; everything drawn stays within 1E12 units",
-            )
-        for unmet in result.unmet or ():
-            self.warn(
-                goals[unmet.index].at,
-                _sentence(unmet.sentence),
-                "the model cannot get there within its extremes, or other goals pull it away",
-            )
-        with np.errstate(all="ignore"):
-            limit = result.limit_warning
-        if limit:
-            self.warn(at, _sentence(limit))
-        return result.motion, Vec(float(t[0]), float(t[1]), float(t[2]))
+        for w in block.warnings:
+            self.warn(at if w.goal is None else goals[w.goal].at, _sentence(w.sentence), w.hint)
+        return block.motion, Vec(*block.translation)
 
     def motion_block(self, joints, at):
         spec = {}
