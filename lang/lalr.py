@@ -146,6 +146,8 @@ class Driver:
         tok = None
         spellings: dict = {}
         ttype: str | None  # None only between a missed operator choice and _operator
+        accept = self.end
+        end_tok: Token | None = None  # set once the text has ended
         while True:
             # ------------------------------------------------ next token
             m = scan(text, pos)
@@ -188,15 +190,21 @@ class Driver:
             elif k == DOLLAR:
                 ttype = "DOLLAR_NAME"
             else:
-                break
-            column = start - line_start + 1
-            tok = _new_tuple(Tok, (ttype, value, start, line, column, column + end - start, end))
-            pos = end
+                # The end of the text: $END goes through the same loop, which
+                # reduces what is left and returns at the start rule's end state.
+                ttype = "$END"
+                end_tok = (
+                    Token.new_borrow_pos("$END", "", tok.as_lark()) if tok is not None else Token("$END", "", 0, 1, 1)
+                )
+            if ttype != "$END":
+                column = start - line_start + 1
+                tok = _new_tuple(Tok, (ttype, value, start, line, column, column + end - start, end))
+                pos = end
             # ------------------------------------------------ feed it
             while True:
                 code = actions[state].get(ttype)
                 if code is None:
-                    raise self._unexpected(tok.as_lark(), state)
+                    raise self._unexpected(_lookahead(tok, end_tok), state)
                 if code >= 0:
                     push_state(code)
                     push_value(tok)
@@ -211,6 +219,8 @@ class Driver:
                     if top is None:
                         top = self._chain(key)
                     stack[-1] = state = top
+                    if state == accept:
+                        return values[-1]
                     continue
                 if size:
                     children = values[-size:]
@@ -221,25 +231,9 @@ class Driver:
                 push_value(callback(children))
                 state = actions[stack[-1]][origin]
                 push_state(state)
-        end_tok = Token.new_borrow_pos("$END", "", tok.as_lark()) if tok is not None else Token("$END", "", 0, 1, 1)
-        while True:
-            code = actions[stack[-1]].get("$END")
-            if code is None or code >= 0:
-                raise self._unexpected(end_tok, stack[-1])
-            size, origin, callback = rules[~code]
-            if callback is None:
-                stack[-1] = actions[stack[-2]][origin]
-            else:
-                if size:
-                    children = values[-size:]
-                    del values[-size:]
-                    del stack[-size:]
-                else:
-                    children = []
-                push_value(callback(children))
-                push_state(actions[stack[-1]][origin])
-            if stack[-1] == self.end:
-                return values[-1]
+                # Only a reduction on $END reaches the start rule's end state.
+                if state == accept:
+                    return values[-1]
 
     def _chain(self, key: tuple) -> int:
         """The state a run of one-child ?rule reductions ends in, from (state below, state, lookahead)."""
@@ -255,3 +249,11 @@ class Driver:
     def _unexpected(self, token: Token, state) -> UnexpectedToken:
         expected = {s for s in self.actions[state] if s.isupper()}
         return UnexpectedToken(token, expected, state=state)
+
+
+def _lookahead(tok: Tok | None, end_tok: Token | None) -> Token:
+    """The token the parser could not take, as Lark's exceptions want it: the end, once reached, else ``tok``."""
+    if end_tok is not None:
+        return end_tok
+    assert tok is not None  # before the end, a token was just made
+    return tok.as_lark()
