@@ -9,10 +9,10 @@ scene assigns; the lowering needs the latter to declare them ``nonlocal``
 from __future__ import annotations
 
 from . import ast as A
-from .structure import children
+from .visitor import BLOCKS, children
 
 #: Statements that hold statements, and the fields that hold them (PRIMITIVE bodies are scopes of their own).
-_INNER = {A.If: ("then", "orelse"), A.Do: ("body",), A.Scene: ("init", "body")}
+_INNER = {kind: fields for kind, fields in BLOCKS.items() if kind is not A.PrimitiveDef}
 
 
 def walk(node):
