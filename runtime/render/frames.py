@@ -54,7 +54,7 @@ from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
 from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
 from liganimate.runtime.render.outputs import KEYWORD_NAMES, OutputLock, check_outputs
-from liganimate.runtime.render.raster import Framebuffer, rasterize
+from liganimate.runtime.render.raster import MAX_AA, Framebuffer, rasterize
 from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, GifStream, Mp4Stream
 from liganimate.runtime.values import Graphical, joined_shades
 
@@ -635,11 +635,12 @@ def draw(size, draws, aa=1) -> np.ndarray:
     return image
 
 
-MAX_AA = 8
-
-
 def check_aa(aa, name: str = "--aa") -> int:
-    """``aa`` as an int from 1 to :data:`MAX_AA`, or a RenderError saying why it cannot be."""
+    """``aa`` as an int from 1 to the rasterizer's ``MAX_AA``, or a RenderError naming the option.
+
+    Unlike the rasterizer's own check, this takes the option's text ("2")
+    as the command line and ``Program.render`` options give it.
+    """
     try:
         n = int(aa)
         ok = n == float(aa) and 1 <= n <= MAX_AA
