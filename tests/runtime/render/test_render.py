@@ -18,6 +18,7 @@ import tracemalloc
 
 import numpy as np
 import pytest
+from commands import liganimate as run
 from paths import ROOT_DIR
 from PIL import Image
 
@@ -67,10 +68,35 @@ def program(folder: pathlib.Path, ticks: int, name: str = "swing") -> pathlib.Pa
     return path
 
 
-def run(*args, cwd, env=None, **kw):
-    return subprocess.run(
-        [sys.executable, "-m", "liganimate", *args], capture_output=True, text=True, cwd=cwd, env=env, **kw
+def render_small(src: pathlib.Path, *options: str, cwd, env=None) -> subprocess.CompletedProcess:
+    """``liganimate run SRC`` into ``out/`` at 64x48 (quick to draw), with the other ``options`` given."""
+    return run("run", str(src), "-o", "out", "--size", "64x48", *options, cwd=cwd, env=env)
+
+
+def start_render(src: pathlib.Path, options: list, cwd: pathlib.Path, frames: int) -> subprocess.Popen:
+    """Start ``liganimate run SRC`` into ``out/`` at 160x120 and return once more than ``frames`` are written.
+
+    The command runs in a session of its own, so that a test can signal its
+    whole process group as Ctrl-C at a terminal does.  The test fails if the
+    command ends, or 120 s pass, before ``out/scene1`` holds that many frames.
+    ``stdout`` and ``stderr`` are pipes, read with ``communicate``.
+    """
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "liganimate", "run", str(src), "-o", "out", "--size", "160x120", *options],
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
     )
+    scene = cwd / "out" / "scene1"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        if scene.is_dir() and len(os.listdir(scene)) > frames:
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.communicate()
+    return proc
 
 
 def leftovers(folder: pathlib.Path) -> list:
@@ -100,22 +126,7 @@ def no_ffmpeg_env(tmp_path) -> dict:
 
 def test_run_writes_gif_and_mp4(tmp_path):
     src = program(tmp_path, 12)
-    r = run(
-        "run",
-        str(src),
-        "-o",
-        "out",
-        "--size",
-        "64x48",
-        "--gif",
-        "a.gif",
-        "--mp4",
-        "a.mp4",
-        "--fps",
-        "12",
-        "--quiet",
-        cwd=tmp_path,
-    )
+    r = render_small(src, "--gif", "a.gif", "--mp4", "a.mp4", "--fps", "12", "--quiet", cwd=tmp_path)
     if not have_ffmpeg():
         # Without ffmpeg, MP4 output is refused up front, clearly, and nothing is written.
         assert r.returncode == 1
@@ -156,21 +167,8 @@ def test_run_writes_gif_and_mp4(tmp_path):
 
 def test_mp4_without_ffmpeg_is_refused_before_anything_is_written(tmp_path):
     src = program(tmp_path, 12)
-    r = run(
-        "run",
-        str(src),
-        "-o",
-        "out",
-        "--size",
-        "64x48",
-        "--mp4",
-        "a.mp4",
-        "--gif",
-        "a.gif",
-        "--poses",
-        "p.jsonl",
-        cwd=tmp_path,
-        env=no_ffmpeg_env(tmp_path),
+    r = render_small(
+        src, "--mp4", "a.mp4", "--gif", "a.gif", "--poses", "p.jsonl", cwd=tmp_path, env=no_ffmpeg_env(tmp_path)
     )
     assert r.returncode == 1
     assert "liganimate: error: MP4 output needs the ffmpeg program, and none was found." in r.stderr
@@ -233,7 +231,7 @@ def test_progress_bar_on_a_terminal_and_quiet_silences_it(tmp_path):
 
 
 def test_no_progress_bar_when_stderr_is_not_a_terminal(tmp_path):
-    r = run("run", str(program(tmp_path, 40)), "-o", "out", "--size", "64x48", cwd=tmp_path)
+    r = render_small(program(tmp_path, 40), cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert "images" not in r.stderr and "\r" not in r.stderr
 
@@ -355,20 +353,7 @@ def test_interrupted_render_leaves_only_whole_files(tmp_path, stop):
     args = ["--gif", "a.gif", "--poses", "p.jsonl"]
     if have_ffmpeg():
         args += ["--mp4", "a.mp4"]
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "liganimate", "run", str(src), "-o", "out", "--size", "160x120", *args],
-        cwd=tmp_path,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and proc.poll() is None:
-        if (out / "scene1").is_dir() and len(os.listdir(out / "scene1")) > 40:
-            break
-        time.sleep(0.05)
-    assert proc.poll() is None, proc.communicate()
+    proc = start_render(src, args, tmp_path, 40)
     workers = children(proc.pid)
     assert len(workers) >= 1  # the pool is up (two cores or more), and is what must not survive
     for to, sig in sends:

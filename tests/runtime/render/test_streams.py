@@ -9,13 +9,13 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
-import sys
-import time
 
 import numpy as np
 import pytest
+from commands import liganimate as run
+from commands import python
 from PIL import Image
-from test_render import have_ffmpeg, leftovers, pngs, program, run
+from test_render import have_ffmpeg, leftovers, pngs, program, start_render
 
 from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render import video
@@ -113,9 +113,7 @@ def test_the_same_program_gives_the_same_mp4_bytes(tmp_path):
                 "import sys; from liganimate.cli import load_program; p, _ = load_program(sys.argv[1]); "
                 "p.render(None, mp4=sys.argv[2], size=(96, 72), quiet=True, workers=1)"
             )
-            r = subprocess.run(
-                [sys.executable, "-c", code, str(src), f"{name}.mp4"], cwd=tmp_path, capture_output=True, text=True
-            )
+            r = python("-c", code, str(src), f"{name}.mp4", cwd=tmp_path)
         else:
             r = run(*args, cwd=tmp_path, env=env)
         assert r.returncode == 0, r.stderr
@@ -172,20 +170,7 @@ def test_ctrl_c_during_a_streamed_mp4_leaves_no_video_or_a_playable_one(tmp_path
         assert r.returncode == 0, r.stderr
         before = (tmp_path / "film.mp4").read_bytes()
     out = tmp_path / "out"
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "liganimate", "run", str(src), "-o", "out", "--mp4", "film.mp4", "--size", "160x120"],
-        cwd=tmp_path,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and proc.poll() is None:
-        if (out / "scene1").is_dir() and len(os.listdir(out / "scene1")) > 60:
-            break
-        time.sleep(0.05)
-    assert proc.poll() is None, proc.communicate()
+    proc = start_render(src, ["--mp4", "film.mp4"], tmp_path, 60)
     os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C at a terminal: the whole process group
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
