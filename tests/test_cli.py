@@ -4,20 +4,17 @@ from __future__ import annotations
 
 import json
 import pathlib
-import subprocess
 import sys
 
 import pytest
+from commands import liganimate as run
+from commands import python
 
 from liganimate.compiler import compile_file
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 GOLDEN_COMPILE = ROOT / "tests" / "golden" / "compile"
-
-
-def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "liganimate", *args], capture_output=True, text=True, cwd=cwd)
 
 
 def test_run_appendix_a_writes_one_image_and_poses(tmp_path):
@@ -57,12 +54,7 @@ def test_check_runs_scenes_without_rendering(tmp_path):
 def test_compiled_module_renders_like_run(tmp_path):
     r = run("compile", str(EXAMPLES / "appendix_a.lig"), "-o", "appendix.py", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    p = subprocess.run(
-        [sys.executable, "appendix.py", "-o", "mod", "--size", "160x120", "--quiet"],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-    )
+    p = python("appendix.py", "-o", "mod", "--size", "160x120", "--quiet", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     r2 = run("run", str(EXAMPLES / "appendix_a.lig"), "-o", "cli", "--size", "160x120", "--quiet", cwd=tmp_path)
     assert r2.returncode == 0

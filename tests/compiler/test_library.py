@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import pathlib
-import subprocess
-import sys
 import textwrap
 
 import numpy as np
 import pytest
+from commands import liganimate as cli
+from commands import python
 
 from liganimate.compiler import compile_file, compile_text, library
 from liganimate.lang.diagnostics import LigDiagnostics
@@ -118,12 +118,7 @@ def test_compiled_module_is_standalone(libs, tmp_path_factory):
     (elsewhere / "prog.py").write_text(module)
     for f in (libs / "lib").iterdir():
         f.unlink()  # the module must not need the library files any more
-    r = subprocess.run(
-        [sys.executable, "prog.py", "-o", "out", "--size", "80x60", "--quiet"],
-        cwd=elsewhere,
-        capture_output=True,
-        text=True,
-    )
+    r = python("prog.py", "-o", "out", "--size", "80x60", "--quiet", cwd=elsewhere)
     assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in (elsewhere / "out" / "scene1").iterdir()) == ["00000.png", "00001.png"]
 
@@ -243,10 +238,6 @@ def test_library_values_are_shared_not_aliased(libs):
     s1 = v1["ARM"].locations[1]
     s2 = v2["ARM"].locations[1]
     assert np.allclose(s1, 2 * s2)
-
-
-def cli(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "liganimate", *args], capture_output=True, text=True, cwd=cwd)
 
 
 def test_archive_writes_a_library_that_loads_back(libs):
