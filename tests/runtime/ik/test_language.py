@@ -4,22 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_reach_language import ARM
 
 from liganimate.compiler import load_program
 from liganimate.runtime.errors import FigureError
 from liganimate.runtime.ik import language as RL
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, PlaneGoal, PointGoal
 
-# The planar two-segment arm of test_reach_language.py; TWIN adds a second link named UPPER below LOWER.
-ARM = """\
-UPPER :- BOX AT (0, -0.5, 0), WIDTH 0.1, HEIGHT 1, DEPTH 0.1
-LOWER :- BOX AT (0, -0.5, 0), WIDTH 0.1, HEIGHT 1, DEPTH 0.1
-BASE :- BOX WIDTH 0.2, HEIGHT 0.2, DEPTH 0.2
-STARTMODEL ARM
-  JOINT 1, BASE, (0, 0, 0), UPPER, (0, 0, 0), (0, 0), (0, 0), (-170, 170)
-  JOINT 2, UPPER, (0, -1, 0), LOWER, (0, 0, 0), (0, 0), (0, 0), (0, 160)
-ENDMODEL
-"""
+# TWIN adds a second link named UPPER below LOWER to the arm of test_reach_language.py.
 TWIN = ARM.replace("ENDMODEL", "  JOINT 3, LOWER, (0, -1, 0), UPPER, (0, 0, 0), (0, 0), (0, 0), (0, 90)\nENDMODEL")
 
 
