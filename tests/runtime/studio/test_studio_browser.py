@@ -2,37 +2,26 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import time
 
 import numpy as np
 import pytest
 from browser import Browser, require_chromium
-
-from liganimate.runtime.studio import (
-    Session,
-    StudioServer,
-    start_in_thread,
-    studio_model,
-    studio_page,
-)
+from commands import liganimate
+from studio_support import running_studio
 
 
 @pytest.fixture(scope="module")
-def studio(tmp_path_factory):
+def studio(tmp_path_factory, humanoid):
     require_chromium()
-    fig, model, _ = studio_model(None, None)
     save = tmp_path_factory.mktemp("studio") / "posed.lig"
-    session = Session(fig, model, "POSES", str(save), seed=2024)
-    server = StudioServer(session, studio_page(session.generator, model))
-    start_in_thread(server)
-    with Browser(1300, 950, log_network=True) as b:
+    with (
+        running_studio(humanoid, "HUMANOID", save, seed=2024) as (server, session),
+        Browser(1300, 950, log_network=True) as b,
+    ):
         b.driver.get(server.url)
         _settle(b)
         yield b, server, session, save
-    server.shutdown()
-    server.server_close()
 
 
 def _settle(b, timeout=30):
@@ -96,13 +85,7 @@ def test_a_click_takes_a_limb_then_keep_and_save(studio, tmp_path):
     assert state["saved"] and state["kept"] == 2
     assert "saved 2 pose(s)" in b.driver.find_element("id", "status").text
     assert save.is_file()
-    r = subprocess.run(
-        [sys.executable, "-m", "liganimate", "run", str(save), "-o", str(tmp_path / "f"), "--quiet"],
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    r = liganimate("run", str(save), "-o", str(tmp_path / "f"), "--quiet", timeout=300)
     assert r.returncode == 0, r.stderr
     play = tmp_path / "play.lig"
     play.write_text(
@@ -111,13 +94,7 @@ def test_a_click_takes_a_limb_then_keep_and_save(studio, tmp_path):
         "      ENDSCENE\n      SHOOTSCENES\n",
         encoding="utf-8",
     )
-    r = subprocess.run(
-        [sys.executable, "-m", "liganimate", "run", str(play), "-o", str(tmp_path / "g"), "--quiet"],
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    r = liganimate("run", str(play), "-o", str(tmp_path / "g"), "--quiet", timeout=300)
     assert r.returncode == 0, r.stderr
 
 

@@ -3,33 +3,16 @@
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from commands import liganimate
 
 from liganimate.cli import load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.runtime import exchange as X
 from liganimate.runtime.figure.pose import mesh_table, world_transforms, world_triangles
-from liganimate.runtime.studio import (
-    Generator,
-    library_text,
-    studio_model,
-    widened_extremes,
-    write_library,
-)
-
-
-@pytest.fixture(scope="module")
-def humanoid():
-    return studio_model(None, None)[0]
-
-
-@pytest.fixture(scope="module")
-def human():
-    return studio_model(None, "HUMAN")[0]
+from liganimate.runtime.studio import Generator, library_text, widened_extremes, write_library
 
 
 def _posed(fig, seed=31):
@@ -97,14 +80,11 @@ def test_liganimate_run_accepts_the_library_and_plays_it(tmp_path, humanoid):
     g = _posed(humanoid, seed=5)
     lib = tmp_path / "poses.lig"
     write_library(str(lib), library_text(humanoid, "HUMANOID", "POSES", g.kept))
-    env = dict(os.environ)
-    cmd = [sys.executable, "-m", "liganimate", "run", str(lib), "-o", str(tmp_path / "lib_frames"), "--quiet"]
-    r = subprocess.run(cmd, check=False, capture_output=True, text=True, env=env, timeout=120)
+    r = liganimate("run", str(lib), "-o", str(tmp_path / "lib_frames"), "--quiet", timeout=120)
     assert r.returncode == 0, r.stderr
     assert "error" not in r.stderr
     prog, _ = _play(tmp_path, lib, "HUMANOID", "POSES", 25)
-    cmd = [sys.executable, "-m", "liganimate", "run", str(prog), "-o", str(tmp_path / "frames"), "--quiet"]
-    r = subprocess.run(cmd, check=False, capture_output=True, text=True, env=env, timeout=120)
+    r = liganimate("run", str(prog), "-o", str(tmp_path / "frames"), "--quiet", timeout=120)
     assert r.returncode == 0, r.stderr
     assert len(os.listdir(tmp_path / "frames" / "scene1")) == 25
 

@@ -13,31 +13,17 @@ import sys
 import time
 
 import pytest
+from commands import liganimate
+from studio_support import running_studio
 
 from liganimate.runtime.errors import LigError
-from liganimate.runtime.studio import (
-    MAX_BODY,
-    Session,
-    StudioServer,
-    start_in_thread,
-    studio_model,
-    studio_page,
-)
-
-
-@pytest.fixture(scope="module")
-def humanoid():
-    return studio_model(None, None)[0]
+from liganimate.runtime.studio import MAX_BODY, studio_model
 
 
 @pytest.fixture
 def server(tmp_path, humanoid):
-    session = Session(humanoid, "HUMANOID", "POSES", str(tmp_path / "saved.lig"), seed=9)
-    srv = StudioServer(session, studio_page(session.generator, "HUMANOID"))
-    start_in_thread(srv)
-    yield srv
-    srv.shutdown()
-    srv.server_close()
+    with running_studio(humanoid, "HUMANOID", tmp_path / "saved.lig", seed=9) as (srv, _):
+        yield srv
 
 
 def _request(srv, method, path, body=None, headers=None):
@@ -272,8 +258,7 @@ def test_the_command_prints_its_port_and_serves(tmp_path):
     ],
 )
 def test_the_command_refuses_bad_choices(tmp_path, args, message):
-    cmd = [sys.executable, "-m", "liganimate", "studio", "--no-browser", *args]
-    r = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    r = liganimate("studio", "--no-browser", *args, cwd=tmp_path, timeout=120)
     assert r.returncode == 1 and message in r.stderr and "Traceback" not in r.stderr
 
 
