@@ -28,21 +28,10 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, "five_humans.lig")
-CHROMIUM = "/usr/bin/chromium"
-CHROMEDRIVER = "/usr/bin/chromedriver"
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--window-size=1000,760",
-]
+# The browser tests' Chromium, started the same way (flags, fresh profile, no network of its own).
+sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests"))
+
+from browser import Browser, missing  # noqa: E402 - found through the sys.path line above
 
 
 def build_page(folder: str):
@@ -61,21 +50,11 @@ def build_page(folder: str):
 
 def load_times(path: str, rounds: int):
     """Milliseconds from navigation to the first frame, one per load; None without Chromium."""
-    if not (os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER)):
+    if missing():
         return None
-    try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.service import Service
-    except ImportError:
-        return None
-    profile = tempfile.mkdtemp(prefix="lig-bench-")
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
-    for flag in FLAGS + [f"--user-data-dir={profile}"]:
-        opts.add_argument(flag)
-    driver = webdriver.Chrome(options=opts, service=Service(CHROMEDRIVER))
     times = []
-    try:
+    with Browser(1000, 760) as browser:
+        driver = browser.driver
         for _ in range(rounds):
             driver.get("about:blank")
             driver.get("file://" + os.path.abspath(path))
@@ -88,11 +67,6 @@ def load_times(path: str, rounds: int):
             if ready is None:
                 raise RuntimeError("the viewer did not start")
             times.append(float(ready))
-    finally:
-        driver.quit()
-        import shutil
-
-        shutil.rmtree(profile, ignore_errors=True)
     return times
 
 

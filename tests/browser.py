@@ -1,9 +1,9 @@
 """Headless Chromium for the browser tests: Debian's chromium and chromium-driver, driven by selenium.
 
-:func:`chromium` starts a browser with no network of its own (no component
+:class:`Browser` starts a browser with no network of its own (no component
 updates, sync or background requests), a fresh profile, and WebGL through
 SwiftShader (there is no GPU).  When CI is set, a missing browser is an
-error, not a skip.
+error, not a skip.  benchmarks/view.py loads its page in the same browser.
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ import shutil
 import tempfile
 
 import numpy as np
-import pytest
 
 CHROMIUM = os.environ.get("LIGANIMATE_CHROMIUM", "/usr/bin/chromium")
 CHROMEDRIVER = os.environ.get("LIGANIMATE_CHROMEDRIVER", "/usr/bin/chromedriver")
@@ -37,17 +36,27 @@ FLAGS = [
 ]
 
 
-def require_chromium() -> None:
-    """Skip (or, under CI, fail) when Chromium or its driver is missing."""
-    missing = [p for p in (CHROMIUM, CHROMEDRIVER) if not os.path.exists(p)]
+def missing() -> list[str]:
+    """What :class:`Browser` needs and this machine lacks: Chromium's and its driver's paths, the selenium package."""
+    lacking = [p for p in (CHROMIUM, CHROMEDRIVER) if not os.path.exists(p)]
     try:
         import selenium  # noqa: F401
     except ImportError:
-        missing.append("the selenium package")
-    if missing:
+        lacking.append("the selenium package")
+    return lacking
+
+
+def require_chromium() -> None:
+    """Skip (or, under CI, fail) when Chromium or its driver is missing."""
+    # pytest is imported here, not at the top: benchmarks/view.py drives the
+    # same browser through this module and runs without the test extra.
+    import pytest
+
+    lacking = missing()
+    if lacking:
         why = (
             "browser tests need "
-            + ", ".join(missing)
+            + ", ".join(lacking)
             + " (apt-get install chromium chromium-driver; pip install -e '.[test]')"
         )
         if os.environ.get("CI"):
