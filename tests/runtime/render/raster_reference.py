@@ -1,467 +1,234 @@
-"""Reference for tests and benchmarks: the rasterizer as of commit 2526992, frozen.
+"""A second rasterizer, written plainly from the documented rules, to check runtime/render/raster.py against.
 
-Do not optimise this file: it is what runtime/render/raster.py is checked
-against byte for byte (tests/runtime/render/test_raster_crosscheck.py) and
-timed against (benchmarks/raster.py).  Its original description follows.
+It shares no code with the live camera or rasterizer: from a ``Camera`` it
+reads only the four numbers that define a view (``point``, ``width``,
+``size``, ``near``) and derives the rest itself from the formulas in
+docs/semantics-render.md ("Camera").  Where the live rasterizer turns
+triangles into row spans for all triangles at once, this one takes one
+triangle at a time and tests every pixel centre of its bounding box with
+three edge functions; where the live one interpolates 1/z along each span,
+this one weighs the vertices' 1/z by barycentric coordinates at each pixel
+centre.  The rules it implements, all from docs/semantics-render.md:
 
-A vectorized z-buffer rasterizer for flat-shaded triangles.
+* projection: ``x = W/2 + F x/z``, ``y = H/2 - F y/z``, ``F = |P| W / w``,
+  camera axes from the forward direction and the +Y (or, looking along Y,
+  -Z) up hint;
+* near clipping: a triangle is cut along the plane ``z = near`` into one or
+  two triangles keeping its number, new vertices interpolated from the
+  vertex in front towards the one behind;
+* coverage: a pixel whose centre is strictly inside, or exactly on a left
+  or top edge (the top-left rule); triangles of no area draw nothing;
+* depth: the key of a covered pixel is the upper 32 bits of the float64
+  1/z at its centre (linear in screen space, kept within the vertices'
+  range) above the triangle's number; the largest key wins, so the nearer
+  surface, and at equal depth the later triangle;
+* facing: ``(v1 - v0) x (v2 - v0)`` pointing towards the eye; a back face's
+  1/z is scaled down by 4e-6, and one flagged in ``cull`` is not drawn;
+* anti-aliasing: ``aa x aa`` samples per pixel, drawn as an image ``aa``
+  times larger, each pixel the integer mean of its block rounded half up.
 
-No Python loop runs per triangle, row or pixel.  The pipeline:
+Float results agree with the live code's to the last bit or two, not
+always exactly (operations in another order), so on random scenes the two
+could disagree only where a pixel centre lies within about 1e-13 pixels of
+an edge or two depths straddle a key boundary, which the cross-checked
+scenes do not meet.  Where a centre lies exactly on an edge, this module's
+edge functions are exact for the test's lattice scenes, so it applies the
+top-left rule as documented; the live code agrees when the edge's slope is
+exact in binary, and not always otherwise (see the xfail in
+test_raster_crosscheck.py).
 
-1. to camera space; back faces dropped where ``cull`` allows;
-2. clipping against the near plane (a triangle with one vertex behind it
-   becomes a quadrilateral, i.e. two triangles; with two behind, a smaller
-   triangle);
-3. projection; each triangle splits at its middle vertex into two
-   trapezoids, and each trapezoid gives one span per pixel row, bounded by
-   its two edges' crossings of the row's centre line;
-4. spans expand to fragments (pixels) with ``np.repeat``; each fragment
-   gets an int64 key: the upper 32 bits of the float64 ``1/z`` (sign,
-   exponent and 20 mantissa bits, so keys order like depths to about 1e-6
-   relative) above the triangle's number.  One ``np.maximum.at`` then does
-   the depth test *and* the tie rule: nearer wins, and at equal depth the
-   higher triangle number wins.
-
-Coverage rule: a pixel belongs to a triangle when its centre lies inside it;
-a centre exactly on an edge belongs to the triangle to its right, or below it
-for a horizontal edge (the top-left rule).  Two triangles sharing an edge
-therefore never both cover, nor both miss, a pixel along it: the crossing
-point of a shared edge is computed from the same two vertices in the same
-order in both triangles, so it is bit-identical.
-
-Speed notes (measured with callgrind and wall time; see
-``benchmarks/raster.py``): ``np.repeat`` costs a few instructions per element
-where a gather (``np.take``, fancy indexing) costs 15-30, so per-span values
-reach fragments by repeating, never by gathering with a span index.  With
-EMPTY = 0 a new depth buffer is ``np.zeros``, whose pages the kernel supplies
-zeroed on first touch: cheaper than keeping a buffer and clearing it.
+Slow by design (a Python loop over triangles, numpy only over one
+bounding box at a time): use small images.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from liganimate.runtime.errors import RenderError
-from liganimate.runtime.render.camera import Camera
-
-# The depth buffer's "nothing drawn here".  Every fragment's key is
-# positive (it starts with the bits of a positive float64).
-EMPTY = 0
-
-_INDEX_BITS = 32
-_INDEX_MASK = (1 << _INDEX_BITS) - 1
-_DEPTH_MASK = ~_INDEX_MASK
-_MAX_TRIANGLES = 1 << 31
-
-# Back-facing triangles have their 1/z scaled down by this fraction (about
-# four units of the key's last depth bit).  For a closed solid seen from
-# outside, every back-face pixel is also covered by a front face of the same
-# solid at a depth no greater; along silhouettes the two depths are equal up
-# to rounding, and the bias makes the front face win that near-tie, so
-# drawing back faces (cull=None) gives exactly the image that culling them
-# gives.
-_BACK_BIAS = 4e-6
-
-# Fragments expanded at once; bounds temporary memory at about 50 bytes each.
-_CHUNK = 1 << 18
+# docs/semantics-render.md, "Back faces and culling".
+BACK_BIAS = 4e-6
+# docs/semantics-render.md, "Camera": within this sine of the Y axis, -Z is the up hint.
+PARALLEL_SINE = 1e-9
 
 
-def rasterize(triangles, shade, camera: Camera, background: int = 255, cull=None) -> np.ndarray:
-    """Draw flat-shaded triangles with a z-buffer into a new image.
+def rasterize(triangles, shade, camera, background=255, cull=None, aa: int = 1) -> np.ndarray:
+    """Draw flat-shaded triangles with a depth buffer, one triangle at a time.
 
     Parameters
     ----------
-    triangles : array_like, shape (N, 3, 3)
-        World-space vertices, ``triangles[i, k]`` is vertex ``k`` of
-        triangle ``i``.
-    shade : array_like, shape (N,)
-        Grey level (0 black .. 255 white) of each triangle.
-    camera : Camera
-        The view; its ``size`` is the image size.
-    background : int, optional
-        Grey level where no triangle is drawn; default 255 (white).
-    cull : array_like of bool, shape (N,), optional
-        True where the triangle is part of a closed solid whose faces are
-        wound counter-clockwise seen from outside (outward right-hand
-        normals); such triangles are dropped when they face away from the
-        eye.  This is only a speed-up: for closed solids seen from outside
-        the image is the same with or without it.
-
-    Returns
-    -------
-    ndarray, shape (H, W), uint8
-        The image, row 0 at the top.
-
-    Raises
-    ------
-    RenderError
-        If the arrays have the wrong shape, coordinates are not finite, or a
-        grey level is outside 0..255.
-    """
-    W, H = camera.size
-    img = np.full((H, W), _grey(background, "background"), dtype=np.uint8)
-    # Nothing drawn yet: the depth buffer need only span the pixels touched.
-    _draw(None, img, triangles, shade, camera, cull, 0)
-    return img
-
-
-class Framebuffer:
-    """An image and its depth buffer, accumulating several draws.
-
-    Draws share the depth test, so e.g. several ticks drawn into one image
-    hide each other correctly; a later draw counts as "later" for the tie
-    rule.
-
-    Parameters
-    ----------
-    size : tuple of int
-        ``(W, H)`` in pixels.
-    background : int, optional
-        Initial grey level; default 255.
-
-    Attributes
-    ----------
-    image : ndarray, shape (H, W), uint8
-        The image so far (updated in place by :meth:`draw`).
-    zbuf : ndarray, shape (H, W), int64
-        Depth keys (see :func:`rasterize_into`); ``EMPTY`` where nothing is drawn.
-    count : int
-        Triangles drawn so far; the next draw's triangles are numbered from here.
-    """
-
-    def __init__(self, size, background: int = 255):
-        try:
-            W, H = (int(s) for s in size)
-            ok = W > 0 and H > 0 and (W, H) == tuple(size)
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise RenderError(f"The image size must be two positive whole numbers, not {size!r}.")
-        self.size = (W, H)
-        self.image = np.full((H, W), _grey(background, "background"), dtype=np.uint8)
-        self.zbuf = np.zeros((H, W), dtype=np.int64)  # all EMPTY
-        self.count = 0
-
-    def draw(self, triangles, shade, camera: Camera, cull=None) -> None:
-        """Draw triangles over what is already there, depth-tested.
-
-        Parameters
-        ----------
-        triangles : array_like, shape (N, 3, 3)
-            World-space vertices.
-        shade : array_like, shape (N,)
-            Grey levels 0..255.
-        camera : Camera
-            The view; ``camera.size`` must equal the framebuffer's size.
-        cull : array_like of bool, shape (N,), optional
-            See :func:`rasterize`.
-        """
-        self.count = rasterize_into(self.zbuf, self.image, triangles, shade, camera, cull, self.count)
-
-    def depth(self) -> np.ndarray:
-        """The depth of the visible surface at each pixel centre.
-
-        Returns
-        -------
-        ndarray, shape (H, W), float64
-            Camera-space depth to about 1e-6 relative (a back face that won
-            reads about 4e-6 too far, see ``_BACK_BIAS``); ``inf`` where
-            nothing was drawn.
-        """
-        drawn = self.zbuf != EMPTY
-        out = np.full(self.zbuf.shape, np.inf)
-        out[drawn] = 1.0 / (self.zbuf[drawn] & _DEPTH_MASK).view(np.float64)
-        return out
-
-
-def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first_index: int = 0) -> int:
-    """Draw triangles into an existing image and depth buffer.
-
-    Parameters
-    ----------
-    zbuf : ndarray, shape (H, W), int64, C-contiguous
-        Depth keys, updated in place.  Start from all ``EMPTY`` (zero).  A key is
-        the float64 ``1/z`` with its low 32 bits replaced by
-        ``first_index + i``: the larger key is the nearer surface, or at
-        equal depth the later triangle.  All draws into one buffer must
-        use the same camera.
-    img : ndarray, shape (H, W), uint8, C-contiguous
-        The image, updated in place where a triangle wins the depth test.
     triangles : array_like, shape (N, 3, 3)
         World-space vertices.
-    shade : array_like, shape (N,)
-        Grey levels 0..255.
+    shade : array_like, shape (N,) or (N, 3)
+        Grey levels or ``(r, g, b)`` colours, 0..255.
     camera : Camera
-        The view; ``camera.size`` must be ``(W, H)``.
+        The view; only ``point``, ``width``, ``size`` and ``near`` are read.
+    background : int or tuple of 3 int, optional
+        Grey level or colour where nothing is drawn; default 255.
     cull : array_like of bool, shape (N,), optional
-        See :func:`rasterize`.
-    first_index : int, optional
-        Number of triangle 0 for the tie rule; pass the previous call's
-        return value so later draws win ties.
+        True where a triangle facing away from the eye may be skipped.
+    aa : int, optional
+        Samples per pixel side; default 1.
 
     Returns
     -------
-    int
-        ``first_index + N``: the number to give the next draw.
+    ndarray, shape (H, W) or (H, W, 3), uint8
+        RGB when ``shade`` or ``background`` is a colour.
     """
-    W, H = camera.size
-    if img.shape != (H, W) or zbuf.shape != (H, W):
-        raise RenderError(
-            f"The camera's image size {W}x{H} does not match the {img.shape[1]}x{img.shape[0]} image being drawn into."
-        )
-    if not (img.flags.c_contiguous and zbuf.flags.c_contiguous and zbuf.dtype == np.int64 and img.dtype == np.uint8):
-        raise RenderError("The image and depth buffer must be C-contiguous uint8 and int64 arrays.")
-    return _draw(zbuf, img, triangles, shade, camera, cull, first_index)
-
-
-def _draw(zbuf, img, triangles, shade, camera, cull, first_index):
-    tris, shade = _check(triangles, shade, cull)
-    n = len(tris)
-    if first_index + n >= _MAX_TRIANGLES:
-        raise RenderError(f"Too many triangles in one image (more than {_MAX_TRIANGLES - 1}).")
-    spans = _spans(tris, cull, camera, first_index) if n else None
-    if spans is None:
-        return first_index + n
-    offset, wstart, step, tag, count = spans
-    flat_img = img.reshape(-1)
-    if zbuf is None:
-        # A fresh buffer: allocate depth keys for the touched range only.
-        drawn = count > 0
-        lo = int(offset[drawn].min())
-        hi = int((offset[drawn] + count[drawn]).max())
-        flat_z = np.zeros(hi - lo, dtype=np.int64)
-        flat_img = flat_img[lo:hi]
-        offset = offset - lo
-    else:
-        flat_z = zbuf.reshape(-1)
-    ends = np.cumsum(count)
-    if ends[-1] <= _CHUNK:
-        pix, key = _expand(offset, wstart, step, tag, count, ends)
-        np.maximum.at(flat_z, pix, key)
-        won = flat_z[pix] == key
-        # A pixel is won by at most one fragment (keys are unique per
-        # triangle, and a triangle covers a pixel at most once), so this
-        # assignment has no repeated indices.
-        flat_img[pix[won]] = shade[(key[won] & _INDEX_MASK) - first_index]
-        return first_index + n
-    # Too many fragments for one go: depth-test chunk by chunk, then find
-    # this draw's winners by scanning the whole buffer for its numbers.
-    lo = 0
-    for hi in np.searchsorted(ends, np.arange(_CHUNK, ends[-1], _CHUNK), side="right").tolist() + [len(count)]:
-        if hi > lo:
-            sl = slice(lo, hi)
-            pix, key = _expand(offset[sl], wstart[sl], step[sl], tag[sl], count[sl], None)
-            np.maximum.at(flat_z, pix, key)
-            lo = hi
-    num = flat_z & _INDEX_MASK
-    sel = np.flatnonzero((flat_z != EMPTY) & (num >= first_index))
-    flat_img[sel] = shade[num[sel] - first_index]
-    return first_index + n
-
-
-# Shared read-only aranges, grown as needed (replaced, never modified, so
-# threads may use them concurrently).
-_ARANGE = (np.arange(0, dtype=np.int64), np.arange(0, dtype=np.float64))
-
-
-def _expand(offset, wstart, step, tag, count, ends):
-    """Spans (P,) to fragments: pixel numbers (F,) and depth keys (F,)."""
-    global _ARANGE
-    if ends is None:
-        ends = np.cumsum(count)
-    n = int(ends[-1])
-    iar, far = _ARANGE
-    if len(iar) < n:
-        iar = np.arange(max(n, 2 * len(iar)), dtype=np.int64)
-        far = iar.astype(np.float64)
-        _ARANGE = (iar, far)
-    starts = ends - count
-    pix = np.repeat(offset - starts, count)
-    pix += iar[:n]
-    # 1/z = wstart + (i - start) * step for fragment i.  Anchoring the
-    # ramp at fragment 0 instead saves two passes; its extra rounding is
-    # about 1e-16 * start * |step| (start < _CHUNK + W, and |step| at most
-    # the triangle's 1/z range), far below the key's 1e-6 resolution.
-    w = np.repeat(step, count)
-    w *= far[:n]
-    w += np.repeat(wstart - starts * step, count)
-    key = w.view(np.int64)
-    key &= _DEPTH_MASK
-    key += np.repeat(tag, count)
-    return pix, key
-
-
-def _grey(value, what: str) -> int:
-    try:
-        v = int(value)
-    except (TypeError, ValueError):
-        v = -1
-    if v != value or not 0 <= v <= 255:
-        raise RenderError(f"The {what} grey level must be a whole number from 0 to 255, not {value!r}.")
-    return v
-
-
-def _check(triangles, shade, cull):
     tris = np.asarray(triangles, dtype=np.float64)
-    if tris.ndim != 3 or tris.shape[1:] != (3, 3):
-        raise RenderError(f"Triangles must be an array of shape (N, 3, 3), not {tris.shape}.")
-    if not np.isfinite(tris).all():
-        raise RenderError("A triangle has a coordinate that is not a finite number.")
-    s = np.asarray(shade)
-    if s.shape != (len(tris),):
-        raise RenderError(f"Expected {len(tris)} grey levels, one per triangle, got shape {s.shape}.")
-    if s.dtype != np.uint8:
-        if s.size and (not np.all(np.isfinite(s)) or s.min() < 0 or s.max() > 255 or np.any(s != np.round(s))):
-            raise RenderError("Grey levels must be whole numbers from 0 to 255.")
-        s = s.astype(np.uint8)
-    if cull is not None and np.shape(cull) != (len(tris),):
-        raise RenderError(f"Expected {len(tris)} cull flags, one per triangle, got shape {np.shape(cull)}.")
-    return tris, s
-
-
-def _spans(tris, cull, camera: Camera, first_index: int):
-    """Triangles (N, 3, 3) to spans: (pixel offset, 1/z at first pixel, 1/z step, key tag, length).
-
-    The pixel offset is ``row * W + first column``; all five arrays have
-    shape (P,), one entry per span, and some spans may be empty.  Returns
-    None when nothing is visible.
-    """
+    shade = np.asarray(shade).astype(np.uint8)
+    colour = shade.ndim == 2 or np.ndim(background) == 1
+    if colour:
+        shade = shade.reshape(len(tris), -1) * np.ones((1, 3), np.uint8)
+        background = np.asarray(background, np.uint8) * np.ones(3, np.uint8)
     W, H = camera.size
-    v0, v1, v2 = tris[:, 0], tris[:, 1], tris[:, 2]
-    # Facing is decided in world space (camera space is left-handed).
-    a, b = v1 - v0, v2 - v0
-    c = camera.point - v0
-    front = (
-        (a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]) * c[:, 0]
-        + (a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]) * c[:, 1]
-        + (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) * c[:, 2]
-    ) > 0.0
-    src = np.arange(len(tris))
-    if cull is not None:
-        keep = front | ~np.asarray(cull, dtype=bool)
-        if not keep.all():
-            src = np.flatnonzero(keep)
-            tris = tris[src]
-    cam, src = _clip_near(camera.to_camera(tris), src, camera.near)
-    m = len(src)
-    if m == 0:
-        return None
-
-    scr = camera.camera_to_pixels(cam)  # (m, 3, 3): x, y, depth
-    # Sorting vertices by y fixes the orientation of every edge (top end
-    # first), which is what makes shared edges bit-identical.
-    order = np.argsort(scr[:, :, 1], axis=1, kind="stable") + 3 * np.arange(m)[:, None]
-    scr = np.take(scr.reshape(-1, 3), order.reshape(-1), axis=0).reshape(m, 3, 3)
-    x0, x1, x2 = scr[:, 0, 0], scr[:, 1, 0], scr[:, 2, 0]
-    y0, y1, y2 = scr[:, 0, 1], scr[:, 1, 1], scr[:, 2, 1]
-    w0, w1, w2 = 1.0 / scr[:, 0, 2], 1.0 / scr[:, 1, 2], 1.0 / scr[:, 2, 2]
-
-    # Each triangle is two trapezoids: rows whose centre r + 0.5 lies in
-    # [y0, y1) are bounded by the long edge 0-2 and the upper edge 0-1,
-    # rows in [y1, y2) by the long edge and the lower edge 1-2.
-    r0 = np.clip(np.ceil(y0 - 0.5), 0, H).astype(np.int64)
-    r1 = np.clip(np.ceil(y1 - 0.5), 0, H).astype(np.int64)
-    r2 = np.clip(np.ceil(y2 - 0.5), 0, H).astype(np.int64)
-    det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
-    xmax = np.maximum(np.maximum(x0, x1), x2)
-    xmin = np.minimum(np.minimum(x0, x1), x2)
-    visible = (det != 0.0) & (xmax > 0.5 - 1e-9) & (xmin < W - 0.5 + 1e-9)
-    nrows = np.concatenate([np.where(visible, r1 - r0, 0), np.where(visible, r2 - r1, 0)])
-    if not nrows.any():
-        return None
-
-    # An edge's crossing with row centre cy is x = xtop + (cy - ytop) * s,
-    # from the edge's top vertex: the same numbers, in the same order, for
-    # every triangle sharing the edge.
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s_long = (x2 - x0) / (y2 - y0)
-        s_short = np.concatenate([(x1 - x0) / (y1 - y0), (x2 - x1) / (y2 - y1)])
-        # 1/z is affine in screen space: 1/z = wc + gx x + gy y.
-        gx = ((w1 - w0) * (y2 - y0) - (w2 - w0) * (y1 - y0)) / det
-        gy = ((x1 - x0) * (w2 - w0) - (x2 - x0) * (w1 - w0)) / det
-        wc = w0 - gx * x0 - gy * y0
-    wmin = np.minimum(np.minimum(w0, w1), w2)
-    wmax = np.maximum(np.maximum(w0, w1), w2)
-    if not front.all():
-        scale = np.where(front[src], 1.0, 1.0 - _BACK_BIAS)
-        wc, gx, gy, wmin, wmax = wc * scale, gx * scale, gy * scale, wmin * scale, wmax * scale
-    tag = first_index + src
-
-    # One entry per (trapezoid, row).  Pairs are grouped by trapezoid, so
-    # np.repeat spreads per-trapezoid values over them; it costs a few
-    # instructions per element where a gather (np.take, fancy indexing)
-    # costs 15-30.
-    def per_row(values):
-        return np.repeat(values, nrows)
-
-    def both(values):
-        return np.concatenate([values, values])
-
-    cy = np.arange(int(nrows.sum())) + per_row(np.concatenate([r0, r1]) - (np.cumsum(nrows) - nrows) + 0.5)
-    xa = per_row(both(x0)) + (cy - per_row(both(y0))) * per_row(both(s_long))
-    xb = per_row(np.concatenate([x0, x1])) + (cy - per_row(np.concatenate([y0, y1]))) * per_row(s_short)
-    c0 = np.minimum(np.maximum(np.ceil(np.minimum(xa, xb) - 0.5), 0), W)
-    c1 = np.minimum(np.maximum(np.ceil(np.maximum(xa, xb) - 0.5), 0), W)
-    count = (c1 - c0).astype(np.int64)
-    if not (count > 0).any():
-        return None
-
-    # 1/z at the first and last pixel centre, clamped to the triangle's range
-    # so that a sliver's ill-conditioned plane cannot produce a wild depth.
-    tgx = per_row(both(gx))
-    wrow = per_row(both(wc)) + cy * per_row(both(gy))
-    lo, hi = per_row(both(wmin)), per_row(both(wmax))
-    # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
-    wstart = np.fmin(np.fmax(wrow + (c0 + 0.5) * tgx, lo), hi)
-    wend = np.fmin(np.fmax(wrow + (c1 - 0.5) * tgx, lo), hi)
-    step = (wend - wstart) / np.maximum(count - 1, 1)
-    # Spans of no pixels stay: np.repeat skips them at no cost.
-    offset = ((cy - 0.5) * W + c0).astype(np.int64)
-    return offset, wstart, step, per_row(both(tag)), count
+    view = _View(camera.point, camera.width, W * aa, H * aa, camera.near)
+    keys = np.zeros((H * aa, W * aa), dtype=np.int64)  # 0: nothing drawn
+    eye = [float(c) for c in camera.point]
+    for number, tri in enumerate(tris.tolist()):
+        faces = _faces(tri, eye)
+        if not faces and cull is not None and cull[number]:
+            continue
+        for piece in _clip(view, [view.to_camera(p) for p in tri]):
+            _draw(keys, [view.to_pixels(p) for p in piece], number, 1.0 if faces else 1.0 - BACK_BIAS)
+    drawn = keys != 0
+    samples = np.empty(keys.shape + shade.shape[1:], np.uint8)
+    samples[...] = background
+    samples[drawn] = shade[keys[drawn] & 0xFFFFFFFF]
+    return box_filter(samples, aa)
 
 
-def _clip_near(cam, src, near: float):
-    """Clip camera-space triangles (M, 3, 3) to depth >= near.
+def box_filter(samples, aa: int) -> np.ndarray:
+    """Each ``aa x aa`` block's mean, rounded half up, in integers.
 
-    Returns the clipped triangles and, for each, the index of the triangle
-    it came from.  New vertices are always interpolated from the vertex in
-    front towards the vertex behind, so an edge shared by two triangles is
-    cut at a bit-identical point in both.
+    Parameters
+    ----------
+    samples : ndarray, shape (aa H, aa W) or (aa H, aa W, 3), uint8
+
+    Returns
+    -------
+    ndarray, shape (H, W) or (H, W, 3), uint8
     """
-    inside = cam[:, :, 2] >= near
-    nin = inside.sum(axis=1)
-    if (nin == 3).all():
-        return cam, src
-    out = [cam[nin == 3]]
-    out_src = [src[nin == 3]]
+    h, w = samples.shape[0] // aa, samples.shape[1] // aa
+    blocks = samples.reshape((h, aa, w, aa) + samples.shape[2:]).astype(np.int64)
+    total = blocks.sum(axis=(1, 3))
+    return ((total + aa * aa // 2) // (aa * aa)).astype(np.uint8)
 
-    def cut(a, b):
-        # a in front, b behind the plane.
-        t = (near - a[:, 2]) / (b[:, 2] - a[:, 2])
-        p = a + t[:, None] * (b - a)
-        p[:, 2] = near
-        return p
 
-    one = np.flatnonzero(nin == 1)
-    if len(one):
-        # Rotate so the vertex in front comes first; rotation keeps winding.
-        k = np.argmax(inside[one], axis=1)
-        v = cam[one]
-        a = v[np.arange(len(one)), k]
-        b = v[np.arange(len(one)), (k + 1) % 3]
-        c = v[np.arange(len(one)), (k + 2) % 3]
-        out.append(np.stack([a, cut(a, b), cut(a, c)], axis=1))
-        out_src.append(src[one])
+def _cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
-    two = np.flatnonzero(nin == 2)
-    if len(two):
-        k = np.argmin(inside[two], axis=1)  # the vertex behind
-        v = cam[two]
-        a = v[np.arange(len(two)), k]
-        b = v[np.arange(len(two)), (k + 1) % 3]
-        c = v[np.arange(len(two)), (k + 2) % 3]
-        pb, pc = cut(b, a), cut(c, a)
-        out.append(np.stack([b, c, pc], axis=1))
-        out.append(np.stack([b, pc, pb], axis=1))
-        out_src += [src[two], src[two]]
-    return np.concatenate(out), np.concatenate(out_src)
+
+def _sub(a, b):
+    return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _faces(tri, eye) -> bool:
+    """Whether the triangle's right-hand normal points towards the eye."""
+    v0, v1, v2 = tri
+    return _dot(_cross(_sub(v1, v0), _sub(v2, v0)), _sub(eye, v0)) > 0.0
+
+
+class _View:
+    """The camera of docs/semantics-render.md, from its defining numbers."""
+
+    def __init__(self, point, width, W, H, near):
+        self.eye = [float(c) for c in point]
+        distance = math.sqrt(_dot(self.eye, self.eye))
+        forward = [-c / distance for c in self.eye]
+        right = _cross(forward, [0.0, 1.0, 0.0])
+        if math.sqrt(_dot(right, right)) < PARALLEL_SINE:
+            right = _cross(forward, [0.0, 0.0, -1.0])
+        length = math.sqrt(_dot(right, right))
+        right = [c / length for c in right]
+        self.axes = [right, _cross(right, forward), forward]
+        self.F = distance * W / float(width)
+        self.W, self.H, self.near = W, H, float(near)
+
+    def to_camera(self, p):
+        q = _sub(p, self.eye)
+        return [_dot(q, axis) for axis in self.axes]
+
+    def to_pixels(self, c):
+        """Pixel x, pixel y and 1/z of a camera-space point."""
+        x, y, z = c
+        return (self.W / 2 + self.F * x / z, self.H / 2 - self.F * y / z, 1.0 / z)
+
+
+def _clip(view, verts):
+    """The triangles (lists of 3 camera-space points) of the part in front of the near plane.
+
+    A walk round the triangle keeps the vertices in front and adds a cut
+    point on each edge that crosses the plane, starting from a vertex in
+    front whose predecessor is not; the polygon is then fanned from its
+    first vertex.
+    """
+    near = view.near
+    front = [v[2] >= near for v in verts]
+    if all(front):
+        return [verts]
+    if not any(front):
+        return []
+    start = next(k for k in range(3) if front[k] and not front[k - 1])
+    poly = []
+    for k in range(start, start + 3):
+        a, b = verts[k % 3], verts[(k + 1) % 3]
+        if front[k % 3]:
+            poly.append(a)
+        if front[k % 3] != front[(k + 1) % 3]:
+            inner, outer = (a, b) if front[k % 3] else (b, a)
+            t = (near - inner[2]) / (outer[2] - inner[2])
+            poly.append([inner[0] + t * (outer[0] - inner[0]), inner[1] + t * (outer[1] - inner[1]), near])
+    return [[poly[0], poly[k], poly[k + 1]] for k in range(1, len(poly) - 1)]
+
+
+def _edge(a, b, px, py):
+    """Twice the signed area of (a, b, p): positive when p is right of a -> b on screen (y down)."""
+    return (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])
+
+
+def _owns(a, b) -> bool:
+    """Whether centres exactly on edge a -> b (interior on its positive side) are inside.
+
+    With that orientation a left edge runs upward on screen (y down) and a
+    top edge, horizontal, runs to the right.
+    """
+    return b[1] < a[1] or (b[1] == a[1] and b[0] > a[0])
+
+
+def _draw(keys, pts, number, scale):
+    """Depth-test one projected triangle (3 of (x, y, 1/z)) into ``keys`` (H, W), int64."""
+    p0, p1, p2 = pts
+    area = _edge(p0, p1, p2[0], p2[1])
+    if area == 0.0:
+        return
+    if area < 0.0:
+        p1, p2 = p2, p1
+        area = -area
+    H, W = keys.shape
+    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
+    c0, c1 = max(0, math.floor(min(xs))), min(W, math.floor(max(xs)) + 1)
+    r0, r1 = max(0, math.floor(min(ys))), min(H, math.floor(max(ys)) + 1)
+    if c0 >= c1 or r0 >= r1:
+        return
+    px = np.arange(c0, c1, dtype=np.float64)[None, :] + 0.5
+    py = np.arange(r0, r1, dtype=np.float64)[:, None] + 0.5
+    inside = np.ones((r1 - r0, c1 - c0), dtype=bool)
+    # weight[k]: the edge function of the edge opposite vertex k.
+    weight = {}
+    for k, (a, b) in enumerate([(p1, p2), (p2, p0), (p0, p1)]):
+        e = _edge(a, b, px, py)
+        inside &= (e > 0.0) | ((e == 0.0) & _owns(a, b))
+        weight[k] = e
+    if not inside.any():
+        return
+    w = (weight[0] * p0[2] + weight[1] * p1[2] + weight[2] * p2[2]) / area
+    w = np.clip(w, min(p[2] for p in pts), max(p[2] for p in pts)) * scale
+    key = ((w.view(np.int64) >> 32) << 32) | number
+    box = keys[r0:r1, c0:c1]
+    np.copyto(box, key, where=inside & (key > box))
