@@ -59,17 +59,17 @@ def rasterize(triangles, shade, camera, background=255, cull=None, aa: int = 1) 
     Parameters
     ----------
     triangles : array_like, shape (N, 3, 3)
-        World-space vertices.
+        Corner ``k`` of triangle ``i`` is ``triangles[i, k]``, in world coordinates.
     shade : array_like, shape (N,) or (N, 3)
-        Grey levels or ``(r, g, b)`` colours, 0..255.
+        One level 0..255, or one ``(r, g, b)`` of them, per triangle.
     camera : Camera
-        The view; only ``point``, ``width``, ``size`` and ``near`` are read.
+        Read for ``point``, ``width``, ``size`` and ``near`` only.
     background : int or tuple of 3 int, optional
-        Grey level or colour where nothing is drawn; default 255.
+        What empty pixels show (default 255).
     cull : array_like of bool, shape (N,), optional
-        True where a triangle facing away from the eye may be skipped.
+        Where True, the triangle is left out if it faces away from the eye.
     aa : int, optional
-        Samples per pixel side; default 1.
+        Each pixel averages ``aa x aa`` samples (default 1).
 
     Returns
     -------
