@@ -12,23 +12,10 @@ from liganimate.runtime.studio import (
     circle,
     joint_axes,
     sphere,
-    studio_model,
 )
 from liganimate.runtime.studio._genes import directions, solutions, wrap
 
-
-@pytest.fixture(scope="module")
-def humanoid():
-    fig, name, _ = studio_model(None, None)
-    assert name == "HUMANOID"
-    return fig
-
-
-@pytest.fixture(scope="module")
-def human(tmp_path_factory):
-    """The Appendix A human: other axes, repeated segment names, extremes that exclude 0."""
-    fig, _name, _ = studio_model(None, "HUMAN")
-    return fig
+# humanoid and human come from conftest.py.
 
 
 @pytest.fixture(scope="module")
