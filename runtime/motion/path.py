@@ -7,8 +7,10 @@ way: a path *continues*.  ``a + b`` plays ``b``'s displacement from where
 ``a`` ended, ``n * a`` walks on copy after copy, and reversal walks back
 from where it starts.  Two lazy nodes do it without copying keyframes:
 :class:`Shift` (a track moved by a constant) and :class:`Drift` (``n``
-copies, each moved by the displacement of the ones before).  The laws are
-written out in ``docs/semantics-motion.md``.
+copies, each moved by the displacement of the ones before), and a third,
+:class:`Reversal`, remembers what a reversal reversed so that reversing
+twice gives the path back exactly.  The laws are written out in
+``docs/semantics-motion.md``.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import numpy as np
 
 from . import track as tr
 
-__all__ = ["Drift", "Shift", "concat", "repeat", "reverse", "shift"]
+__all__ = ["Drift", "Reversal", "Shift", "concat", "repeat", "reverse", "shift"]
 
 
 class Shift(tr.Track):
@@ -86,6 +88,8 @@ def shift(track: tr.Track, d) -> tr.Track:
     d = np.asarray(d, dtype=float).reshape(3)
     if not d.any():
         return track
+    if isinstance(track, Reversal):  # a moved reversal is another path: fold into what it plays
+        return shift(track.played, d)
     if isinstance(track, Shift):
         return Shift(track.inner, track.d + d)
     if isinstance(track, tr.Const):
@@ -247,6 +251,68 @@ def repeat(a: tr.Track, n: int, period: float) -> tr.Track:
     return tr.concat(tr.concat(head, mids, period), tail, (n - 1) * period, end=plain.end)
 
 
+class Reversal(tr.Track):
+    """A path played backwards over ``length`` frames, remembering the path it reverses.
+
+    Mirroring a frame ``x`` to ``length - x`` is not an involution in
+    floating point: ``20 - (20 - 1.6)`` is ``1.6000000000000014``.  Mirroring
+    twice would move every step and junction that lies where the subtraction
+    rounds, and a pose that jumps there would differ by the whole jump just
+    beside it.  So reversing this node again over the same ``length`` hands
+    back ``origin`` instead of mirroring what it plays.
+
+    Parameters
+    ----------
+    origin : Track
+        The path reversed; ``origin.end <= length``.
+    length : float
+    played : Track
+        What the reversal shows: ``origin`` mirrored about ``length / 2``,
+        moved to start where ``origin`` starts; ends at ``length``.
+    """
+
+    __slots__ = ("length", "origin", "played")
+
+    def __init__(self, origin: tr.Track, length: float, played: tr.Track):
+        self.origin, self.length, self.played = origin, float(length), played
+        self.end = played.end
+        self.start_value, self.end_value = played.start_value, played.end_value
+        self.min_keys = played.min_keys
+
+    def children(self):
+        return (self.played,)
+
+    def sample(self, t):
+        return self.played.sample(t)
+
+    def sample_x(self, t):
+        return self.played.sample_x(t)
+
+    def _reversed(self, length, memo):
+        # A time mirror alone (a piece of a reversed sum): over the same length it is the
+        # origin, moved as ``played`` moved it.
+        if length == self.length:
+            return shift(self.origin, self.origin.start_value - self.origin.end_value)
+        return tr.reverse(self.played, length, memo)
+
+    def _scaled_frames(self, r, memo):
+        # Stretching commutes with reversal; the played path is stretched as before, so
+        # only the memory is new.
+        return Reversal(tr.scale_frames(self.origin, r, memo), self.length * r, tr.scale_frames(self.played, r, memo))
+
+    def _mapped(self, m, memo):  # pragma: no cover - angle maps never reach a root path
+        raise TypeError("a root path has no angles to map")
+
+    def _emit(self, out, offset):
+        self.played._emit(out, offset)
+
+    def _edge_leaf(self, side):
+        return tr.edge_leaf(self.played, side)
+
+    def _with_edge(self, side, edge):
+        return tr.with_edge(self.played, side, edge)
+
+
 def reverse(a: tr.Track, length: float, memo: dict | None = None) -> tr.Track:
     """The path played backwards over ``length`` frames: ``a'(t) = a(length - t) - a(length) + a(0)``.
 
@@ -261,6 +327,10 @@ def reverse(a: tr.Track, length: float, memo: dict | None = None) -> tr.Track:
     Returns
     -------
     Track
-        Starts where ``a`` starts and walks back: a reversed walk walks backwards.
+        Starts where ``a`` starts and walks back: a reversed walk walks
+        backwards.  Reversing a :class:`Reversal` over its own length gives
+        back the very path it reversed.
     """
-    return shift(tr.reverse(a, length, memo), a.start_value - a.end_value)
+    if isinstance(a, Reversal) and a.length == length:
+        return a.origin
+    return Reversal(a, length, shift(tr.reverse(a, length, memo), a.start_value - a.end_value))

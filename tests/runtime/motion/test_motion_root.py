@@ -28,7 +28,9 @@ def walk(step=1.6, length=16.0, start=(0.0, 0.0, 0.0), method="LINEAR") -> Motio
 @st.composite
 def rooted(draw):
     n = draw(st.integers(1, 3))
-    frames = sorted(draw(st.lists(st.floats(0.5, 20.0), min_size=n, max_size=n, unique=True)))  # steps: see report
+    frames = sorted(draw(st.lists(st.floats(0.5, 20.0), min_size=n, max_size=n)))
+    if draw(st.booleans()):
+        frames.append(frames[-1])  # a step at the path's end: where reversal used to round
     pos = st.tuples(*[st.floats(-5.0, 5.0)] * 3)
     keys = [(f, draw(pos), draw(st.sampled_from(METHODS))) for f in frames]
     joint = {2: ((0, 0, 0), [(draw(st.floats(0.5, 20.0)), (0, 0, 5), "LINEAR")])}
@@ -64,8 +66,57 @@ def test_n_times_is_a_sum_of_copies(a, n):
 @settings(max_examples=25, deadline=None)
 @given(rooted())
 def test_reversal_twice_is_the_identity(a):
-    same_path(a.scale_frames(-1.0).scale_frames(-1.0), a)
-    same_path((3 * a).scale_frames(-1.0).scale_frames(-1.0), 3 * a, atol=1e-8)
+    for m in (a, 3 * a):
+        twice = m.scale_frames(-1.0).scale_frames(-1.0)
+        t = times(m)
+        np.testing.assert_array_equal(twice.root_offset(t), m.root_offset(t))
+        assert twice.length == m.length
+
+
+def stepping(end: float, length: float) -> Motion:
+    """A path that ends with a step at ``end`` (two keyframes on one frame), in a motion of ``length``."""
+    keys = [
+        (end / 2, (1.0, 2.0, 0.0), "DECELERATE"),
+        (end, (3.0, 0.0, 1.0), "ACCELERATE"),
+        (end, (5.0, 1.0, 0.0), "LINEAR"),
+    ]
+    return Motion.from_tracks({2: ((0, 0, 0), [(length, (0, 0, 5), "LINEAR")])}, root=((0.0, 0.0, 0.0), keys))
+
+
+def around(frames) -> np.ndarray:
+    """Each frame and the doubles on either side of it."""
+    f = np.asarray(frames, dtype=float)
+    return np.concatenate([np.nextafter(f, -np.inf), f, np.nextafter(f, np.inf)])
+
+
+@pytest.mark.parametrize(
+    ("n", "end", "length"),
+    # 3 * 10.7 ends at 32.099999999999994: its junctions 10.7 and 21.4 mirror to 21.399999999999995
+    # and 10.699999999999996, not to the reversed repeat's own 21.4 and 10.7.  1.6 in 20 frames:
+    # the path holds after its step, and 20 - (20 - 1.6) is 1.6000000000000014.
+    [(3, 10.7, 10.7), (5, 1.6, 1.6), (3, 12.7, 12.7), (1, 1.6, 20.0), (3, 1.6, 20.0)],
+)
+def test_reversing_twice_a_path_that_steps_gives_it_back_exactly(n, end, length):
+    m = n * stepping(end, length)
+    twice = m.scale_frames(-1.0).scale_frames(-1.0)
+    # The step of every copy, the junctions and the end, and a beat either side of each.
+    steps = [k * length + end for k in range(n)] + [k * length for k in range(n + 1)]
+    t = np.concatenate([around(steps), times(m)])
+    np.testing.assert_array_equal(twice.root_offset(t), m.root_offset(t))
+
+
+def test_a_reversed_path_remembers_what_it_reversed_through_stretching_and_sums():
+    m = 3 * stepping(10.7, 10.7)
+    t = np.concatenate([around([10.7, 21.4, 32.1]), times(m)])
+    back = m.scale_frames(-2.0).scale_frames(-0.5)  # stretched, then shrunk: the same frames
+    np.testing.assert_array_equal(back.root_offset(t), m.root_offset(t))
+    # Reversing a sum reverses its pieces; where the sum's reversal mirrors a reversed piece's
+    # span exactly (here 48.099999999999994 - 32.099999999999994 is 16), it comes back as it was, moved.
+    w = walk()
+    both = (m.scale_frames(-1.0) + w).scale_frames(-1.0)
+    want = w.scale_frames(-1.0) + m
+    t = np.concatenate([around([both.length - k * 10.7 for k in range(4)]), times(both)])
+    np.testing.assert_allclose(both.root_offset(t), want.root_offset(t), atol=1e-12, rtol=0)
 
 
 @settings(max_examples=25, deadline=None)
@@ -158,6 +209,9 @@ def test_pickled_motions_keep_their_path():
 
     w = 3 * walk()
     same_path(pickle.loads(pickle.dumps(w)), w)
+    back = pickle.loads(pickle.dumps(w.scale_frames(-1.0)))
+    same_path(back, w.scale_frames(-1.0))
+    same_path(back.scale_frames(-1.0), w)
 
 
 def test_every_method_interpolates_a_root_track_like_a_joint_track():
