@@ -160,7 +160,7 @@ def main(argv=None) -> int:
         )
         small = program if ticks <= 2_000 else scene_program(folder, 2_000)
         draws = captured_draws(small, 40 if args.quick else 120)
-        ms480, ms1080 = draw_ratio(draws, 3 if args.quick else 5)
+        ms480, ms1080 = draw_ratio(draws, 5)
         print(
             f"draw step: {ms480:.2f} ms at 640x480, {ms1080:.2f} ms at 1920x1080: {ms1080 / ms480:.2f}x "
             f"for 6.75x the pixels",
