@@ -18,6 +18,7 @@ from liganimate import __version__
 from liganimate.lang import ast as A
 from liganimate.lang import bindings
 from liganimate.lang import numbers as N
+from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import MODIFIERS
 from liganimate.runtime.ik.solvers import DEFAULT_SOLVER, SOLVER_KEYWORDS
@@ -92,9 +93,10 @@ class Lowerer(NodeVisitor):
 
     # ------------------------------------------------------------- basics
     def at(self, node) -> int:
-        pos = node if isinstance(node, A.Pos) else node.pos
-        # A Pos is one int, equal exactly when its four numbers are: the key
-        # costs nothing more (a tuple of four ints took ~130 bytes a position).
+        # The module keeps lines and columns only (where a runtime error's caret
+        # goes); a Pos without its offsets is one int, equal exactly when those
+        # four numbers are: the key costs nothing more than the position.
+        pos = (node if isinstance(node, A.Pos) else node.pos).without_offsets()
         index = self.pos_index.get(pos)
         if index is None:
             index = self.pos_index[pos] = len(self.positions)
@@ -452,7 +454,7 @@ class Lowerer(NodeVisitor):
                 parts.append(f"('table', {item.value.name}, {item.value.name!r})")
             else:
                 t = self.type_of(item.value)
-                label = _source_text(self.c.program.source, item.value.pos)
+                label = spelling(self.c.program.source, item.value.pos)
                 parts.append(f"({t!r}, {self.expr(item.value)}, {label!r})")
         self.emit(f"rt.print_items(({''.join(p + ', ' for p in parts)}), {self.at(s)})")
 
@@ -648,22 +650,6 @@ def _tuple_target(names) -> str:
 
 def _tuple_value(names) -> str:
     return "(" + "".join(n + ", " for n in names) + ")"
-
-
-def _source_text(source: str, pos: A.Pos) -> str:
-    lines = source.splitlines()
-    if pos.line == pos.end_line and 1 <= pos.line <= len(lines):
-        line = lines[pos.line - 1]
-        end = pos.end_column - 1
-        # A call's span stops at its last argument (the parser drops the
-        # ")" token); take the closing parentheses the label still needs.
-        while line[pos.column - 1 : end].count("(") > line[pos.column - 1 : end].count(")"):
-            close = line.find(")", end)
-            if close < 0:
-                break
-            end = close + 1
-        return line[pos.column - 1 : end].upper()
-    return "value"
 
 
 def lower(checked: Checked, name: str, consume: bool = False) -> str:

@@ -11,8 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Self
 
-_M12, _M24, _M64 = (1 << 12) - 1, (1 << 24) - 1, (1 << 64) - 1
-_START = _M24 | _M12 << 24  # the line and column bits of a packed Pos
+_M12, _M24, _M28, _M32, _M64 = (1 << 12) - 1, (1 << 24) - 1, (1 << 28) - 1, (1 << 32) - 1, (1 << 64) - 1
+_START = _M24 | _M12 << 24 | _M32 << 60  # the line, column and offset bits of a packed Pos
+_PLACE = (1 << 60) - 1  # the line and column bits: a Pos without its offsets
 _int_new = int.__new__
 
 
@@ -25,80 +26,118 @@ def _unzig(z: int) -> int:
 
 
 class Pos(int):
-    """A source span: 1-based lines and columns, end exclusive.
+    """A source span: 1-based lines and columns, end exclusive, and character offsets.
 
     Read it as ``pos.line``, ``pos.column``, ``pos.end_line`` and
-    ``pos.end_column``; make it as ``Pos(line, column, end_line, end_column)``.
-    It is a value: immutable, hashable, equal to another Pos with the same
-    four numbers.
+    ``pos.end_column``, which are where a diagnostic's caret and underline
+    go, and ``pos.start`` and ``pos.end``, the 0-based character offsets of
+    the text the construct occupies, so that ``text[pos.start:pos.end]`` is
+    its spelling. The two agree except around parentheses: the parser widens
+    the offsets of ``(A + B)`` over its parentheses (a parent's text and a
+    PRINT label keep them) while the caret stays on ``A + B``. A position not
+    made from program text (a synthetic one) has offsets 0 and 0.
 
-    A big program has millions of positions, so the four numbers are packed
-    into one int (48 bytes, where an object with four fields took 64 and
-    kept its line number alive in another 32). The usual span (line below
-    2**24, columns below 4096, at most 4095 lines long) packs into 60 bits;
-    any other is stored negated, each number zigzag-encoded in 64 bits.
+    Make it as ``Pos(line, column, end_line, end_column, start, end)``. It is
+    a value: immutable, hashable, equal to another Pos with the same six
+    numbers.
+
+    A big program has millions of positions, so the numbers are packed into
+    one int (56 bytes, where an object with six fields would take 72 and
+    keep its numbers alive in more). The usual span (line below 2**24,
+    columns below 4096, at most 4095 lines long, starting in the first
+    2**32 characters and at most 2**28 long, which a source of at most
+    64 MB always is) packs into 120 bits; any other is stored negated, each
+    number zigzag-encoded in 64 bits.
     """
 
     __slots__ = ()
 
-    def __new__(cls, line: int, column: int, end_line: int, end_column: int) -> Self:
+    def __new__(cls, line: int, column: int, end_line: int, end_column: int, start: int = 0, end: int = 0) -> Self:
         lines = end_line - line
+        length = end - start
         # (a | b) >> k is 0 exactly when both are in [0, 2**k): one test for range and sign.
-        if not ((column | end_column | lines) >> 12 or line >> 24):
-            return _int_new(cls, line | column << 24 | end_column << 36 | lines << 48)
+        if not ((column | end_column | lines) >> 12 or line >> 24 or start >> 32 or length >> 28):
+            return _int_new(cls, line | column << 24 | end_column << 36 | lines << 48 | start << 60 | length << 92)
         packed = 0
-        for shift, n in ((0, line), (64, column), (128, end_line), (192, end_column)):
+        for shift, n in enumerate((line, column, end_line, end_column, start, end)):
             z = _zig(n)
             if z > _M64:
                 raise OverflowError(f"position {n} is out of range")
-            packed |= z << shift
+            packed |= z << (64 * shift)
         return _int_new(cls, -1 - packed)
+
+    def _field(self, i: int) -> int:
+        return _unzig((-1 - self) >> (64 * i) & _M64)
 
     @property
     def line(self) -> int:
         """First line (1-based)."""
-        return self & _M24 if self >= 0 else _unzig((-1 - self) & _M64)
+        return self & _M24 if self >= 0 else self._field(0)
 
     @property
     def column(self) -> int:
         """First column (1-based)."""
-        return self >> 24 & _M12 if self >= 0 else _unzig((-1 - self) >> 64 & _M64)
+        return self >> 24 & _M12 if self >= 0 else self._field(1)
 
     @property
     def end_line(self) -> int:
         """Last line."""
-        return (self & _M24) + (self >> 48) if self >= 0 else _unzig((-1 - self) >> 128 & _M64)
+        return (self & _M24) + (self >> 48 & _M12) if self >= 0 else self._field(2)
 
     @property
     def end_column(self) -> int:
         """Column just after the end."""
-        return self >> 36 & _M12 if self >= 0 else _unzig((-1 - self) >> 192)
+        return self >> 36 & _M12 if self >= 0 else self._field(3)
+
+    @property
+    def start(self) -> int:
+        """Offset of the first character of the construct's text (0-based)."""
+        return self >> 60 & _M32 if self >= 0 else self._field(4)
+
+    @property
+    def end(self) -> int:
+        """Offset just after the construct's text."""
+        return (self >> 60 & _M32) + (self >> 92) if self >= 0 else self._field(5)
 
     def to(self, other: Pos) -> Pos:
         """The span from the start of ``self`` to the end of ``other``."""
         if self >= 0 and other >= 0:
-            lines = (other & _M24) + (other >> 48) - (self & _M24)
-            if not lines >> 12:
-                return _int_new(Pos, (self & _START) | (other >> 36 & _M12) << 36 | lines << 48)
-        return Pos(self.line, self.column, other.end_line, other.end_column)
+            lines = (other & _M24) + (other >> 48 & _M12) - (self & _M24)
+            length = (other >> 60 & _M32) + (other >> 92) - (self >> 60 & _M32)
+            if not (lines >> 12 or length >> 28):
+                return _int_new(Pos, (self & _START) | (other >> 36 & _M12) << 36 | lines << 48 | length << 92)
+        return Pos(self.line, self.column, other.end_line, other.end_column, self.start, other.end)
+
+    def widened(self, start: int, end: int) -> Pos:
+        """The same caret, with the offsets ``start``, ``end`` (a construct's text with its parentheses)."""
+        return Pos(self.line, self.column, self.end_line, self.end_column, start, end)
+
+    def without_offsets(self) -> Pos:
+        """The same lines and columns, with the offsets of a synthetic position (0 and 0)."""
+        if self >= 0:
+            return _int_new(Pos, self & _PLACE)
+        return Pos(self.line, self.column, self.end_line, self.end_column)
 
     def __bool__(self) -> bool:
         return True  # a position, not a number: even NOWHERE
 
     def __repr__(self) -> str:
-        return f"Pos(line={self.line}, column={self.column}, end_line={self.end_line}, end_column={self.end_column})"
+        text = f"Pos(line={self.line}, column={self.column}, end_line={self.end_line}, end_column={self.end_column}"
+        start, end = self.start, self.end
+        return text + (f", start={start}, end={end})" if start or end else ")")
 
     __str__ = __repr__
 
     def __reduce__(self):
-        return (Pos, (self.line, self.column, self.end_line, self.end_column))
+        return (Pos, (self.line, self.column, self.end_line, self.end_column, self.start, self.end))
 
 
-def token_pos(line: int, column: int, end_column: int) -> Pos:
-    """``Pos(line, column, line, end_column)``, quicker: the parser makes one for every name and number."""
-    if not ((column | end_column) >> 12 or line >> 24):
-        return _int_new(Pos, line | column << 24 | end_column << 36)
-    return Pos(line, column, line, end_column)
+def token_pos(line: int, column: int, end_column: int, start: int = 0, end: int = 0) -> Pos:
+    """``Pos(line, column, line, end_column, start, end)``, quicker: the parser makes one for every name and number."""
+    length = end - start
+    if not ((column | end_column) >> 12 or line >> 24 or start >> 32 or length >> 28):
+        return _int_new(Pos, line | column << 24 | end_column << 36 | start << 60 | length << 92)
+    return Pos(line, column, line, end_column, start, end)
 
 
 NOWHERE = Pos(0, 0, 0, 0)

@@ -32,7 +32,10 @@ from lark import Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedToken
 from lark.lexer import Lexer, TerminalDef
 
-_SKIP = r"(?:[ \t\f\r\n]+|\{[^}]*\})*"
+# Possessive (*+, ++): with plain quantifiers a run of n blanks before a
+# character that starts no token was split 2**n ways before the match
+# failed (30 blanks and a stray "_" took minutes: a hang any file could cause).
+_SKIP = r"(?:[ \t\f\r\n]++|\{[^}]*+\})*+"
 SCAN = re.compile(
     _SKIP
     + r"(?:(?P<w>[A-Za-z][A-Za-z0-9_]*)"

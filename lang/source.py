@@ -241,10 +241,49 @@ def prepare(text: str, filename: str) -> Source:
                     severity="warning",
                 )
             )
-        return ""
+        # Blanks, not nothing: every character keeps its offset, so that a
+        # position's offsets index the text as written (lang/ast.py's Pos).
+        return " " * len(match.group())
 
     prepared = _STAR_FLAG.sub(" ", _COMMENT_LINE.sub(blank, text))
     return Source(filename, text, prepared, warnings)
+
+
+# Each maximal run of blanks and {comments}, taken whole (possessive), so
+# that joining is linear however long a run is.
+_BLANKS = re.compile(r"(?:\s|\{[^}]*+\})++")
+
+
+def _joined(match: re.Match) -> str:
+    run = match.group()
+    return " " if "\n" in run or "{" in run else run
+
+
+def spelling(text: str, pos: Pos) -> str:
+    """The program's own spelling of the construct at ``pos``, on one line and upper-cased.
+
+    It is ``text[pos.start:pos.end]`` (the parser's offsets include the
+    parentheses and sign around a construct), with the comments the lexer
+    skips dropped: ``{...}``, and C comment lines and ``*`` flags as
+    :func:`prepare` blanks them. A line break or a comment, with the blanks
+    around it, becomes one space. A synthetic position spells "".
+
+    Parameters
+    ----------
+    text : str
+        The program text as written (``Source.text``).
+    pos : Pos
+        A position the parser made from that text.
+    """
+    start, end = pos.start, pos.end
+    if not 0 <= start < end <= len(text):
+        return ""
+    # Whole lines, so that the comment-line rule sees each line as the lexer did.
+    first = text.rfind("\n", 0, start) + 1
+    last = text.find("\n", end)
+    lines = text[first : len(text) if last < 0 else last]
+    lines = _STAR_FLAG.sub(" ", _COMMENT_LINE.sub(lambda m: " " * len(m.group()), lines))
+    return _BLANKS.sub(_joined, lines[start - first : end - first]).strip().upper()
 
 
 def load(path: str, display_name: str | None = None) -> Source:

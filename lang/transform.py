@@ -20,11 +20,11 @@ TOKENS = (Token, Tok)
 
 def _tpos(tok: Token | Tok) -> A.Pos:
     if type(tok) is Tok:
-        return A.token_pos(tok[3], tok[4], tok[5])
+        return A.token_pos(tok[3], tok[4], tok[5], tok[2], tok[6])
     # Lark types a Token's positions Optional, as a Token may be made without
     # them; the Tokens that reach here come from Tok.as_lark (LigLexer) or
     # Lark's own lexer, which set all four. Checking would cost every token.
-    return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column)  # type: ignore[arg-type]
+    return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column, tok.start_pos, tok.end_pos)  # type: ignore[arg-type]
 
 
 def _pos_of(x) -> A.Pos | None:
@@ -56,14 +56,14 @@ def span(children) -> A.Pos:
     if children:
         first, last = children[0], children[-1]
         if type(first) is Tok:
-            start = A.token_pos(first[3], first[4], first[5])
+            start = A.token_pos(first[3], first[4], first[5], first[2], first[6])
         elif isinstance(first, A.Node):
             start = first.pos
         else:
             start = None
         if start is not None:
             if type(last) is Tok:
-                return start.to(A.token_pos(last[3], last[4], last[5]))
+                return start.to(A.token_pos(last[3], last[4], last[5], last[2], last[6]))
             if isinstance(last, A.Node):
                 return start.to(last.pos)
     first = _pos_of(children)
@@ -72,6 +72,18 @@ def span(children) -> A.Pos:
     last = _last_pos_of(children)
     assert last is not None  # the scan from the front found a position, so the one from the back does
     return first.to(last)
+
+
+def _offsets(tok: Token | Tok) -> tuple[int, int]:
+    """The character offsets (start, end) of a token."""
+    if type(tok) is Tok:
+        return tok[2], tok[6]
+    return tok.start_pos, tok.end_pos  # type: ignore[return-value]  # set by both lexers, as in _tpos
+
+
+def _enclosed(pos: A.Pos, first: Token | Tok, last: Token | Tok) -> A.Pos:
+    """``pos`` with its text widened from ``first``'s start to ``last``'s end; its caret stays."""
+    return pos.widened(_offsets(first)[0], _offsets(last)[1])
 
 
 def _nodes(children):
@@ -327,7 +339,12 @@ class ToAst(Transformer):
         tok = children[0]
         pos = _tpos(tok)
         return A.PrintItem(
-            pos, "table", A.Name(A.Pos(pos.line, pos.column + 1, pos.end_line, pos.end_column), tok.value[1:].upper())
+            pos,
+            "table",
+            A.Name(
+                A.Pos(pos.line, pos.column + 1, pos.end_line, pos.end_column, pos.start + 1, pos.end),
+                tok.value[1:].upper(),
+            ),
         )
 
     def print_text(self, children):
@@ -352,7 +369,8 @@ class ToAst(Transformer):
         return A.Return(span(children))
 
     def draw_with(self, children):
-        return A.DrawWith(span(children), children[2])
+        draw, with_, (_lt, *mods, _gt) = children
+        return A.DrawWith(span([draw, with_, mods]), mods)
 
     def draw_poly(self, children):
         return A.DrawPoly(span(children), _nodes(children))
@@ -425,14 +443,29 @@ class ToAst(Transformer):
         return A.BinOp(span(children), "MOD", left, right, _tpos(op))
 
     def neg(self, children):
-        (operand,) = children
-        return A.Neg(operand.pos, operand)
+        minus, operand = children
+        # The caret stays on the operand, as it always has; the text takes the sign.
+        return A.Neg(operand.pos.widened(_offsets(minus)[0], operand.pos.end), operand)
+
+    def plus(self, children):
+        sign, operand = children
+        operand.pos = operand.pos.widened(_offsets(sign)[0], operand.pos.end)
+        return operand
+
+    def paren(self, children):
+        # (A + B) is the node A + B: its caret stays inside, its text takes the
+        # parentheses, so that an enclosing span and a PRINT label keep them.
+        lpar, node, rpar = children
+        node.pos = _enclosed(node.pos, lpar, rpar)
+        return node
 
     def modified(self, children):
-        target, mods = children
+        target, (_lt, *mods, gt) = children
+        # The caret ends at the last modifier, as it always has; the text at ">".
+        pos = span([target, mods]).widened(target.pos.start, _offsets(gt)[1])
         if isinstance(target, A.Modified):
-            return A.Modified(span(children), target.target, target.modifiers + mods)
-        return A.Modified(span(children), target, mods)
+            return A.Modified(pos, target.target, target.modifiers + mods)
+        return A.Modified(pos, target, mods)
 
     def number(self, children):
         return _number(children[0])
@@ -442,11 +475,12 @@ class ToAst(Transformer):
         return A.Var(_tpos(tok), upper_name(tok.value))
 
     def call(self, children):
-        tok = children[0]
-        return A.Call(span(children), upper_name(tok.value), list(children[1:]))
+        tok, args, rpar = children[0], children[2:-1], children[-1]
+        return A.Call(_enclosed(span([tok, *args]), tok, rpar), upper_name(tok.value), args)
 
     def tuple(self, children):
-        return A.Tuple(span(children), list(children))
+        items = children[1:-1]
+        return A.Tuple(_enclosed(span(items), children[0], children[-1]), items)
 
     def prim_call(self, children):
         tok = children[0]
@@ -457,7 +491,7 @@ class ToAst(Transformer):
         return A.Clause(span(children), upper_name(tok.value), value)
 
     def modlist(self, children):
-        return list(children)
+        return list(children)  # "<", the modifiers, ">": its user takes the ">" for its text
 
     # --------------------------------------------------------- conditions
     def cond_or(self, children):
@@ -474,7 +508,7 @@ class ToAst(Transformer):
         return A.Compare(span(children), op.value, left, right)
 
     def cond_group(self, children):
-        return children[0]
+        return self.paren(children)
 
 
 def _modifier_rule(kind: str, axis: bool):

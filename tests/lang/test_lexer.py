@@ -118,3 +118,26 @@ def test_contextual_words_and_operators():
 def test_mutated_programs_agree(index, steps):
     _, text = mutated(index, steps)
     agree(text)
+
+
+def test_a_long_run_of_blanks_before_a_bad_character_is_an_error_not_a_hang():
+    # The blank-skipping pattern once had nested plain quantifiers: before
+    # failing at a character that starts no token it tried every way of
+    # splitting the blanks in front of it, 2**n for n blanks (30 took
+    # minutes). The timeout only detects a hang, a thousand times what the
+    # parse takes; it measures nothing.
+    import subprocess
+    import sys
+
+    code = (
+        "from liganimate.lang.parser import parse\n"
+        "from liganimate.lang.diagnostics import LigDiagnostics\n"
+        "for blanks in (' ' * 40, '\\n' * 40, ' {a} ' * 40, ' \\t\\r\\n' * 5000):\n"
+        "    try:\n"
+        "        parse('X = 1' + blanks + '_bad = 2\\n')\n"
+        "    except LigDiagnostics as exc:\n"
+        "        print(exc.diagnostics[0].message)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == ["unexpected character '_'"] * 4

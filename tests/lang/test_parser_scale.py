@@ -300,7 +300,7 @@ def test_prepare_blanks_comments_and_flags_as_line_by_line(tmp_path):
             elif line[:1] in ("C", "c") and (len(line) == 1 or line[1] in " \t\r"):
                 if _LOOKS_LIKE_CODE.match(line):
                     warned.append(number)
-                line = ""
+                line = " " * len(line)  # blanked, so that every offset stays
             out.append(line)
         return "\n".join(out), warned
 
