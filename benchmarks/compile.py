@@ -38,9 +38,13 @@ import os
 import subprocess
 import sys
 import time
-from importlib import resources
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tests"))
+
+from bigprograms import mixed_lines, short_lines  # noqa: E402 - found through the sys.path line above
+from stock_lark import primitives, stock_parser  # noqa: E402
+
 APPENDIX_A = os.path.join(ROOT, "examples", "appendix_a.lig")
 THESIS_SECONDS = 1.139
 
@@ -93,33 +97,9 @@ def thesis_style_program(lines: int = 10_000) -> str:
     return "".join(out)
 
 
-def big_program(lines: int = 10_000) -> str:
-    """A dense program of ``lines`` lines, every line a statement, using most statement kinds."""
-    out = ["REAL X, Y", "VECTOR V", "MOTION M", "GRAPHICAL G", "MODEL A", "G :- BOX WIDTH 1, HEIGHT 2, DEPTH 0.5"]
-    i = 0
-    while len(out) < lines:
-        i += 1
-        out += [
-            f"X = X + {i}.5 * (Y - 2) / 3",
-            f"V = (X, Y, {i}) + V * 0.5",
-            f"M[{i % 20 + 1}, 1] := FRAME {i % 50 + 1} POSITION X, 0, {i % 90}",
-            f"IF X > {i} THEN Y = Y + 1 ELSE Y = Y - 1",
-            f"DO {i + 10} J = 1, 3",
-            "  Y = Y + J MOD 2",
-            f"{i + 10} CONTINUE",
-            f"A :- JOINT {i % 30 + 1}, G, (0, 1, 0), G, (0, -1, 0), (-45, 45), (0, 0), (-90, {i % 90})",
-        ]
-    return "\n".join(out[:lines]) + "\n"
-
-
-def short_lines_program(lines: int) -> str:
-    """``lines`` short assignment lines (``X17 = 17``) over a hundred variables, as issue 14's stress test."""
-    return "".join(f"X{i % 100} = {i}\n" for i in range(lines))
-
-
 #: The scale sizes and styles.
 SIZES = (1_000, 10_000, 50_000)
-STYLES = {"short": short_lines_program, "thesis": thesis_style_program}
+STYLES = {"short": short_lines, "thesis": thesis_style_program}
 
 
 def scale_times(rounds: int) -> dict:
@@ -210,34 +190,20 @@ def main(argv=None) -> int:
     big_rounds = 2 if args.quick else 5
     cold_rounds = 3 if args.quick else 10
 
-    from lark import Lark
-
     from liganimate.compiler import compile_text
     from liganimate.lang import parser as P
     from liganimate.lang.source import prepare
-    from liganimate.lang.transform import ToAst
 
     with open(APPENDIX_A, encoding="utf-8") as fh:
         text = fh.read()
     P.build_parser()
     compiled = compile_text(text, APPENDIX_A)
-    grammar = resources.files("liganimate.lang").joinpath("lig.lark").read_text(encoding="utf-8")
-    stock = Lark(
-        grammar,
-        parser="lalr",
-        lexer="contextual",
-        postlex=P._PrimitiveNames(),
-        transformer=ToAst(),
-        maybe_placeholders=False,
-    )
+    stock = stock_parser(whole_words=False)  # the grammar as it is: what a user of Lark would run
     lexed = prepare(text, APPENDIX_A).lexed
 
     def stock_parse():
-        token = P._primitive_names.set(P.BUILTIN_PRIMITIVES)
-        try:
+        with primitives(P.BUILTIN_PRIMITIVES):
             stock.parse(lexed)
-        finally:
-            P._primitive_names.reset(token)
 
     # Interleave the three so drifting load hits all alike.
     t_ours = t_parse = t_stock = t_python = float("inf")
@@ -253,7 +219,7 @@ def main(argv=None) -> int:
     )
 
     thesis = thesis_style_program()
-    big = big_program()
+    big = mixed_lines(10_000)
     t_thesis = t_big = float("inf")
     for _ in range(big_rounds):
         t_thesis = min(t_thesis, best(lambda: compile_text(thesis, "thesis_style.lig"), 1))

@@ -10,8 +10,8 @@ the parse. Here the same tables are renumbered once: a state's actions map
 a symbol to an int (a shift's next state, or ``~rule``), rules are a list,
 and a one-child ``?rule`` only changes the state on top of the stack.
 
-The tree is the one Lark's loop builds (tests/test_lexer.py checks this
-against Lark's stock contextual lexer and loop), and errors are Lark's
+The tree is the one Lark's loop builds (tests/lang/test_lexer.py checks
+this against Lark's stock contextual lexer and loop), and errors are Lark's
 ``UnexpectedToken`` and ``UnexpectedCharacters``, as before.
 """
 
@@ -124,9 +124,9 @@ class Driver:
     def parse(self, text: str, primitives: frozenset):
         """Parse ``text``; a NAME in ``primitives`` is a PRIM_NAME. Returns the start rule's value.
 
-        The scanner's loop (:meth:`Scanner.tokens`) and the LALR loop in
-        one: a generator between them cost a fifth of the time. The
-        scanner's decisions are its own methods, shared with ``tokens``.
+        The only loop that cuts the text, and the LALR loop, in one: a
+        generator between them cost a fifth of the time. What a word or an
+        operator is in a state is the :class:`~.lexer.Scanner`'s decision.
         """
         actions = self.actions
         rules = self.rules

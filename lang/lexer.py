@@ -16,9 +16,9 @@ reports it as unexpected. Operators take the longest spelling the state
 accepts (``<=`` is RELOP in a condition but ``<`` then ``=`` in a modifier
 list).
 
-:class:`Scanner` does the work and yields light :class:`Tok` tuples to
-:mod:`liganimate.lang.lalr`'s loop; :class:`LigLexer` wraps it for Lark's
-own loop.
+:class:`Scanner` holds those decisions and :mod:`liganimate.lang.lalr`'s
+loop makes light :class:`Tok` tuples with them; Lark's own loop is not used
+(:class:`TablesOnly`).
 """
 
 from __future__ import annotations
@@ -171,16 +171,18 @@ class Tok(tuple):
 
 
 _new_tok = tuple.__new__
-_NO_PRIMITIVES: frozenset = frozenset()
 
 
 class Scanner:
     """Cuts text into :class:`Tok` tokens, asking the parser's state which terminal each word is.
 
     ``states`` is the LALR table (state -> the symbols it accepts). The
-    parser shares its state stack with :meth:`tokens`, which reads the state
-    on top of it for each token, so the scanner always sees the state the
-    previous token left.
+    loop that cuts the text is :meth:`liganimate.lang.lalr.Driver.parse`
+    (scanning and parsing in one loop, as a generator between them cost a
+    fifth of the time); the decisions it asks for are here: which terminal
+    a keyword is in a state (:meth:`keyword`), which spelling of an
+    operator (:meth:`_operator`), and the error for a character that
+    starts no token.
     """
 
     def __init__(self, terminals: Collection[TerminalDef], states: dict) -> None:
@@ -195,59 +197,6 @@ class Scanner:
         if acc is None:
             acc = self._accepts[state] = frozenset(self.states[state])
         return acc
-
-    def tokens(self, text: str, stack: list, primitives: frozenset = _NO_PRIMITIVES):
-        """Yield the tokens of ``text``; ``stack[-1]`` is the parser's state.
-
-        A NAME in ``primitives`` becomes PRIM_NAME (the post-lexer's rule,
-        done here when the caller has no post-lexer).
-        """
-        pos = 0
-        line, line_start = 1, 0
-        scan = SCAN.match
-        tables = self.tables
-        keywords = tables.keywords
-        choice = self._choice
-        count = text.count
-        ttype: str | None  # None only between a missed operator choice and _operator
-        while True:
-            m = scan(text, pos)
-            if m is None:
-                self.unexpected_character(text, pos, line, stack[-1])
-            k = m.lastindex
-            if not k:  # never: a match always ends in one of the groups; this narrows k for mypy
-                self.unexpected_character(text, pos, line, stack[-1])
-            start = m.start(k)
-            if start != pos:
-                nl = count(_NEWLINE, pos, start)
-                if nl:
-                    line += nl
-                    line_start = text.rfind(_NEWLINE, pos, start) + 1
-            end = m.end()
-            value = text[start:end]
-            if k == WORD:
-                word = value.upper()
-                if word in keywords:
-                    ttype = self.keyword(word, stack[-1], text, end)
-                    if ttype == "NAME" and word in primitives:
-                        ttype = "PRIM_NAME"
-                else:
-                    ttype = "PRIM_NAME" if word in primitives else "NAME"
-            elif k == NUMBER:
-                ttype = "NUMBER"
-            elif k == OPERATOR:
-                ttype = choice.get((stack[-1], value))
-                if ttype is None:
-                    ttype, value, end = self._operator(value, start, stack[-1])
-            elif k == STRING:
-                ttype = "STRING"
-            elif k == DOLLAR:
-                ttype = "DOLLAR_NAME"
-            else:
-                return
-            column = start - line_start + 1
-            yield _new_tok(Tok, (ttype, value, start, line, column, column + end - start, end))
-            pos = end
 
     def keyword(self, word: str, state, text: str, end: int) -> str:
         """The terminal the keyword ``word`` (upper-cased, ending at ``end``) is in parser state ``state``."""
@@ -297,33 +246,25 @@ class Scanner:
         return _OPERATORS[greedy][0], greedy, start + len(greedy)
 
 
-class LigLexer(Lexer):
-    """A Lark lexer (``lexer=LigLexer``) over :class:`Scanner`, for Lark's own LALR loop.
+class TablesOnly(Lexer):
+    """The lexer Lark is told about, so that it keeps the tables: it never scans.
 
-    :func:`liganimate.lang.parser.parse` drives the scanner with its own
-    loop (:mod:`liganimate.lang.lalr`); this adapter keeps ``Lark.parse``
-    working with the same tokens, for tests and tools.
+    The one loop that scans is :meth:`liganimate.lang.lalr.Driver.parse`,
+    which asks :class:`Scanner` for its decisions; a second scanning loop for
+    Lark's own ``Lark.parse`` would be the same rules written twice. Lark
+    builds this class when it loads the tables (cheaply, unlike its
+    contextual lexer, which compiles a scanner per parser state), and
+    ``Lark.parse`` is refused plainly.
     """
 
     __future_interface__ = 2
 
-    def __init__(self, lexer_conf):
+    def __init__(self, lexer_conf) -> None:
         self.terminals = lexer_conf.terminals
-        self._scanner = None
 
     def lex(self, lexer_state, parser_state):
-        text = lexer_state.text
-        text = getattr(text, "text", text)  # Lark 1.3 hands over a TextSlice
-        if self._scanner is None:
-            self._scanner = Scanner(self.terminals, parser_state.parse_conf.parse_table.states)
-        try:
-            for tok in self._scanner.tokens(text, parser_state.state_stack):
-                tok = tok.as_lark()
-                lexer_state.last_token = tok
-                yield tok
-        except UnexpectedCharacters as exc:
-            exc.state = parser_state
-            raise
+        """Refuse: liganimate parses with :func:`liganimate.lang.parser.parse`."""
+        raise NotImplementedError("liganimate parses with liganimate.lang.parser.parse, not Lark.parse")
 
 
-__all__ = ["LigLexer", "Scanner", "Tok", "UnexpectedToken"]
+__all__ = ["Scanner", "TablesOnly", "Tok", "UnexpectedToken"]

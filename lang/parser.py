@@ -9,7 +9,6 @@ and every Lark exception becomes a
 
 from __future__ import annotations
 
-import contextvars
 import functools
 import re
 
@@ -20,7 +19,7 @@ from . import ast as A
 from . import collector, tables
 from .diagnostics import Diagnostic, LigDiagnostics
 from .lalr import Driver
-from .lexer import LigLexer
+from .lexer import TablesOnly
 from .source import Source, prepare
 from .structure import group_blocks
 from .transform import ToAst
@@ -29,30 +28,14 @@ from .vocabulary import BLOCKS
 #: Primitives every program knows without defining them.
 BUILTIN_PRIMITIVES = frozenset({"BOX"})
 
-_primitive_names: contextvars.ContextVar = contextvars.ContextVar("primitive_names", default=BUILTIN_PRIMITIVES)
-
-
-class _PrimitiveNames:
-    """Post-lexer: a NAME that names a primitive becomes PRIM_NAME.
-
-    Primitive calls take their arguments by juxtaposition (``BOX WIDTH 1,
-    ...``); knowing which words are primitives is what keeps that from
-    swallowing the next statement of a newline-insensitive language.
-    """
-
-    always_accept = ()
-
-    def process(self, stream):
-        names = _primitive_names.get()
-        for tok in stream:
-            if tok.type == "NAME" and tok.value.upper() in names:
-                tok.type = "PRIM_NAME"
-            yield tok
-
 
 def grammar_parts() -> tuple:
-    """The lexer class, post-lexer and transformer the parser is made with."""
-    return LigLexer, _PrimitiveNames(), ToAst()
+    """The lexer class, post-lexer and transformer the parser's tables are made and loaded with.
+
+    The lexer never scans and there is no post-lexer: :mod:`.lalr` scans
+    and parses in one loop, PRIM_NAME included (see :class:`.lexer.TablesOnly`).
+    """
+    return TablesOnly, None, ToAst()
 
 
 @functools.lru_cache(maxsize=1)

@@ -22,8 +22,8 @@ def _tpos(tok: Token | Tok) -> A.Pos:
     if type(tok) is Tok:
         return A.token_pos(tok[3], tok[4], tok[5], tok[2], tok[6])
     # Lark types a Token's positions Optional, as a Token may be made without
-    # them; the Tokens that reach here come from Tok.as_lark (LigLexer) or
-    # Lark's own lexer, which set all four. Checking would cost every token.
+    # them; the Tokens that reach here come from Lark's own lexer (in the
+    # stock reference parser the tests compare with), which sets them all.
     return A.Pos(tok.line, tok.column, tok.end_line, tok.end_column, tok.start_pos, tok.end_pos)  # type: ignore[arg-type]
 
 

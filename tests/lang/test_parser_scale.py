@@ -15,6 +15,7 @@ import textwrap
 import tracemalloc
 
 import pytest
+from bigprograms import mixed_lines, short_lines
 from paths import ROOT_DIR
 
 from liganimate.lang import parser as P
@@ -63,14 +64,14 @@ def test_edited_grammar_is_built_not_loaded(monkeypatch):
     assert tables.load(*P.grammar_parts()) is None
 
 
-def test_loaded_parser_works_with_lark_own_loop():
-    # LigLexer, the post-lexer (PRIM_NAME) and the transformer, through Lark.parse.
-    token = P._primitive_names.set(P.BUILTIN_PRIMITIVES)
-    try:
-        body = P.build_parser().parse("G :- BOX WIDTH 1, HEIGHT 2, DEPTH 3\nX = 1\n")
-    finally:
-        P._primitive_names.reset(token)
-    assert body == P.parse("G :- BOX WIDTH 1, HEIGHT 2, DEPTH 3\nX = 1\n").body
+def test_a_parser_built_from_the_grammar_parses_as_the_shipped_one():
+    # The path an edited grammar takes (tables computed, not loaded) runs the
+    # same loop to the same tree.
+    from liganimate.lang.lalr import Driver
+
+    text = "G :- BOX WIDTH 1, HEIGHT 2, DEPTH 3\nX = (1 + 2) * -3\n"
+    built = Driver(tables.build(*P.grammar_parts()))
+    assert built.parse(text, P.BUILTIN_PRIMITIVES) == P.parse(text).body
 
 
 def test_nothing_is_cached_in_the_temporary_folder(tmp_path):
@@ -98,30 +99,6 @@ def test_nothing_is_cached_in_the_temporary_folder(tmp_path):
 
 
 # ------------------------------------------------------------------- scale
-
-
-def short_lines(n: int) -> str:
-    """``n`` short assignment lines, issue 14's stress shape."""
-    return "".join(f"X{i % 100} = {i}\n" for i in range(n))
-
-
-def mixed_lines(n: int) -> str:
-    """``n`` lines of varied statements: arithmetic, vectors, keyframes, IF, DO, a primitive call."""
-    out = ["REAL X, Y", "VECTOR V", "MOTION M", "GRAPHICAL G"]
-    i = 0
-    while len(out) < n:
-        i += 1
-        out += [
-            f"X = X + {i}.5 * (Y - 2) / 3",
-            f"V = (X, Y, {i}) + V * 0.5",
-            f"M[{i % 20 + 1}, 1] := FRAME {i % 50 + 1} POSITION X, 0, {i % 90}",
-            f"IF X > {i} THEN Y = Y + 1 ELSE Y = Y - 1",
-            f"DO {i + 10} J = 1, 3",
-            "  Y = Y + J MOD 2",
-            f"{i + 10} CONTINUE",
-            "G :- BOX WIDTH 1, HEIGHT 2, DEPTH X",
-        ]
-    return "\n".join(out[:n]) + "\n"
 
 
 def parse_memory(text: str) -> tuple:
