@@ -594,21 +594,26 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     if total == 0:
         return None
 
-    # A table of per-trapezoid values, one row per quantity (see _TABLE);
-    # a triangle's two trapezoids share the long edge, the plane, the depth
-    # range and the tag.  An edge's crossing with row centre cy is
-    # x = xtop + (cy - ytop) * slope, from the edge's top vertex: the same
-    # numbers, in the same order, for every triangle sharing the edge.
-    table = np.empty((13, 2, m))
+    # A table of per-trapezoid values, one row per quantity (listed after
+    # this function); a triangle's two trapezoids share the long edge, the
+    # plane, the depth range and the tag.  An edge's crossing with row centre cy is
+    # x = xtop + ((cy - ytop) * dx) / dy, from the edge's top vertex: the
+    # same numbers, in the same order, for every triangle sharing the edge.
+    # Multiplying before dividing (never by a rounded slope dx/dy) makes
+    # the crossing exact whenever it is representable and the product is
+    # exact, so a centre exactly on an edge is found exactly on it and the
+    # top-left rule decides (e.g. edges between half-pixel points).
+    table = np.empty((15, 2, m))
     upper = table[:, 0]
     table[0] = x0
     table[1] = x[:2]
     table[2] = y0
     table[3] = y[:2]
+    upper[4] = dx[1]
+    np.subtract(x[1:], x[:2], out=table[5])
+    upper[13] = dy[1]
+    np.subtract(y[1:], y[:2], out=table[14])
     with np.errstate(divide="ignore", invalid="ignore"):
-        np.divide(dx[1], dy[1], out=upper[4])
-        np.subtract(x[1:], x[:2], out=table[5])
-        table[5] /= y[1:] - y[:2]
         # 1/z is affine in screen space: 1/z = wc + gx x + gy y.
         gx, gy, wc = upper[6], upper[8], upper[7]
         np.multiply(dw[0], dy[1], out=gx)
@@ -626,9 +631,10 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     if not np.logical_and.reduce(faces):
         upper[6:11] *= np.where(faces, 1.0, 1.0 - _BACK_BIAS)
     table[4, 1] = upper[4]
+    table[13, 1] = upper[13]
     table[6:11, 1] = upper[6:11]
     table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
-    table = table.reshape(13, 2 * m)
+    table = table.reshape(15, 2 * m)
     first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
 
     bounds = [0, total]
@@ -664,6 +670,7 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     # the first and one past the last pixel column (rows 0 and 1 of cols).
     xab = np.subtract(cy, t[2:4])
     xab *= t[4:6]
+    xab /= t[13:15]
     xab += t[0:2]
     cols = np.empty((2, total))
     np.minimum(xab[0], xab[1], out=cols[0])
@@ -698,9 +705,9 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
 
 
 # Rows of _spans' table: 0-1 x of the top of the long and the short edge,
-# 2-3 their y, 4-5 their slopes dx/dy, 6-8 gx, wc, gy of the plane
+# 2-3 their y, 4-5 their dx (bottom minus top), 6-8 gx, wc, gy of the plane
 # 1/z = wc + gx x + gy y, 9-10 the least and greatest 1/z, 11 the tag,
-# 12 first row centre minus the number of spans before.
+# 12 first row centre minus the number of spans before, 13-14 the edges' dy.
 _NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 # From the first and one-past-last pixel column to the first and last centre.

@@ -33,9 +33,8 @@ could disagree only where a pixel centre lies within about 1e-13 pixels of
 an edge or two depths straddle a key boundary, which the cross-checked
 scenes do not meet.  Where a centre lies exactly on an edge, this module's
 edge functions are exact for the test's lattice scenes, so it applies the
-top-left rule as documented; the live code agrees when the edge's slope is
-exact in binary, and not always otherwise (see the xfail in
-test_raster_crosscheck.py).
+top-left rule as documented; so does the live code, whose crossings
+``xtop + ((cy - ytop) * dx) / dy`` are exact there too, whatever the slope.
 
 Slow by design (a Python loop over triangles, numpy only over one
 bounding box at a time): use small images.

@@ -136,17 +136,24 @@ def test_lattice_edges_and_ties_byte_equal(seed):
     assert len(np.unique(img)) > 10
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="raster._spans computes an edge's crossing as xtop + (cy - ytop) * (dx / dy), rounding the slope first: "
-    "when dx / dy is not exact in binary, a pixel centre exactly on the edge can land on the wrong side of it "
-    "(here centre (27.5, 38.5) on the right edge (59, 32)-(-4, 45) of triangle 13 of seed 302 is drawn), "
-    "against the top-left rule; shared edges stay crack-free",
-)
 def test_lattice_edges_of_any_slope_byte_equal():
     for seed in range(300, 312):
         tris, shade = lattice(np.random.default_rng(seed), 40, dyadic=False)
         same(tris, shade, LATTICE_CAM, background=0)
+
+
+def test_a_centre_on_an_edge_of_inexact_slope_goes_to_the_triangle_on_its_right():
+    # The edge (59, 32)-(-4, 45) has slope -63/13, not exact in binary; it
+    # passes exactly through the centre (27.5, 38.5) of pixel (27, 38).  Its
+    # crossing with that row once came out one ulp right of 27.5 (the slope
+    # rounded first), giving the pixel to the triangle on the left.
+    W, H = LATTICE_CAM.size
+    px = np.array([[(59, 32), (46, 9), (-4, 45)], [(59, 32), (-4, 45), (59, 60)]], dtype=float)
+    tris = np.stack([(px[..., 0] - W / 2) / 8, (H / 2 - px[..., 1]) / 8, np.zeros(px.shape[:2])], axis=-1)
+    for order in ([0, 1], [1, 0]):  # whichever is drawn later
+        img = same(tris[order], np.array([1, 2])[order], LATTICE_CAM, background=0)
+        assert img[38, 27] == 2
+        assert img[38, 26] == 1
 
 
 def test_lattice_mesh_has_no_cracks():
