@@ -13,19 +13,34 @@ Reported, side by side:
   two workers (processes and threads, both reported; the faster is
   ``png_ips_2proc``);
 * the cost of one frame at 640x480, 1920x1080 and 3840x2160 (same view, so
-  the figures cover proportionally more pixels), for the rasterizer and for
-  the previous one (``tests/runtime/render/raster_reference.py``) side by
-  side, with the ratios 1080p/480p (6.75x the pixels) and 4K/1080p (4x);
+  the figures cover proportionally more pixels), for this rasterizer
+  ("new") and for the previous one ("old") side by side, with the ratios
+  1080p/480p (6.75x the pixels) and 4K/1080p (4x);
 * the fixed cost of a frame: a tiny scene (one box, 12 triangles) at
   640x480, and the five figures at 64x48 (per-triangle work, almost no
   pixels), old and new;
-* the cost multiplier of anti-aliasing (aa=2, aa=4) at 640x480.
+* the cost multiplier of anti-aliasing (aa=2, aa=4) at 640x480 (new only:
+  the old one has no anti-aliasing).
+
+"Old" is the rasterizer before its optimisation (issue 13): the file
+``runtime/render/raster.py`` of commit ``PREVIOUS`` (before bands of rows,
+per-trapezoid tables and anti-aliasing), read with ``git show`` when the
+benchmark runs and loaded as a module from a temporary file.  Without git
+or without that history (an installed copy, a shallow clone) the output
+says so and the old figures are null.  (Until the rasterizer got an
+independent, deliberately slow cross-check reference, "old" was a frozen
+copy of that same version under tests/; it no longer is.)
 
 Frame costs are CPU time of this process (``time.process_time``), best of
 several rounds with old and new interleaved: on a shared machine, wall time
 also counts other processes' turns.
 
-The last line printed is one JSON object with the figures.
+The last line printed is one JSON object with the figures.  Keys
+``old_ms_<case>``, ``old_ratio_1080p_480p`` and ``old_ratio_4k_1080p`` are
+null when the old rasterizer is not available; ``old_source`` names where
+it came from (``"git <commit>:runtime/render/raster.py"``), or is null, and
+``old_same_image`` says whether it drew the 480p benchmark frame with the
+same bytes.
 
 Usage: ``python benchmarks/raster.py [--quick]``.
 """
@@ -33,9 +48,11 @@ Usage: ``python benchmarks/raster.py [--quick]``.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import multiprocessing as mp
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -53,10 +70,10 @@ from liganimate.runtime.render.camera import Camera  # noqa: E402
 from liganimate.runtime.render.imagefiles import write_png  # noqa: E402
 from liganimate.runtime.render.raster import rasterize  # noqa: E402
 
-# The previous rasterizer, kept frozen beside the tests that check the new
-# one against it byte for byte.
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "runtime", "render"))
-import raster_reference  # noqa: E402 - found through the sys.path line above
+#: The commit whose runtime/render/raster.py is the "old" rasterizer: the
+#: last one before the optimisations of issue 13.
+PREVIOUS = "2526992"
+_REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 SIZE = (640, 480)
 VIEW_POINT = (3.0, 4.0, 14.0)
@@ -263,6 +280,40 @@ def bench_png(frames: int, rounds: int, workers: int, mode: str) -> float:
             return _best_rate(run, frames, rounds)
 
 
+def previous_rasterizer():
+    """The old rasterizer's ``rasterize``, out of git history, or why it is not available.
+
+    Returns
+    -------
+    tuple
+        ``(rasterize, source)`` with ``source`` naming the commit and file,
+        or ``(None, reason)``.
+    """
+    where = f"{PREVIOUS}:runtime/render/raster.py"
+    try:
+        shown = subprocess.run(
+            ["git", "-C", _REPO, "show", where], capture_output=True, text=True, check=False, timeout=60
+        )
+    except (OSError, subprocess.SubprocessError) as exc:
+        return None, f"git could not be run ({exc})"
+    if shown.returncode != 0:
+        first = (shown.stderr.strip().splitlines() or ["no output"])[0]
+        return None, f"git show {where} failed: {first}"
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, f"raster_{PREVIOUS}.py")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(shown.stdout)
+        spec = importlib.util.spec_from_file_location(f"raster_{PREVIOUS}", path)
+        if spec is None or spec.loader is None:
+            return None, f"{where} could not be loaded as a module"
+        module = importlib.util.module_from_spec(spec)
+        try:
+            spec.loader.exec_module(module)
+        except Exception as exc:  # its imports may no longer exist in this tree
+            return None, f"{where} does not load any more ({type(exc).__name__}: {exc})"
+    return module.rasterize, f"git {where}"
+
+
 RESOLUTIONS = {"480p": (640, 480), "1080p": (1920, 1080), "4K": (3840, 2160)}
 
 
@@ -276,17 +327,18 @@ def _frame_cost(draw, scenes, camera, frames: int, **kw) -> float:
     return (time.process_time() - t0) / frames * 1e3
 
 
-def bench_costs(frames: int, rounds: int) -> dict:
+def bench_costs(frames: int, rounds: int, old=None) -> dict:
     """Best CPU ms per frame: old and new at each resolution, the fixed costs, and aa.
 
-    Returns a dict keyed ``(implementation, case)``.
+    ``old`` is the previous rasterizer's ``rasterize``, or None to time only
+    this one.  Returns a dict keyed ``(implementation, case)``.
     """
     scenes = _scene_cache(20)
     tiny = [(tris[:12], shade[:12]) for tris, shade in scenes]
     cases = {name: (scenes, Camera(VIEW_POINT, VIEW_WIDTH, size), {}) for name, size in RESOLUTIONS.items()}
     cases["tiny"] = (tiny, _camera(), {})
     cases["64x48"] = (scenes, Camera(VIEW_POINT, VIEW_WIDTH, (64, 48)), {})
-    impls = {"old": raster_reference.rasterize, "new": rasterize}
+    impls = {"new": rasterize} if old is None else {"old": old, "new": rasterize}
     jobs = [(impl, case) for case in cases for impl in impls]
     jobs += [("new", "aa2"), ("new", "aa4")]
     cases["aa2"] = (scenes, _camera(), {"aa": 2})
@@ -337,14 +389,25 @@ def main(argv=None) -> int:
     print(f"rasterize + write_png, 2 processes: {png2p:8.1f} images/s")
     print(f"rasterize + write_png, 2 threads:   {png2t:8.1f} images/s")
 
-    cost = bench_costs(frames, rounds)
-    print("CPU ms per frame (best of rounds), previous rasterizer vs this one:")
+    old, source = previous_rasterizer()
+    same_image = None
+    if old is None:
+        print(f"previous rasterizer not available: {source}; timing this one only")
+    else:
+        cam, flags = _camera(), np.ones(len(tris), dtype=bool)
+        same_image = bool(np.array_equal(old(*scene(0), cam, cull=flags), rasterize(*scene(0), cam, cull=flags)))
+        print(f"previous rasterizer: {source} (same 480p image: {'yes' if same_image else 'NO'})")
+    cost = bench_costs(frames, rounds, old)
+    impls = ("new",) if old is None else ("old", "new")
+    print("CPU ms per frame (best of rounds), " + ("previous rasterizer vs this one:" if old else "this rasterizer:"))
     for case in ["480p", "1080p", "4K", "tiny", "64x48"]:
-        old, new = cost["old", case], cost["new", case]
-        print(f"  {case:6s} old {old:8.3f}   new {new:8.3f}   old/new {old / new:5.2f}")
+        new = cost["new", case]
+        if old is None:
+            print(f"  {case:6s} new {new:8.3f}")
+        else:
+            print(f"  {case:6s} old {cost['old', case]:8.3f}   new {new:8.3f}   old/new {cost['old', case] / new:5.2f}")
     ratios = {
-        impl: (cost[impl, "1080p"] / cost[impl, "480p"], cost[impl, "4K"] / cost[impl, "1080p"])
-        for impl in ("old", "new")
+        impl: (cost[impl, "1080p"] / cost[impl, "480p"], cost[impl, "4K"] / cost[impl, "1080p"]) for impl in impls
     }
     for impl, (r1, r2) in ratios.items():
         print(f"  {impl}: 1080p/480p {r1:5.2f} (pixels 6.75)   4K/1080p {r2:5.2f} (pixels 4)")
@@ -355,6 +418,9 @@ def main(argv=None) -> int:
         for impl in ("old", "new"):
             if (impl, case) in cost:
                 figures[f"{impl}_ms_{case}"] = round(cost[impl, case], 4)
+            elif impl == "old" and case not in ("aa2", "aa4"):
+                figures[f"{impl}_ms_{case}"] = None
+    ratios.setdefault("old", (None, None))
     print(
         json.dumps(
             {
@@ -368,10 +434,12 @@ def main(argv=None) -> int:
                 "png_ips_2proc_processes": round(png2p, 1),
                 "png_ips_2proc_threads": round(png2t, 1),
                 **figures,
-                "old_ratio_1080p_480p": round(ratios["old"][0], 2),
-                "new_ratio_1080p_480p": round(ratios["new"][0], 2),
-                "old_ratio_4k_1080p": round(ratios["old"][1], 2),
-                "new_ratio_4k_1080p": round(ratios["new"][1], 2),
+                "old_ratio_1080p_480p": _rounded(ratios["old"][0]),
+                "new_ratio_1080p_480p": _rounded(ratios["new"][0]),
+                "old_ratio_4k_1080p": _rounded(ratios["old"][1]),
+                "new_ratio_4k_1080p": _rounded(ratios["new"][1]),
+                "old_source": source if old else None,
+                "old_same_image": same_image,
                 "aa2_cost_x": round(aa2, 2),
                 "aa4_cost_x": round(aa4, 2),
                 "cores": os.cpu_count(),
@@ -380,6 +448,10 @@ def main(argv=None) -> int:
         )
     )
     return 0
+
+
+def _rounded(value):
+    return None if value is None else round(value, 2)
 
 
 if __name__ == "__main__":
