@@ -27,7 +27,10 @@ a centre exactly on an edge belongs to the triangle to its right, or below it
 for a horizontal edge (the top-left rule).  Two triangles sharing an edge
 therefore never both cover, nor both miss, a pixel along it: the crossing
 point of a shared edge is computed from the same two vertices in the same
-order in both triangles, so it is bit-identical.
+order in both triangles, so it is bit-identical.  It is computed as
+``xtop + ((cy - ytop) * dx) / dy``, not with a rounded slope, so a centre
+lying exactly on an edge is found exactly on it whenever the product is
+exact and the crossing representable.
 
 Anti-aliasing (``aa=N``) draws the same triangles with a camera of N times
 the resolution in each direction (:meth:`Camera.supersampled`), so each
@@ -39,9 +42,15 @@ Speed notes (measured with callgrind and CPU time; see
 where a gather (``np.take``, fancy indexing) costs 15-30, so per-span values
 reach fragments by repeating, never by gathering with a span index.  With a
 few hundred triangles a frame costs mostly numpy calls (about a microsecond
-each), so the per-triangle steps work on whole (k, N) blocks.  The algorithm
-before bands is kept in ``tests/runtime/render/raster_reference.py``; the
-tests check this one against it byte for byte.
+each), so the per-triangle steps work on whole (k, N) blocks.  The benchmark
+times this rasterizer beside its version before these optimisations (that
+of commit 2526992, read from git history).
+
+``tests/runtime/render/raster_reference.py`` is an independent
+per-triangle edge-function rasterizer written from the rules of
+docs/semantics-render.md; the tests check byte equality with it on random
+scenes and on scenes where edges pass exactly through pixel centres and
+depths tie.
 """
 
 from __future__ import annotations
