@@ -28,8 +28,10 @@ DEFAULT_SIZE = (640, 480)
 _PARALLEL_SINE = 1e-9
 
 # The near plane sits at this fraction of the eye's distance from the origin.
-# Depth is compared as float32 1/z, whose precision is relative, so a small
-# near distance costs no depth resolution; it only has to keep 1/z finite.
+# Depth is compared on the upper 32 bits of the float64 1/z (sign, exponent
+# and 20 mantissa bits: about 1e-6 relative, see raster.py).  That precision
+# is relative, so a small near distance costs no depth resolution; it only
+# has to keep 1/z finite.
 _NEAR_FRACTION = 1e-4
 
 
