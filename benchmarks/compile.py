@@ -198,7 +198,7 @@ def main(argv=None) -> int:
         text = fh.read()
     P.build_parser()
     compiled = compile_text(text, APPENDIX_A)
-    stock = stock_parser(whole_words=False)  # the grammar as it is: what a user of Lark would run
+    stock = stock_parser()
     lexed = prepare(text, APPENDIX_A).lexed
 
     def stock_parse():

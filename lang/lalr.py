@@ -133,6 +133,7 @@ class Driver:
         chains = self._chains
         scanner = self.scanner
         keywords = scanner.tables.keywords
+        clause_states = scanner.clause_states
         choice = scanner._choice
         state = self.start
         stack = [state]
@@ -172,6 +173,8 @@ class Driver:
                         ttype = "PRIM_NAME"
                 else:
                     ttype = "PRIM_NAME" if word in primitives else "NAME"
+                if ttype == "NAME" and state in clause_states:
+                    ttype = scanner.clause(text, end)
             elif k == NUMBER:
                 ttype = "NUMBER"
                 # The syntax tree keeps each number's spelling: share the

@@ -89,7 +89,7 @@ class GrammarTables:
         self.contextual: set = set()  # words whose terminal depends on the text after them
         for t in terminals:
             pattern = t.pattern
-            if t.name in ("NAME", "DOLLAR_NAME", "NUMBER", "STRING", "WS", "BRACE_COMMENT"):
+            if t.name in ("NAME", "CLAUSE_NAME", "DOLLAR_NAME", "NUMBER", "STRING", "WS", "BRACE_COMMENT"):
                 continue
             if type(pattern).__name__ == "PatternStr" and pattern.value[:1].isalpha():
                 self.plain[pattern.value.upper()] = t.name
@@ -190,6 +190,8 @@ class Scanner:
         self.states = states
         self._accepts: dict = {}  # parser state -> frozenset of terminal names
         self._choice: dict[tuple[object, str], str] = {}  # (state, word or operator) -> token type
+        #: The parser states where a primitive's clause may start (they take CLAUSE_NAME).
+        self.clause_states = frozenset(state for state, acts in states.items() if "CLAUSE_NAME" in acts)
 
     def accepted(self, state) -> frozenset:
         """The symbols parser state ``state`` accepts."""
@@ -209,6 +211,17 @@ class Scanner:
             ttype = self._pick(candidates, state, cache=None if word in self.tables.contextual else key)
         return ttype
 
+    @staticmethod
+    def clause(text: str, end: int) -> str:
+        """What a NAME ending at ``end`` is in a state that takes a clause: CLAUSE_NAME, or NAME before an assignment.
+
+        LALR(1) cannot tell ``P1 WIDTH 2`` (a clause) from ``P1`` followed by
+        the statement ``B :- P1`` by the name alone; what follows the name
+        can: a clause's word is followed by its value, a statement's name by
+        ``=``, ``:=``, ``:-`` or ``[``, which no value starts with.
+        """
+        return "NAME" if _NOT_BEFORE_ASSIGN.match(text, end) else "CLAUSE_NAME"
+
     def unexpected_character(self, text: str, pos: int, line: int, state) -> NoReturn:
         """Raise UnexpectedCharacters for the first character after ``pos`` that starts no token."""
         blank = re.compile(_SKIP).match(text, pos)
@@ -221,7 +234,8 @@ class Scanner:
     def _pick(self, candidates, state, cache=None) -> str:
         acc = self.accepted(state)
         for c in candidates:
-            if c in acc:
+            # NAME stands for CLAUSE_NAME where a clause may start (the caller decides which, by what follows).
+            if c in acc or (c == "NAME" and state in self.clause_states):
                 break
         else:
             c = candidates[0]  # what the whole grammar makes of it; the parser will object

@@ -84,6 +84,7 @@ def parse(text: str, filename: str = "<string>", primitives: frozenset | set = f
 # __ANON_0 or $END can reach a message.
 _FRIENDLY = {
     "NAME": "a name",
+    "CLAUSE_NAME": "a word of the primitive's pattern",
     "PRIM_NAME": "a primitive such as BOX",
     "NUMBER": "a number",
     "STRING": "a quoted word",

@@ -22,7 +22,7 @@ _names: contextvars.ContextVar = contextvars.ContextVar("primitive_names", defau
 
 
 class PrimitiveNames:
-    """Post-lexer: a NAME that names a primitive becomes PRIM_NAME (our scanner does this itself)."""
+    """Post-lexer: a NAME (or CLAUSE_NAME) that names a primitive becomes PRIM_NAME (our scanner does this itself)."""
 
     always_accept = ()
 
@@ -30,7 +30,7 @@ class PrimitiveNames:
         """Retype the NAMEs of the primitives :func:`primitives` set."""
         names = _names.get()
         for tok in stream:
-            if tok.type == "NAME" and tok.value.upper() in names:
+            if tok.type in ("NAME", "CLAUSE_NAME") and tok.value.upper() in names:
                 tok.type = "PRIM_NAME"
             yield tok
 
@@ -45,17 +45,19 @@ def primitives(names):
         _names.reset(token)
 
 
-@functools.lru_cache(maxsize=2)
-def stock_parser(whole_words: bool = True) -> Lark:
+@functools.lru_cache(maxsize=1)
+def stock_parser() -> Lark:
     """Lark's own LALR parser of lig.lark with its contextual lexer, the transformer inside.
 
-    ``whole_words``: our keywords are whole words, while Lark's scanner, in
-    a state that does not accept NAME, lets "SCALE" match the start of
-    "SCALEFRAMES"; with it, each plain keyword becomes a word-bounded regex
-    ranked above NAME, the one intended difference made the same. The
-    benchmark times the grammar as it is (``False``).
+    Two rules our scanner applies by itself are given to Lark as terminal
+    priorities: keywords are whole words (Lark's scanner, in a state that
+    does not accept NAME, would let "SCALE" match the start of
+    "SCALEFRAMES"), so each plain keyword becomes a word-bounded regex; and
+    the order is regex keywords, then plain keywords, then CLAUSE_NAME (a
+    name not followed by an assignment, where a clause may start), then
+    NAME.
     """
     grammar = tables.grammar_text()
-    if whole_words:
-        grammar = re.sub(r'^([A-Z_]+): "([A-Z]+)"i$', r"\1.1: /\2\\b/i", grammar, flags=re.MULTILINE)
+    grammar = re.sub(r"^([A-Z_]+)\.2:", r"\1.3:", grammar, flags=re.MULTILINE)
+    grammar = re.sub(r'^([A-Z_]+): "([A-Z]+)"i$', r"\1.2: /\2\\b/i", grammar, flags=re.MULTILINE)
     return Lark(grammar, **tables.options("contextual", PrimitiveNames(), ToAst()))

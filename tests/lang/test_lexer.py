@@ -120,3 +120,38 @@ def test_a_long_run_of_blanks_before_a_bad_character_is_an_error_not_a_hang():
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False)
     assert r.returncode == 0, r.stderr
     assert r.stdout.splitlines() == ["unexpected character '_'"] * 4
+
+
+PRIMITIVE_P1 = """PRIMITIVE P1
+  P1 ::= 'P1' [ 'SIZE' S ] <S = 1> ;
+  REAL S
+  DRAW POLY FROM (0, 0, 0) TO (S, 0, 0) TO (0, S, 0)
+END
+GRAPHICAL A, B
+MOTION M
+"""
+
+
+def test_a_call_without_clauses_does_not_take_the_next_statement():
+    # LALR(1) took the B of "B :- P1" for a clause of the P1 before it.
+    for after in ("B :- P1\n", "B = P1\n", "B := P1\n", "M[1, 2] := FRAME 3 POSITION 0, 0, 0\n", "PRINT A\n"):
+        text = PRIMITIVE_P1 + "A :- P1\n" + after
+        kind, body = agree(text)
+        assert kind == "tree", after
+        call = body[-2].value
+        assert call.name == "P1" and call.clauses == [], after
+
+
+def test_a_clause_word_is_still_a_clause_even_a_keyword_elsewhere():
+    text = PRIMITIVE_P1 + "A :- P1 SIZE 2\nB :- BOX AT (0, 1, 0), WIDTH 1, HEIGHT 2, DEPTH 3, LIGHTNESS 40\n"
+    kind, body = agree(text)
+    assert kind == "tree"
+    assert [c.keyword for c in body[-2].value.clauses] == ["SIZE"]
+    assert [c.keyword for c in body[-1].value.clauses] == ["AT", "WIDTH", "HEIGHT", "DEPTH", "LIGHTNESS"]
+
+
+def test_a_clause_word_followed_by_an_assignment_ends_the_call():
+    # "P1 SIZE = 2" is the call P1, then the statement SIZE = 2 (which needs
+    # a declared SIZE, but parses): the name before "=" starts a statement.
+    kind, body = agree(PRIMITIVE_P1 + "A :- P1\nSIZE = 2\n")
+    assert kind == "tree" and body[-1].target.name == "SIZE"
