@@ -273,7 +273,7 @@ def _end(tok: Token) -> int:
 
 
 def _word_taken_as_name(tok: Token, text: str, expected: set):
-    """The closing word the parser took for the start of an assignment, if that is what failed.
+    """The closing word (or BEGIN) the parser took for the start of an assignment, if that is what failed.
 
     Where a statement may start, a closing word the state does not accept
     (ENDMOTION after its block is closed) is lexed as a NAME, and the error
@@ -293,7 +293,7 @@ def _word_taken_as_name(tok: Token, text: str, expected: set):
             return None
         start = m.start()
     m = _WORD.match(text, start or 0)
-    if m is None or m.group(0).upper() not in _STRAY and m.group(0).upper() != "CONTINUE":
+    if m is None or m.group(0).upper() not in _STRAY and m.group(0).upper() not in ("CONTINUE", "BEGIN"):
         return None
     line, col = _line_col(text, m.start())
     return Token("NAME", m.group(0), m.start(), line, col, line, col + len(m.group(0)), m.end())
@@ -314,6 +314,16 @@ def _stray_diagnostic(tok: Token, text: str, source: Source, as_name: bool):
             pos,
             f"{word} cannot be a variable name here, after an expression",
             "choose another name, or start the statement with another one",
+            source=source.text,
+        )
+    if word == "BEGIN":
+        # The thesis' BEGIN ... END is a branch of IF; where a statement may
+        # start, BEGIN is only a name, and the error would show at the next line.
+        return Diagnostic(
+            source.filename,
+            pos,
+            "BEGIN starts a block only after THEN or ELSE",
+            "a program's statements need no BEGIN ... END around them; remove both, or write IF ... THEN BEGIN ... END",
             source=source.text,
         )
     if word == "CONTINUE":

@@ -504,3 +504,21 @@ def test_cli_bad_program_exits_1_and_writes_nothing(tmp_path):
     assert "Traceback" not in r.stderr + r.stdout
     # No frames folder (neither -o frames nor the default div_frames), no module.
     assert set(os.listdir(tmp_path)) == before
+
+
+@pytest.mark.parametrize("before", ["", "REAL X\nX = 1\n", "C a comment\n\n"])
+def test_a_begin_block_outside_if_is_reported_at_begin(before):
+    # BEGIN where a statement may start was read as a variable called BEGIN,
+    # and the error came a line later ("unexpected REAL; expected =").
+    d = diagnose(before + "BEGIN\n  REAL Y\n  Y = 2\nEND\n")
+    line = before.count("\n") + 1
+    assert (d.pos.line, d.pos.column, d.pos.end_column) == (line, 1, 6)
+    assert d.message == "BEGIN starts a block only after THEN or ELSE"
+    assert "remove both" in d.hint
+
+
+def test_begin_is_still_a_variable_name():
+    out = io.StringIO()
+    program, _ = load_program(text="REAL BEGIN\nBEGIN = 2\nPRINT BEGIN\n")
+    program.check(stdout=out)
+    assert out.getvalue() == "BEGIN = 2\n"
