@@ -145,9 +145,10 @@ def test_parse_memory_grows_in_proportion_to_the_program(make):
 
 def test_parse_memory_is_a_small_multiple_of_the_source():
     # Issue 14: a million short lines must check in under 500 MB, and the
-    # syntax tree is most of that. Measured per line of "X17 = 17": 432
-    # bytes kept, 511 at the peak (the tree before it was slimmed: 539 and
-    # 619). About 45 times the source text, which is 12 bytes a line.
+    # syntax tree is most of that. Measured per line of "X17 = 17": 456
+    # bytes kept, 509 at the peak, since positions carry character offsets
+    # (432 and 511 before; before the tree was slimmed, 539 and 619). About
+    # 45 times the source text, which is 12 bytes a line.
     text = short_lines(20_000)
     peak, retained = parse_memory(text)
     assert retained / 20_000 < 470
