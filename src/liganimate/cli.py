@@ -43,6 +43,38 @@ def _size(text: str):
         raise argparse.ArgumentTypeError(f"{text!r} is not a size like 640x480") from None
 
 
+def _lig_name(text: str) -> str:
+    """An option that names a MODEL or MOTION a tool writes: a name a program may define (compiler/names.py)."""
+    from liganimate.compiler.names import definable
+
+    if not definable(text):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a LIG name a library can define (a letter, then letters, digits and _; not a keyword)"
+        )
+    return text.upper()
+
+
+def _shot_scenes(path: str, doing: str) -> list:
+    """The scenes the program at ``path`` shoots, its warnings printed; an error when it shoots none.
+
+    ``doing`` finishes the sentence "there is nothing to ..." (export, view).
+    """
+    from liganimate.runtime import exchange as X
+    from liganimate.runtime.errors import LigError
+
+    program, warnings = load_program(path)
+    _print_diagnostics(warnings)
+    run_warnings: list = []
+    scenes = X.collect(program, run_warnings)
+    _print_diagnostics(run_warnings)
+    if not scenes:
+        raise LigError(
+            f"the program shoots no scene, so there is nothing to {doing}.",
+            "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES",
+        )
+    return scenes
+
+
 def load_program(path: str):
     """Compile a .lig file in memory (the same lowering ``compile`` writes) and return (program, warnings)."""
     from liganimate.compiler import load_program as _load

@@ -35,19 +35,9 @@ def _degrees(text: str) -> float:
     return value
 
 
-def _lig_name(text: str) -> str:
-    from liganimate.compiler.names import definable
-
-    if not definable(text):
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not a LIG name a library can define (a letter, then letters, digits and _; not a keyword)"
-        )
-    return text.upper()
-
-
 def add_commands(subparsers) -> None:
     """Add ``export`` and ``import`` to the ``liganimate`` command's subparsers."""
-    from liganimate.cli import _size
+    from liganimate.cli import _lig_name, _size
 
     p = subparsers.add_parser(
         "export",
@@ -96,7 +86,7 @@ def add_commands(subparsers) -> None:
 
 def cmd_export(args) -> int:
     """``liganimate export FILE -o OUT``."""
-    from liganimate.cli import _guarded, _print_diagnostics, load_program
+    from liganimate.cli import _guarded, _shot_scenes
 
     def go():
         from liganimate.runtime import exchange as X
@@ -108,16 +98,7 @@ def cmd_export(args) -> int:
                 f"cannot tell the format of {args.output} from its extension.",
                 "write to a file ending in .glb, .gltf or .bvh",
             )
-        program, warnings = load_program(args.file)
-        _print_diagnostics(warnings)
-        run_warnings: list = []
-        scenes = X.collect(program, run_warnings)
-        _print_diagnostics(run_warnings)
-        if not scenes:
-            raise LigError(
-                "the program shoots no scene, so there is nothing to export.",
-                "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES",
-            )
+        scenes = _shot_scenes(args.file, "export")
         if kind == "bvh":
             files = X.bvh_files(scenes, args.output, args.fps)
         else:

@@ -13,16 +13,6 @@ import os
 import sys
 
 
-def _lig_name(text: str) -> str:
-    from liganimate.runtime.studio import lig_name
-
-    if not lig_name(text):
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not a LIG name a library can define (a letter, then letters, digits and _; not a keyword)"
-        )
-    return text.upper()
-
-
 def _whole(text: str, low: int, high: int, message: str) -> int:
     # One rule for every whole-number option: digits only, within its range,
     # and the option's own sentence when not.
@@ -49,6 +39,8 @@ def _frames(text: str) -> int:
 
 def add_commands(subparsers) -> None:
     """Add ``view`` and ``studio`` to the ``liganimate`` command's subparsers."""
+    from liganimate.cli import _lig_name
+
     p = subparsers.add_parser(
         "view",
         help="write a program's scenes as one HTML page with a 3D viewer",
@@ -85,24 +77,14 @@ def add_commands(subparsers) -> None:
 
 def cmd_view(args) -> int:
     """``liganimate view FILE [-o OUT.html]``."""
-    from liganimate.cli import _guarded, _print_diagnostics, load_program
+    from liganimate.cli import _guarded, _shot_scenes
 
     def go():
         from liganimate.runtime import exchange as X
-        from liganimate.runtime.errors import LigError
         from liganimate.runtime.view import viewer_html
 
         out = args.output or os.path.splitext(os.path.basename(args.file))[0] + ".html"
-        program, warnings = load_program(args.file)
-        _print_diagnostics(warnings)
-        run_warnings: list = []
-        scenes = X.collect(program, run_warnings)
-        _print_diagnostics(run_warnings)
-        if not scenes:
-            raise LigError(
-                "the program shoots no scene, so there is nothing to view.",
-                "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES",
-            )
+        scenes = _shot_scenes(args.file, "view")
         page = viewer_html(scenes, os.path.basename(args.file)).encode("utf-8")
         X.write_files([(out, page)])
         if not args.quiet:
