@@ -386,7 +386,10 @@ class Motion:
                 if j in other._open:
                     opened.add(j)
             elif ta is None:
-                tracks[j] = tr.concat(tr.Const(tb.start_value), tb, la)  # already in place for b
+                if j in other._open:
+                    tracks[j] = tr.lead_gap(tb, la)  # one gap: refilled whole by what comes before
+                else:
+                    tracks[j] = tr.concat(tr.Const(tb.start_value), tb, la)  # already in place for b
                 opened.add(j)
             else:
                 if j in other._open:

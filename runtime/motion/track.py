@@ -960,6 +960,38 @@ def refill(track: Track, value) -> Track:
     raise TypeError(f"track {type(track).__name__} does not begin with a gap")  # pragma: no cover
 
 
+def lead_gap(track: Track, frames: float) -> Track:
+    """``track`` played ``frames`` later, its leftmost gap ``Const`` grown to cover the frames before.
+
+    ``a + b``, where ``a`` does not drive the joint and ``b`` begins with a
+    gap, makes one gap of the two: a gap prefixed as a piece of its own
+    would be refilled later (:func:`refill`) while ``b``'s own stayed as it
+    was, and ``+`` would not be associative.
+
+    Parameters
+    ----------
+    track : Track
+        Its leftmost piece (through Concat and Pad nodes) is a ``Const``.
+    frames : float
+        Non-negative.
+
+    Returns
+    -------
+    Track
+        Of end ``track.end + frames``.
+    """
+    if isinstance(track, Const):
+        return Const(track.value, track.end + frames)
+    if isinstance(track, Concat):
+        first = track.pieces[0]
+        first = Const(first.value, first.end + frames) if isinstance(first, Const) else lead_gap(first, frames)
+        return Concat((first,) + track.pieces[1:], track.pivots + frames, track.rights, track.end + frames)
+    if isinstance(track, Pad):
+        hold = None if track.hold_from is None else track.hold_from + frames
+        return Pad(lead_gap(track.inner, frames), track.end + frames, hold)
+    raise TypeError(f"track {type(track).__name__} does not begin with a gap")  # pragma: no cover
+
+
 def _smooth_start(track: Track) -> bool:
     """True if ``track`` begins with a leaf joined smoothly to what precedes it."""
     leaf = edge_leaf(track, "left")
