@@ -21,13 +21,20 @@ the language imports it; the command line reaches it through
 
 from ._bvh_read import BvhClip, read_bvh
 from ._bvh_write import bvh_files, bvh_text
+from ._clip import ClipPose, clip_pose, cut_frames, resample
 from ._collect import ModelTake, SceneCollector, SceneTake, collect
 from ._files import write_files
 from ._gltf import gltf_bytes, gltf_document
-from ._lig_write import clip_angles, lig_library, read_root_path
+from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
 
 __all__ = [
     "BvhClip",
+    "ClipPose",
+    "ImportOptions",
+    "clip_pose",
+    "cut_frames",
+    "import_library",
+    "resample",
     "ModelTake",
     "SceneCollector",
     "SceneTake",
