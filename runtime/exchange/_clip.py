@@ -101,7 +101,9 @@ def clip_pose(clip, joint_translation: str = "error") -> ClipPose:
     offsets = clip.offsets.copy()
     path = np.broadcast_to(clip.offsets[0], (F, 3)).copy()
     size = clip_size(clip.parents, clip.offsets)
-    notes, still, slid = [], [], []
+    notes: list = []
+    still: list = []
+    slid: list = []
     for j in range(J):
         cols = clip.first[j] + np.arange(len(clip.channels[j]))
         rot = [(c[0], col) for c, col in zip(clip.channels[j], cols) if c.endswith("rotation")]

@@ -36,6 +36,16 @@ def _degrees(text: str) -> float:
     return value
 
 
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of frames per second") from None
+    if not (0 < value < 1e6):
+        raise argparse.ArgumentTypeError(f"the frame rate must be a positive number, not {text}")
+    return value
+
+
 def _frame_range(text: str) -> tuple:
     first, sep, last = text.partition(":")
     try:
@@ -108,7 +118,7 @@ def add_commands(subparsers) -> None:
         "at its first frame's offset (drop); position channels that hold still are always dropped, with a note",
     )
     p.add_argument("--frames", type=_frame_range, metavar="A:B", help="import frames A to B only (inclusive)")
-    p.add_argument("--fps", type=_fps, metavar="N", help="resample the capture to N frames per second")
+    p.add_argument("--fps", type=_rate, metavar="N", help="resample the capture to N frames per second")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_import)
 
