@@ -33,6 +33,7 @@ import numpy as np
 from liganimate.compiler.names import reserved
 from liganimate.lang import name_table
 from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.motion.keyframe import Keyframe
 
 from ._clip import clip_pose, clip_size
 from ._numbers import format_rows
@@ -344,7 +345,7 @@ def reduce_keyframes(angles: np.ndarray, tolerance: float, rounds: int = 64) -> 
     budget = tolerance - 10.0**-DECIMALS
     for _ in range(rounds):
         spec = {
-            j + 1: (values[0, j], [(float(f), values[f, j], "LINEAR") for f in keep[j][1:].tolist()]) for j in range(J)
+            j + 1: (values[0, j], [Keyframe(float(f), values[f, j]) for f in keep[j][1:].tolist()]) for j in range(J)
         }
         motion = Motion.from_tracks(spec).unwrapped({j + 1: (True, True, True) for j in range(J)})
         played = motion.evaluate(frames)
