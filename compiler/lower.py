@@ -133,7 +133,8 @@ class Lowerer(NodeVisitor):
         for i, lib in enumerate(self.c.libraries):
             # The library's own compiled module travels inside this one, so the
             # generated file stays standalone; it runs once, when first needed.
-            self.emit(f"_LIB{i} = _host.Library({lib.display!r}, {lib.python!r})")
+            names = f", names={lib.names!r}" if lib.names else ""
+            self.emit(f"_LIB{i} = _host.Library({lib.display!r}, {lib.python!r}{names})")
         for name, i in sorted(self.c.loaded_primitives.items()):
             self.emit(f"_prim_{name} = _LIB{i}.primitive({name!r})")
         if self.c.libraries:

@@ -30,6 +30,7 @@ from liganimate.runtime.figure import tree as F
 from liganimate.runtime.library import Library  # noqa: F401  (generated modules name it _host.Library)
 from liganimate.runtime.motion import algebra as M
 from liganimate.runtime.motion import edits as E
+from liganimate.runtime.motion.keyframe import Keyframe
 from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
 if TYPE_CHECKING:
@@ -565,7 +566,7 @@ class Runtime(Arithmetic):
                 self._guard(jat, E.check_angles, start, joint is None)
             spec[joint] = (
                 tuple(start) if start is not None else (0.0, 0.0, 0.0),
-                [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
+                [Keyframe(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
         root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
         return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root))

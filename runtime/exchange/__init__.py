@@ -39,10 +39,11 @@ from ._formats import (
 if TYPE_CHECKING:
     from ._bvh_read import BvhClip, read_bvh
     from ._bvh_write import bvh_files, bvh_text
+    from ._clip import ClipPose, clip_pose, cut_frames, resample
     from ._collect import ModelTake, SceneCollector, SceneTake, collect
     from ._files import write_files
     from ._gltf import gltf_bytes, gltf_document
-    from ._lig_write import clip_angles, lig_library, read_root_path
+    from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
 
 #: Name -> the module of this package that defines it, imported on first use.
 _LAZY = {
@@ -57,6 +58,12 @@ _LAZY = {
     "write_files": "_files",
     "gltf_bytes": "_gltf",
     "gltf_document": "_gltf",
+    "ClipPose": "_clip",
+    "clip_pose": "_clip",
+    "cut_frames": "_clip",
+    "resample": "_clip",
+    "ImportOptions": "_lig_write",
+    "import_library": "_lig_write",
     "clip_angles": "_lig_write",
     "lig_library": "_lig_write",
     "read_root_path": "_lig_write",
@@ -76,23 +83,29 @@ __all__ = [
     "EXPORT_FORMATS",
     "EXPORT_OPTIONS",
     "BvhClip",
+    "ClipPose",
     "Export",
     "ExportFormat",
     "ExportOption",
+    "ImportOptions",
     "ModelTake",
     "SceneCollector",
     "SceneTake",
     "bvh_files",
     "bvh_text",
     "clip_angles",
+    "clip_pose",
     "collect",
+    "cut_frames",
     "export_format",
     "export_options",
     "export_scenes",
     "gltf_bytes",
     "gltf_document",
+    "import_library",
     "lig_library",
     "read_bvh",
     "read_root_path",
+    "resample",
     "write_files",
 ]

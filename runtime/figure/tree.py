@@ -47,6 +47,7 @@ __all__ = [
     "Joint",
     "JointSpec",
     "Link",
+    "LinkSource",
     "TraversalLevel",
     "assemble",
     "join",
@@ -182,6 +183,24 @@ def normalize_extremes(extremes) -> np.ndarray:
 # --------------------------------------------------------------------------
 
 
+class LinkSource(NamedTuple):
+    """A link's name and channels in the file it came from (see :attr:`Link.source`).
+
+    Attributes
+    ----------
+    name : str
+        The name as the source spelled it (any characters).
+    channels : tuple of str
+        Its BVH channels in the source's order (empty when unknown).
+    end : tuple of 3 floats or None
+        Its BVH End Site offset, for a leaf that had one.
+    """
+
+    name: str
+    channels: tuple = ()
+    end: tuple | None = None
+
+
 @dataclass(frozen=True, eq=False)
 class Link:
     """A rigid segment of a figure.
@@ -196,11 +215,17 @@ class Link:
     scale : float, default 1.0
         Uniform factor the renderer applies to ``shape``'s coordinates before
         the link's pose (SCALE MODEL accumulates here; negative mirrors).
+    source : LinkSource or None
+        How the link was written in the file it was imported from (a BVH
+        joint's own name, such as ``mixamorig:Hips``, and its channels), so
+        that export gives the names back; None for a link made in LIG.  A
+        library's name table sets it (see docs/exchange.md, "Names").
     """
 
     name: str | None
     shape: object
     scale: float = 1.0
+    source: LinkSource | None = None
 
     def __post_init__(self) -> None:
         if self.name is not None and not isinstance(self.name, str):
@@ -562,6 +587,22 @@ class Figure:
         links = tuple(dataclasses.replace(l, scale=l.scale * r) for l in self.links)
         joints = tuple(dataclasses.replace(j, loc1=j.loc1 * r, loc2=j.loc2 * r) for j in self.joints)
         return dataclasses.replace(self, links=links, joints=joints)
+
+    def with_sources(self, sources: dict) -> Figure:
+        """The same figure with each named link's :attr:`Link.source` set.
+
+        Parameters
+        ----------
+        sources : dict of str to LinkSource
+            By link name (case-insensitive); links not in it are unchanged.
+        """
+        table = {k.upper(): v for k, v in sources.items()}
+        if not table:
+            return self
+        links = tuple(
+            dataclasses.replace(l, source=table[_key(l.name)]) if _key(l.name) in table else l for l in self.links
+        )
+        return dataclasses.replace(self, links=links)
 
     def scale_extremes(self, r: float) -> Figure:
         """SCALE EXTREMES ``r``: multiply every joint extreme by ``r``.

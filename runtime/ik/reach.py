@@ -36,6 +36,7 @@ from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoa
 from liganimate.runtime.ik.model import IKModel
 from liganimate.runtime.ik.solvers import CONVERGED, DEFAULT_SOLVER, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.motion.keyframe import Keyframe
 
 __all__ = [
     "PointGoal",
@@ -571,7 +572,7 @@ def reach(
     tracks = {}
     for jid in driven:
         k = figure.joint_index(jid)
-        tracks[jid] = (tuple(s0[k]), [(frames, tuple(sol.angles[k]), method)])
+        tracks[jid] = (tuple(s0[k]), [Keyframe(frames, tuple(sol.angles[k]), method)])
     return Reach(Motion.from_tracks(tracks, name="REACH"), sol, tuple(driven), unmet_goals(figure, goals, sol))
 
 
@@ -635,5 +636,5 @@ def reach_keyframes(
     tracks = {}
     for jid in driven:
         k = figure.joint_index(jid)
-        tracks[jid] = (tuple(s0[k]), [(f, tuple(sol.angles[i, k]), method) for i, f in enumerate(frames)])
+        tracks[jid] = (tuple(s0[k]), [Keyframe(f, tuple(sol.angles[i, k]), method) for i, f in enumerate(frames)])
     return Reach(Motion.from_tracks(tracks, name="REACH"), sol, tuple(driven))

@@ -36,6 +36,28 @@ def _degrees(text: str) -> float:
     return value
 
 
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of frames per second") from None
+    if not (0 < value < 1e6):
+        raise argparse.ArgumentTypeError(f"the frame rate must be a positive number, not {text}")
+    return value
+
+
+def _frame_range(text: str) -> tuple:
+    first, sep, last = text.partition(":")
+    try:
+        a = int(first) if first.strip() else 0
+        b = int(last) if last.strip() else None
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a range of frames such as 100:399") from None
+    if not sep or a < 0 or (b is not None and b < a):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a range of frames A:B with 0 <= A <= B")
+    return a, b
+
+
 def add_commands(subparsers) -> None:
     """Add ``export`` and ``import`` to the ``liganimate`` command's subparsers."""
     from liganimate.cli import _lig_name
@@ -88,6 +110,15 @@ def add_commands(subparsers) -> None:
         metavar="DEG",
         help="drop keyframes while every angle stays within DEG degrees (default 0: every frame)",
     )
+    p.add_argument(
+        "--joint-translation",
+        choices=("error", "drop"),
+        default="error",
+        help="joints other than the ROOT that slide: refuse the file (error, the default) or keep each "
+        "at its first frame's offset (drop); position channels that hold still are always dropped, with a note",
+    )
+    p.add_argument("--frames", type=_frame_range, metavar="A:B", help="import frames A to B only (inclusive)")
+    p.add_argument("--fps", type=_rate, metavar="N", help="resample the capture to N frames per second")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_import)
 
@@ -138,10 +169,21 @@ def cmd_import(args) -> int:
             )
         out = args.output or f"{stem}.lig"
         clip = X.read_bvh(args.file)
-        text = X.lig_library(
-            clip, model=model, motion=motion, source_name=os.path.basename(args.file), tolerance=args.tolerance
+        if args.frames is not None:
+            clip = X.cut_frames(clip, *args.frames)
+        if args.fps is not None:
+            clip = X.resample(clip, args.fps)
+        options = X.ImportOptions(
+            model=model,
+            motion=motion,
+            source_name=os.path.basename(args.file),
+            tolerance=args.tolerance,
+            joint_translation=args.joint_translation,
         )
+        text, notes = X.import_library(clip, options)
         X.write_files([(out, text)])
+        for note in notes:
+            sys.stderr.write(f"liganimate: note: {note}\n")
         if not args.quiet:
             sys.stderr.write(
                 f"wrote {out}: MODEL {model} and MOTION {motion} "
