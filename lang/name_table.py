@@ -85,8 +85,9 @@ def read_tables(text: str) -> dict:
     Returns
     -------
     dict
-        ``{MODEL: {SEGMENT: (source name, channels tuple, end tuple or None,
-        joint name or None, rpy tuple or None)}}``
+        ``{MODEL: {SEGMENT: (source name, channels tuple, end tuple or None)}}``,
+        with ``joint name or None, rpy tuple or None`` after them on a row
+        that has either
         in capitals; rows that do not follow the format are left out (a
         table is a comment: it never stops a library from loading).
     """
@@ -140,4 +141,6 @@ def _row(line: str):
             del words[:3]
         else:
             return None
+    if joint is None and rpy is None:
+        return m.group(1).upper(), name, tuple(channels), end
     return m.group(1).upper(), name, tuple(channels), end, joint, rpy
