@@ -510,7 +510,7 @@ def _wrap(atoms: list, lead: str, tokens: list, verbatim: bool) -> list:
     :func:`_break_points`).
     """
     flat = lead + "".join(space + text for space, text, _ in atoms)
-    if verbatim or len(flat) <= WIDTH:
+    if verbatim or _width(flat) <= WIDTH:
         return [flat]
     candidates, forced, column = _break_points(atoms, tokens, lead)
     continuation = " " * column if column is not None else lead + CONTINUATION
@@ -531,43 +531,38 @@ def _wrap(atoms: list, lead: str, tokens: list, verbatim: bool) -> list:
 
 
 def _fill(atoms: list, candidates: dict, current: str, continuation: str) -> tuple:
-    """Lay ``atoms`` out after the text ``current``: the full lines, and the last (open) line."""
+    """Lay ``atoms`` out after ``current`` (a line's indentation): the full lines, and the last (open) line.
+
+    Each line takes as many atoms as fit, then breaks at the candidate among
+    them with the fewest brackets open (the latest of those); when none
+    fits, at the first candidate after them.
+    """
     lines: list = []
-    widths = [len(space) + len(text) for space, text, _ in atoms]
-    pos = 0
-    while pos < len(atoms):
+    while atoms:
         room = WIDTH - len(current)
-        end, used = pos, 0
-        while end < len(atoms) and used + widths[end] <= room:
-            used += widths[end]
+        end, used = 0, 0
+        while end < len(atoms) and used + len(atoms[end][0]) + _width(atoms[end][1]) <= room:
+            used += len(atoms[end][0]) + _width(atoms[end][1])
             end += 1
         if end == len(atoms):
             break
-        fits = [c for c in candidates if pos < c <= end]
+        fits = [c for c in candidates if 0 < c <= end]
         later = [c for c in candidates if c > end]
-        if fits:
-            cut = min(fits, key=lambda c: (candidates[c], -c))
-        elif later and current.strip() and pos == 0 and current != continuation:
-            cut = pos  # nothing fits after the text before: start on the next line
-        elif later:
-            cut = min(later)
-        else:
+        if not fits and not later:
             break
-        current += "".join(space + text for space, text, _ in atoms[pos:cut])
-        if cut > pos or current.strip():
-            lines.append(current)
-            # A break inside brackets is indented one step further per bracket open.
-            current = continuation + CONTINUATION * candidates.get(cut, 0)
-        atoms_left = atoms[cut:]
-        if atoms_left:
-            atoms = [("", atoms_left[0][1], atoms_left[0][2]), *atoms_left[1:]]
-            widths = [len(space) + len(text) for space, text, _ in atoms]
-            candidates = {c - cut: d for c, d in candidates.items() if c > cut}
-        else:
-            atoms = []
-        pos = 0
-    current += "".join(space + text for space, text, _ in atoms[pos:])
-    return lines, current
+        cut = min(fits, key=lambda c: (candidates[c], -c)) if fits else min(later)
+        lines.append(current + "".join(space + text for space, text, _ in atoms[:cut]))
+        # A break inside brackets is indented one step further per bracket open.
+        current = continuation + CONTINUATION * candidates[cut]
+        atoms = [("", atoms[cut][1], atoms[cut][2]), *atoms[cut + 1 :]]
+        candidates = {c - cut: d for c, d in candidates.items() if c > cut}
+    return lines, current + "".join(space + text for space, text, _ in atoms)
+
+
+def _width(text: str) -> int:
+    """How far ``text`` reaches on its line: a comment of several lines ends the line it starts on."""
+    end = text.find("\n")
+    return len(text) if end < 0 else end
 
 
 def _break_points(atoms: list, tokens: list, lead: str) -> tuple:
