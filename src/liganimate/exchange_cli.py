@@ -61,6 +61,13 @@ def add_commands(subparsers) -> None:
         metavar="WxH",
         help="image size whose aspect ratio the glTF cameras take (default 640x480)",
     )
+    p.add_argument(
+        "--rig",
+        choices=("skin", "nodes"),
+        default="skin",
+        help="glTF: a skeleton and one skinned mesh per model (skin, the default) or a tree of rigid "
+        "segment nodes (nodes)",
+    )
     p.add_argument("--quiet", action="store_true", help="do not list the files written")
     p.set_defaults(func=cmd_export)
     p = subparsers.add_parser(
@@ -102,7 +109,7 @@ def cmd_export(args) -> int:
         if kind == "bvh":
             files = X.bvh_files(scenes, args.output, args.fps)
         else:
-            data, notes = X.gltf_bytes(scenes, kind == "glb", fps=args.fps, size=args.size)
+            data, notes = X.gltf_bytes(scenes, kind == "glb", fps=args.fps, size=args.size, rig=args.rig)
             for note in notes:
                 sys.stderr.write(f"liganimate: warning: {note}\n")
             files = [(args.output, data)]
