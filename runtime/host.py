@@ -10,6 +10,7 @@ written unless the whole program is sound; then in *render* mode.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import sys
 from dataclasses import dataclass
@@ -29,6 +30,7 @@ from liganimate.runtime.figure import tree as F
 from liganimate.runtime.library import Library  # noqa: F401  (generated modules name it _host.Library)
 from liganimate.runtime.motion import algebra as M
 from liganimate.runtime.motion import edits as E
+from liganimate.runtime.motion.keyframe import Keyframe
 from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
 #: How often a long scene reports its progress while it is checked, in ticks.
@@ -73,6 +75,7 @@ class JointArgs:
     secondary_location: object
     extremes: tuple
     at: int
+    kind: tuple = (False, None)  # (SLIDE written, the AXIS vector or None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -384,10 +387,10 @@ class Runtime(Arithmetic):
             self.fail(at, f"{name or 'a model'} is used before it has a value")
         return F.Link(name, value)
 
-    def joint(self, jid, primary, loc1, secondary, loc2, extremes, names, at):
+    def joint(self, jid, primary, loc1, secondary, loc2, extremes, names, at, kind=(False, None)):
         p = self._segment(primary, names[0], at)
         s = self._segment(secondary, names[1], at)
-        fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes)
+        fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes, _joint_kind(kind))
         return self._guard(at, limits.check_figure, fig, "the joined model")
 
     def model_block(self, name, specs, at):
@@ -412,6 +415,7 @@ class Runtime(Arithmetic):
                     j.secondary_location,
                     j.extremes,
                     index,
+                    *dataclasses.astuple(_joint_kind(j.kind)),
                 )
             )
         try:
@@ -527,7 +531,7 @@ class Runtime(Arithmetic):
                 self._guard(jat, E.check_angles, start, joint is None)
             spec[joint] = (
                 tuple(start) if start is not None else (0.0, 0.0, 0.0),
-                [(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
+                [Keyframe(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
         root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
         return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root))
@@ -712,6 +716,12 @@ def _rooted(posed: Posed) -> Posed:
     fig = posed.figure
     placed = P.rooted_placements(np.asarray(fig.placement)[None], posed.motion, np.array([posed.frame]))[0]
     return posed.with_figure(fig.with_placement(placed))
+
+
+def _joint_kind(kind) -> F.JointKind:
+    """The runtime's JointKind from the ``(slide, axis)`` pair a compiled JOINT passes."""
+    slide, axis = kind
+    return F.JointKind(bool(slide), None if axis is None else tuple(float(x) for x in axis))
 
 
 def _sentence(message: str) -> str:

@@ -5,8 +5,7 @@ This sub-package owns the exchange formats and nothing else:
 * running a program's scenes without drawing them (:func:`collect`, with a
   renderer stand-in that implements the renderer's ``begin_scene`` /
   ``add_tick`` / ``end_scene`` interface);
-* glTF 2.0 export (:func:`gltf_bytes`), a skinned rig or a node tree, written
-  through pygltflib;
+* glTF 2.0 export (:func:`gltf_bytes`), written through pygltflib;
 * BVH export (:func:`bvh_files`) and BVH reading with diagnostics
   (:func:`read_bvh`);
 * turning a BVH capture into a LIG library text (:func:`lig_library`);
@@ -20,28 +19,97 @@ the language imports it; the command line reaches it through
 ``liganimate.exchange_cli``.  See ``docs/exchange.md``.
 """
 
-from ._bvh_read import BvhClip, read_bvh
-from ._bvh_write import bvh_files, bvh_text
-from ._collect import ModelTake, SceneCollector, SceneTake, collect
-from ._files import write_files
-from ._gltf import RIGS, gltf_bytes, gltf_document, key_times
-from ._lig_write import clip_angles, lig_library, read_root_path
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
+
+# The format table is light (its writers import on first use): the command
+# line reads it to build its options, and must not pay for numpy or
+# pygltflib to print --help. Everything else loads when first named.
+from ._formats import (
+    EXPORT_FORMATS,
+    EXPORT_OPTIONS,
+    Export,
+    ExportFormat,
+    ExportOption,
+    export_format,
+    export_options,
+    export_scenes,
+)
+
+if TYPE_CHECKING:
+    from ._bvh_read import BvhClip, read_bvh
+    from ._bvh_write import bvh_files, bvh_text
+    from ._clip import ClipPose, clip_pose, cut_frames, resample
+    from ._collect import ModelTake, SceneCollector, SceneTake, collect
+    from ._files import write_files
+    from ._gltf import RIGS, gltf_bytes, gltf_document, key_times
+    from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
+
+#: Name -> the module of this package that defines it, imported on first use.
+_LAZY = {
+    "BvhClip": "_bvh_read",
+    "read_bvh": "_bvh_read",
+    "bvh_files": "_bvh_write",
+    "bvh_text": "_bvh_write",
+    "ModelTake": "_collect",
+    "SceneCollector": "_collect",
+    "SceneTake": "_collect",
+    "collect": "_collect",
+    "write_files": "_files",
+    "gltf_bytes": "_gltf",
+    "gltf_document": "_gltf",
+    "key_times": "_gltf",
+    "RIGS": "_gltf",
+    "ClipPose": "_clip",
+    "clip_pose": "_clip",
+    "cut_frames": "_clip",
+    "resample": "_clip",
+    "ImportOptions": "_lig_write",
+    "import_library": "_lig_write",
+    "clip_angles": "_lig_write",
+    "lig_library": "_lig_write",
+    "read_root_path": "_lig_write",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
+    "EXPORT_FORMATS",
+    "EXPORT_OPTIONS",
     "RIGS",
     "BvhClip",
+    "ClipPose",
+    "Export",
+    "ExportFormat",
+    "ExportOption",
+    "ImportOptions",
     "ModelTake",
     "SceneCollector",
     "SceneTake",
     "bvh_files",
     "bvh_text",
     "clip_angles",
+    "clip_pose",
     "collect",
+    "cut_frames",
+    "export_format",
+    "export_options",
+    "export_scenes",
     "gltf_bytes",
     "gltf_document",
+    "import_library",
     "key_times",
     "lig_library",
     "read_bvh",
     "read_root_path",
+    "resample",
     "write_files",
 ]

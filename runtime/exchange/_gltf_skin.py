@@ -4,7 +4,9 @@ Under the model node (its host placement) hangs a skeleton with one joint
 node, a *bone*, per link of the figure, walked from the current main link as
 the renderer walks it:
 
-* the bone of the main link sits at the model node's origin;
+* the bone of the main link sits at the model node's origin (a capture's
+  importer-added empty ``ORIGIN`` main link has none: the capture's root
+  bone hangs from the model node, as the capture had it);
 * the bone of a link reached through a joint sits at the joint's pivot: its
   translation is the joint's location on the parent link less the parent
   bone's own pivot on that link, and its rotation is the joint's rotation
@@ -31,7 +33,7 @@ import pygltflib as G
 from liganimate.runtime.figure.pose import mesh_table
 
 from ._gltf import joint_quaternions, moving_joints
-from ._names import link_names
+from ._names import added_origin, link_names
 
 __all__ = ["skin_rig"]
 
@@ -46,12 +48,13 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
     loc1, loc2 = fig.locations
     rest = np.zeros((fig.n_links, 3))  # each bone's pivot in the rest pose, in the model node's space
     pivot = np.zeros((fig.n_links, 3))  # each bone's pivot on its own link
-    bones = {fig.main: _bone(b, take, model, names, fig.main, None, root)}
+    # A capture's importer adds an empty ORIGIN main link; its capture's root is the skeleton's root again.
+    bones = {} if added_origin(fig) else {fig.main: _bone(b, take, model, names, fig.main, None, root)}
     for level in fig.traversal:
         for k, p, c, r in zip(level.joints, level.parents, level.children, level.reversed):
             near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
             offset = near - pivot[p]
-            bone = _bone(b, take, model, names, int(c), (int(k), bool(r)), bones[p])
+            bone = _bone(b, take, model, names, int(c), (int(k), bool(r)), bones.get(int(p), root))
             node = b.doc.nodes[bone]
             if offset.any():
                 node.translation = [float(v) for v in offset]
@@ -61,7 +64,7 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
             bones[int(c)] = bone
             rest[c] = rest[p] + offset
             pivot[c] = far
-    order = list(bones)  # the main link first, then level by level: the skin's joint order
+    order = list(bones)  # the main link (or the root it holds) first, then level by level: the skin's joint order
     ibm = np.zeros((len(order), 4, 4), dtype=np.float32)
     ibm[:] = np.eye(4)
     ibm[:, 3, :3] = -rest[order]  # column-major: the translation is the fourth column
@@ -69,7 +72,7 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
     skin = G.Skin(
         name=label,
         joints=[bones[i] for i in order],
-        skeleton=bones[fig.main],
+        skeleton=bones[order[0]],
         inverseBindMatrices=b.accessor(ibm.reshape(len(order), 16), G.MAT4, "ibm"),
     )
     b.doc.skins.append(skin)
@@ -120,7 +123,7 @@ def _skinned_mesh(b, model, order, rest, pivot):
     scale = fig.link_scales[table.link]
     shift = rest[table.link] - pivot[table.link]
     tris = table.triangles * scale[:, None, None] + shift[:, None, :]
-    joint_of = np.empty(fig.n_links, dtype=np.int64)
+    joint_of = np.zeros(fig.n_links, dtype=np.int64)
     joint_of[order] = np.arange(len(order))
     closed = table.closed & (not mirrored)
     return b.mesh_by_vertex_colour(key, model.name, tris, table.shade, closed, joints=joint_of[table.link])

@@ -1,15 +1,19 @@
-"""The names a figure's links and joints take in exported files.
+"""The names a figure's links take in exported glTF files, and the root a source did not have.
 
-A link's own name (the graphical variable it was drawn from) where it is
-unique within the figure; otherwise, and for unnamed links, that name (or
-``SEGMENT``) with the id of the joint that attached the link.  These are
-the names the glTF rigs give bones and segment nodes, so a bone reads
-``R_THIGH`` in Blender and three.js, as the program calls the segment.
+A link imported from a capture keeps the name the capture gave it
+(``Link.source``, from the library's name table: ``mixamorig:Hips``).  A
+link made in LIG is called by its own name (the graphical variable it was
+drawn from) where that is unique within the figure; otherwise, and when
+unnamed, by that name (or ``SEGMENT``) with the id of the joint that
+attached it.  So a bone reads ``R_THIGH`` or ``mixamorig:Hips`` in Blender
+and three.js, as the program or the capture calls the segment.
 """
 
 from __future__ import annotations
 
-__all__ = ["link_names"]
+from liganimate.runtime.values import Graphical
+
+__all__ = ["added_origin", "link_names"]
 
 
 def link_names(fig) -> list[str]:
@@ -22,7 +26,8 @@ def link_names(fig) -> list[str]:
     Returns
     -------
     list of str
-        The link's name where no other link of the figure has it; else the
+        The source's name of an imported link; else the link's name where
+        no other link of the figure has it; else the
         name followed by `` <joint id>`` of the joint that attaches it (``ROOT``
         for the original main link); ``SEGMENT <joint id>`` for an unnamed link.
     """
@@ -32,6 +37,9 @@ def link_names(fig) -> list[str]:
             counts[l.name.upper()] = counts.get(l.name.upper(), 0) + 1
     names = []
     for i, l in enumerate(fig.links):
+        if l.source is not None:
+            names.append(l.source.name)
+            continue
         named = l.name is not None and not l.name.startswith("<")
         base = l.name if named else "SEGMENT"
         if not named or counts.get(l.name.upper(), 0) > 1:
@@ -42,8 +50,27 @@ def link_names(fig) -> list[str]:
     for i, name in enumerate(names):
         # Two links called FOOT and a third called "FOOT 4" could still meet.
         unique, n = name, 2
-        while unique.upper() in taken:
+        while unique in taken:
             unique, n = f"{name} ({n})", n + 1
-        taken.add(unique.upper())
+        taken.add(unique)
         names[i] = unique
     return names
+
+
+def added_origin(fig) -> bool:
+    """Whether the current main link is a root that the figure's source did not have.
+
+    ``liganimate import`` hangs a capture's ROOT under an empty ``ORIGIN``
+    link; an exporter that folds it away writes the capture's own root
+    again.  True when the main link is empty and has no source, some link
+    has one, and the main link holds exactly one sourced link through a
+    joint walked forwards.
+    """
+    main = fig.main
+    if fig.links[main].source is not None or not any(l.source is not None for l in fig.links):
+        return False
+    shape = fig.links[main].shape
+    if isinstance(shape, Graphical) and len(shape) > 0 or not fig.traversal:
+        return False
+    first = fig.traversal[0]
+    return len(first.joints) == 1 and not first.reversed[0] and fig.links[first.children[0]].source is not None

@@ -387,6 +387,13 @@ def cmd_plot(args) -> int:
     return _guarded(go)
 
 
+def cmd_lsp(args) -> int:
+    """``liganimate lsp``: the language server, over stdin and stdout, until the editor says exit."""
+    from liganimate.lsp import main as serve
+
+    return serve()
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``liganimate`` command."""
     parser = argparse.ArgumentParser(
@@ -422,6 +429,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     exchange_cli.add_commands(sub)
     view_cli.add_commands(sub)
+    p = sub.add_parser("lsp", help="serve the LIG language to an editor (the Language Server Protocol, over stdio)")
+    p.set_defaults(func=cmd_lsp)
     return parser
 
 

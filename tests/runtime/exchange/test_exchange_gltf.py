@@ -227,4 +227,5 @@ def test_cli_export_chooses_the_rig(tmp_path):
         capture_output=True,
         text=True,
     )
-    assert r.returncode == 2 and "invalid choice" in r.stderr and not (tmp_path / "x.glb").exists()
+    assert r.returncode == 2 and "'bones' is not a glTF rig; the rigs are skin and nodes" in r.stderr
+    assert not (tmp_path / "x.glb").exists()

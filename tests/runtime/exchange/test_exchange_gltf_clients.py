@@ -260,3 +260,73 @@ def test_blender_makes_an_armature_per_model_posed_as_drawn(tmp_path, name):
             np.testing.assert_allclose(got, want, rtol=0, atol=1e-5 * size, err_msg=f"frame {f} {model}")
             mesh = next(m["name"] for m in seen["meshes"] if m["armatures"] == [model])
             _same_points(shown["vertices"][mesh], _blender(verts), 1e-5 * size, f"frame {f} {model}")
+
+
+# -- imported captures keep their names -------------------------------------------------------
+
+CAPTURE_PLAY = """\
+      LOAD FIG, MOT FROM 'cap.lig'
+      INITIALIZE SCENE 1
+      STARTSCENE LENGTH 12
+        ANIMATE FIG FROM 0 TO 11 USING MOT
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+
+@pytest.mark.filterwarnings("ignore:Importing PyGLM:PendingDeprecationWarning")
+@pytest.mark.parametrize("name", ["mixamo", "rigify"])
+def test_an_imported_capture_keeps_its_names_and_root_in_both_clients(tmp_path, name):
+    """Bones are the capture's joints by their own names (``mixamorig:Hips``), with no ORIGIN root added."""
+    import re
+    import subprocess
+    import sys
+
+    from captures import capture
+
+    src = capture(name)
+    r = subprocess.run(
+        [sys.executable, "-m", "liganimate", "import", src, "-o", str(tmp_path / "cap.lig")]
+        + ["--model", "FIG", "--motion", "MOT", "--joint-translation", "drop", "--quiet"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr
+    with open(src, encoding="utf-8") as fh:
+        source_names = re.findall(r"(?:ROOT|JOINT)\s+(\S[^\r\n]*?)\s*$", fh.read().split("MOTION")[0], re.M)
+    (tmp_path / "play.lig").write_text(CAPTURE_PLAY)
+    from liganimate.cli import load_program
+
+    program, _ = load_program(str(tmp_path / "play.lig"))
+    path = str(tmp_path / "film.glb")
+    _export(program, path, "skin", 30.0)
+    fig = _figures(program)[(1, "FIG")]
+    records = pose_records(program, tmp_path)
+    seen = three_pose(path, [t / 30.0 for t in range(12)])["scenes"][0]
+    (skinned,) = seen["skinned"]
+    # three.js strips characters its property paths reserve (':' '.'), so compare with the file's names too.
+    from exchange_support import load_gltf
+
+    doc, _ = load_gltf(path)
+    (skin,) = doc.skins
+    assert [doc.nodes[j].name for j in skin.joints][0] == source_names[0]
+    assert sorted(doc.nodes[j].name for j in skin.joints) == sorted(source_names)
+    assert len(skinned["skeleton"]) == len(source_names) == fig.n_links - 1  # no bone for ORIGIN
+    segments = [e["liganimate"]["segment"] for e in skinned["skeletonExtras"]]
+    for tick in (0, 5, 11):
+        joints, verts, size = _expected(fig, records[tick])
+        got = seen["ticks"][tick]["skinned"][0]
+        bones = np.array([np.array(m).reshape(4, 4).T[:3, 3] for m in got["bones"]])
+        np.testing.assert_allclose(bones, joints[segments], rtol=0, atol=1e-5 * size, err_msg=f"tick {tick}")
+        _same_points(got["vertices"], verts, 1e-5 * size, f"tick {tick}")
+    blender = blender_pose(path, 30.0, [0, 11])
+    (armature,) = blender["armatures"]
+    assert sorted(armature["bones"]) == sorted(source_names)
+    for f, shown in zip((0, 11), blender["frames"]):
+        joints, verts, size = _expected(fig, records[f])
+        named = {doc.nodes[j].name: doc.nodes[j].extras["liganimate"]["segment"] for j in skin.joints}
+        heads = shown["bones"][armature["name"]]
+        got = np.array([heads[n] for n in named])
+        want = _blender(np.array([joints[s] for s in named.values()]))
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-5 * size, err_msg=f"frame {f}")
