@@ -14,6 +14,7 @@ import dataclasses
 import io
 import sys
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,6 +33,9 @@ from liganimate.runtime.motion import algebra as M
 from liganimate.runtime.motion import edits as E
 from liganimate.runtime.motion.keyframe import Keyframe
 from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
+
+if TYPE_CHECKING:
+    from liganimate.runtime.render.options import RenderOptions
 
 #: How often a long scene reports its progress while it is checked, in ticks.
 PROGRESS_TICKS = 4096
@@ -177,19 +181,53 @@ class Program:
             return self.execute("check", stdout=io.StringIO(), progress=progress).warnings
         return self.execute("check", stdout=stdout, echo_print=True, progress=progress).warnings
 
-    def render(self, out_dir: str, checked: bool = False, **options) -> Runtime:
-        """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`).
+    def render(
+        self,
+        out_dir: str | None = None,
+        checked: bool = False,
+        *,
+        options: RenderOptions | None = None,
+        stdout=None,
+        progress=None,
+        executor=None,
+        **fields,
+    ) -> Runtime:
+        """Check, then render every scene (see :class:`~.render.frames.Renderer`).
 
-        ``checked=True`` says the caller has just run :meth:`check` itself
-        (the command line does, to show its warnings first), so it is not run twice.
+        Parameters
+        ----------
+        out_dir : str or None
+            The frames folder (``RenderOptions.out``); None writes only the movies asked for.
+        checked : bool
+            The caller has just run :meth:`check` itself (the command line
+            does, to show its warnings first), so it is not run twice.
+        options : RenderOptions, optional
+            What to write and how; ``out_dir`` and ``fields`` replace its values.
+        stdout : text stream, optional
+            Where PRINT writes (default ``sys.stdout``).
+        progress, executor
+            As :class:`~.render.frames.Renderer` takes them.
+        **fields
+            Fields of :class:`~.render.options.RenderOptions` (``size=``, ``gif=``, ``fps=``...).
         """
-        from liganimate.runtime.render.frames import Renderer
+        import dataclasses
 
+        from liganimate.runtime.render.frames import Renderer
+        from liganimate.runtime.render.options import RenderOptions
+
+        base = options if options is not None else RenderOptions()
+        if out_dir is not None:
+            fields["out"] = out_dir
+        try:
+            chosen = dataclasses.replace(base, **fields)
+        except TypeError:
+            unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(RenderOptions)})
+            raise TypeError(f"render() got unknown options: {', '.join(unknown)}") from None
         if not checked:
             self.check()
-        renderer = Renderer(out_dir, **options)
+        renderer = Renderer(chosen, progress=progress, executor=executor)
         try:
-            rt = self.execute("render", renderer=renderer, stdout=options.get("stdout"))
+            rt = self.execute("render", renderer=renderer, stdout=stdout)
             renderer.finish()
         finally:
             renderer.close()

@@ -11,12 +11,15 @@ This sub-package owns the exchange formats and nothing else:
 * turning a BVH capture into a LIG library text (:func:`lig_library`);
 * writing several files all or nothing (:func:`write_files`).
 
-It may import the runtime (figure, kinematics, pose, motion, camera, values,
+It is one of the tools, a layer above the runtime core (docs/architecture.md):
+it may import the runtime (figure, kinematics, pose, motion, camera, values,
 errors), ``liganimate.lang.diagnostics`` and ``liganimate.lang.ast`` for
-diagnostics, ``liganimate.compiler.types`` for the names of the built-in
-functions (which imported segment names avoid), numpy and pygltflib.  Nothing in the runtime, the compiler or
-the language imports it; the command line reaches it through
-``liganimate.exchange_cli``.  See ``docs/exchange.md``.
+diagnostics, ``liganimate.compiler.names`` for the names a program may not
+define (which imported segment names avoid), numpy and pygltflib.  The
+runtime core, the compiler and the language never import it; of the other
+tools the viewer and the studio do (to run a program's scenes); the
+command line reaches it through ``liganimate.exchange_cli``, Python through
+``liganimate.api``.  See ``docs/exchange.md``.
 """
 
 from importlib import import_module
