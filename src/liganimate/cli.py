@@ -43,7 +43,7 @@ def _size(text: str):
         raise argparse.ArgumentTypeError(f"{text!r} is not a size like 640x480") from None
 
 
-def _lig_name(text: str) -> str:
+def lig_name(text: str) -> str:
     """An option that names a MODEL or MOTION a tool writes: a name a program may define (compiler/names.py)."""
     from liganimate.compiler.names import definable
 
@@ -54,7 +54,7 @@ def _lig_name(text: str) -> str:
     return text.upper()
 
 
-def _shot_scenes(path: str, doing: str) -> list:
+def shot_scenes(path: str, doing: str) -> list:
     """The scenes the program at ``path`` shoots, its warnings printed; an error when it shoots none.
 
     ``doing`` finishes the sentence "there is nothing to ..." (export, view).
@@ -193,7 +193,7 @@ def _render(program, warnings, options) -> int:
     return 0
 
 
-def _guarded(fn):
+def guarded(fn):
     """Run a command, turning diagnostics into exit status 1 and bugs into a short report.
 
     KeyboardInterrupt (and :class:`~liganimate.runtime.interrupts.Interrupted`)
@@ -276,7 +276,7 @@ def cmd_run(args) -> int:
         program, warnings = load_program(args.file)
         return _render(program, warnings, options)
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_check(args) -> int:
@@ -286,7 +286,7 @@ def cmd_check(args) -> int:
         _print_diagnostics(_checked(program, False, stdout=sys.stdout))
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_compile(args) -> int:
@@ -301,7 +301,7 @@ def cmd_compile(args) -> int:
             fh.write(compiled.python.encode("utf-8"))
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_archive(args) -> int:
@@ -320,7 +320,7 @@ def cmd_archive(args) -> int:
         print(f"wrote {out}", file=sys.stderr)
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_lib(args) -> int:
@@ -346,7 +346,7 @@ def cmd_lib(args) -> int:
                 print(f"  {n:<{width}}  {kind:<9}  {lib.descriptions.get(n, '(no description)')}")
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_plot(args) -> int:
@@ -361,7 +361,7 @@ def cmd_plot(args) -> int:
         plot_motion(rt, name, out)
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_lsp(args) -> int:
@@ -430,6 +430,6 @@ def run_program_cli(program, argv=None) -> int:
     def go():
         args = parser.parse_args(argv)
         stem = os.path.splitext(os.path.basename(program.name))[0]
-        return _guarded(lambda: _render(program, [], _render_options(args, stem)))
+        return guarded(lambda: _render(program, [], _render_options(args, stem)))
 
     return _stoppable(go, argv is None)

@@ -60,7 +60,7 @@ def _frame_range(text: str) -> tuple:
 
 def add_commands(subparsers) -> None:
     """Add ``export`` and ``import`` to the ``liganimate`` command's subparsers."""
-    from liganimate.cli import _lig_name
+    from liganimate.cli import lig_name
     from liganimate.runtime import exchange as X
 
     formats = X.EXPORT_FORMATS
@@ -101,8 +101,8 @@ def add_commands(subparsers) -> None:
     )
     p.add_argument("file", metavar="FILE.bvh")
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
-    p.add_argument("--model", type=_lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
-    p.add_argument("--motion", type=_lig_name, help="the MOTION's name (default: <STEM>)")
+    p.add_argument("--model", type=lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
+    p.add_argument("--motion", type=lig_name, help="the MOTION's name (default: <STEM>)")
     p.add_argument(
         "--tolerance",
         type=_degrees,
@@ -125,7 +125,7 @@ def add_commands(subparsers) -> None:
 
 def cmd_export(args) -> int:
     """``liganimate export FILE -o OUT``."""
-    from liganimate.cli import _guarded, _shot_scenes
+    from liganimate.cli import guarded, shot_scenes
 
     def go():
         from liganimate.runtime import exchange as X
@@ -133,7 +133,7 @@ def cmd_export(args) -> int:
         # The format and its options are checked before the program runs.
         fmt = X.export_format(args.output)
         options = X.export_options(fmt, {o: getattr(args, "export_" + o) for o in X.EXPORT_OPTIONS})
-        scenes = _shot_scenes(args.file, "export")
+        scenes = shot_scenes(args.file, "export")
         export = fmt.write(scenes, args.output, **options)
         for note in export.warnings:
             sys.stderr.write(f"liganimate: warning: {note}\n")
@@ -144,12 +144,12 @@ def cmd_export(args) -> int:
                 sys.stderr.write(f"wrote {path}\n")
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_import(args) -> int:
     """``liganimate import FILE.bvh -o OUT.lig``."""
-    from liganimate.cli import _guarded
+    from liganimate.cli import guarded
 
     def go():
         from liganimate.runtime import exchange as X
@@ -191,4 +191,4 @@ def cmd_import(args) -> int:
             )
         return 0
 
-    return _guarded(go)
+    return guarded(go)
