@@ -82,7 +82,7 @@ def _write(path: str, text: str) -> None:
 
 def _one(path: str, args) -> str:
     """Format one file as ``args`` ask: 'same', 'changed' or 'failed' (its diagnostics printed)."""
-    from liganimate.cli import _guarded
+    from liganimate.cli import guarded
 
     result = ["failed"]
 
@@ -99,7 +99,7 @@ def _one(path: str, args) -> str:
             _write(path, after)
         return 0
 
-    _guarded(go)
+    guarded(go)
     return result[0]
 
 
