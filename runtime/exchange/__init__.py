@@ -48,7 +48,7 @@ if TYPE_CHECKING:
     from ._clip import ClipPose, clip_pose, cut_frames, resample
     from ._collect import ModelTake, SceneCollector, SceneTake, collect
     from ._files import write_files
-    from ._gltf import gltf_bytes, gltf_document
+    from ._gltf import RIGS, gltf_bytes, gltf_document, key_times
     from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
     from ._urdf_lig import MESH_TRIANGLES, UrdfImportOptions, import_urdf, robot_model_name
     from ._urdf_read import Urdf, read_urdf
@@ -66,6 +66,8 @@ _LAZY = {
     "write_files": "_files",
     "gltf_bytes": "_gltf",
     "gltf_document": "_gltf",
+    "key_times": "_gltf",
+    "RIGS": "_gltf",
     "ClipPose": "_clip",
     "clip_pose": "_clip",
     "cut_frames": "_clip",
@@ -96,6 +98,7 @@ def __getattr__(name: str) -> Any:
 __all__ = [
     "EXPORT_FORMATS",
     "EXPORT_OPTIONS",
+    "RIGS",
     "MESH_TRIANGLES",
     "Urdf",
     "UrdfImportOptions",
@@ -123,6 +126,7 @@ __all__ = [
     "gltf_bytes",
     "gltf_document",
     "import_library",
+    "key_times",
     "lig_library",
     "read_bvh",
     "read_root_path",
