@@ -110,6 +110,12 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
         "--aa", default="1", metavar="N", help="anti-aliasing: draw N times finer and average, 1 to 8 (default 1, off)"
     )
     p.add_argument(
+        "--look",
+        default="modern",
+        metavar="NAME",
+        help="modern (default: lit, outlined, shadowed, smooth edges) or thesis (flat shades on white, as in the thesis)",
+    )
+    p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
         default=None,
@@ -126,6 +132,7 @@ def _check_render_options(args, stem: str) -> str:
     """
     from liganimate.runtime.errors import RenderError
     from liganimate.runtime.render.frames import check_aa
+    from liganimate.runtime.render.look import check_look
     from liganimate.runtime.render.outputs import (
         CLI_NAMES,
         check_fps,
@@ -138,6 +145,7 @@ def _check_render_options(args, stem: str) -> str:
     out = args.out if args.out is not None or args.gif or args.mp4 else f"{stem}_frames"
     args.fps = check_fps(args.fps, "--fps")
     args.aa = check_aa(args.aa, "--aa")
+    args.look = check_look(args.look, "--look")
     args.crf = check_crf(args.crf if args.crf is not None else DEFAULT_CRF, "--crf")
     args.preset = check_preset(args.preset if args.preset is not None else DEFAULT_PRESET, "--preset")
     if args.scheduler is None:
@@ -192,7 +200,7 @@ def _render(program, warnings, args, out: str) -> int:
     warnings_run = _checked(program, args.quiet)
     _print_diagnostics(warnings_run)
     options = dict(size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps, quiet=args.quiet)
-    options.update(aa=args.aa, crf=args.crf, preset=args.preset)
+    options.update(aa=args.aa, crf=args.crf, preset=args.preset, look=args.look)
     if args.scheduler is not None:
         options["executor"] = _dask_executor(args.scheduler)
     program.render(out, checked=True, **options)
