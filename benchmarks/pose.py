@@ -77,10 +77,13 @@ def loop_setup(fig, motion):
     for k, jid in enumerate(fig.joint_ids):
         if jid in motion.joints:
             start, keys = motion.keyframes(jid)
-            for _, _, method in keys:
-                if method not in EASE:
-                    raise SystemExit(f"the loop baseline has no ease curve for {method}")
-            tracks[k] = ([float(a) for a in start], [(float(f), [float(a) for a in v], m) for f, v, m in keys])
+            for key in keys:
+                if key.method not in EASE:
+                    raise SystemExit(f"the loop baseline has no ease curve for {key.method}")
+            tracks[k] = (
+                [float(a) for a in start],
+                [(float(key.frame), [float(a) for a in key.position], key.method) for key in keys],
+            )
     return order, np.asarray(loc1), np.asarray(loc2), fig.extremes.tolist(), tracks, fig.link_scales.tolist()
 
 

@@ -32,6 +32,7 @@ from pathlib import Path
 from liganimate import __version__
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+from liganimate.lang.name_table import read_tables
 from liganimate.lang.source import SourceFileError, lig_text, read_source_bytes
 
 from . import library_cache
@@ -74,6 +75,8 @@ class Library:
     signatures: dict  # own PRIMITIVE NAME -> Signature (no defaults: they live in ``python``)
     descriptions: dict  # NAME -> one-line description from its {@ NAME: ...} comments
     warnings: list = field(default_factory=list)
+    # MODEL -> {SEGMENT: (source name, channels, end)}: its {@names ...} tables (lang/name_table.py)
+    names: dict = field(default_factory=dict)
     deps: tuple = ()  # ((absolute path, sha256 of its bytes), ...) of every file it loads, recursively
     scenes: bool = False  # whether it defines or shoots scenes (then it is a program, not a library)
 
@@ -229,6 +232,10 @@ def _to_json(lib: Library) -> dict:
         "python": lib.python,
         "types": lib.types,
         "descriptions": lib.descriptions,
+        "names": {
+            m: {k: [v[0], list(v[1]), None if v[2] is None else list(v[2])] for k, v in rows.items()}
+            for m, rows in lib.names.items()
+        },
         "scenes": lib.scenes,
         "deps": [list(d) for d in lib.deps],
         "signatures": [
@@ -278,6 +285,10 @@ def _from_json(obj: dict) -> Library:
         signatures=sigs,
         descriptions=dict(obj["descriptions"]),
         warnings=warnings,
+        names={
+            m: {k: (v[0], tuple(v[1]), None if v[2] is None else tuple(v[2])) for k, v in rows.items()}
+            for m, rows in obj.get("names", {}).items()
+        },
         deps=tuple((p, h) for p, h in obj["deps"]),
         scenes=bool(obj["scenes"]),
     )
@@ -369,6 +380,7 @@ def _compile(name: str, path: str, data: bytes, stack: tuple) -> Library:
         signatures=sigs,
         descriptions=descriptions(source.text),
         warnings=list(compiled.warnings),
+        names={m: rows for m, rows in read_tables(source.text).items() if types.get(m) == T.MODEL},
         deps=tuple(dict.fromkeys(deps)),
         scenes=_has_scenes(checked.program.body),
     )

@@ -35,13 +35,13 @@ def motion_listing(motion, label: str) -> str:
         for j in motion.joints:
             start, kfs = motion.keyframes(j, limit=1000)
             lines.append(f"  JOINT {j} POSITION {_vector(start)}")
-            for frame, val, method in kfs:
-                lines.append(f"    FRAME {frame:g} POSITION {_vector(val)} INTERPOLATE {method}")
+            for k in kfs:
+                lines.append(f"    FRAME {k.frame:g} POSITION {_vector(k.position)} INTERPOLATE {k.method}")
         if motion.root is not None:
             start, kfs = motion.root_keyframes(limit=1000)
             lines.append(f"  ROOT POSITION {_vector(start)}")
-            for frame, val, method in kfs:
-                lines.append(f"    FRAME {frame:g} POSITION {_vector(val)} INTERPOLATE {method}")
+            for k in kfs:
+                lines.append(f"    FRAME {k.frame:g} POSITION {_vector(k.position)} INTERPOLATE {k.method}")
     except LigError:
         lines.append("  " + motion.describe())
     return "\n".join(lines)

@@ -11,34 +11,104 @@ This sub-package owns the exchange formats and nothing else:
 * turning a BVH capture into a LIG library text (:func:`lig_library`);
 * writing several files all or nothing (:func:`write_files`).
 
-It may import the runtime (figure, kinematics, pose, motion, camera, values,
+It is one of the tools, a layer above the runtime core (docs/architecture.md):
+it may import the runtime (figure, kinematics, pose, motion, camera, values,
 errors), ``liganimate.lang.diagnostics`` and ``liganimate.lang.ast`` for
-diagnostics, ``liganimate.compiler.types`` for the names of the built-in
-functions (which imported segment names avoid), numpy and pygltflib.  Nothing in the runtime, the compiler or
-the language imports it; the command line reaches it through
-``liganimate.exchange_cli``.  See ``docs/exchange.md``.
+diagnostics, ``liganimate.compiler.names`` for the names a program may not
+define (which imported segment names avoid), numpy and pygltflib.  The
+runtime core, the compiler and the language never import it; of the other
+tools the viewer and the studio do (to run a program's scenes); the
+command line reaches it through ``liganimate.exchange_cli``, Python through
+``liganimate.api``.  See ``docs/exchange.md``.
 """
 
-from ._bvh_read import BvhClip, read_bvh
-from ._bvh_write import bvh_files, bvh_text
-from ._collect import ModelTake, SceneCollector, SceneTake, collect
-from ._files import write_files
-from ._gltf import gltf_bytes, gltf_document
-from ._lig_write import clip_angles, lig_library, read_root_path
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
+
+# The format table is light (its writers import on first use): the command
+# line reads it to build its options, and must not pay for numpy or
+# pygltflib to print --help. Everything else loads when first named.
+from ._formats import (
+    EXPORT_FORMATS,
+    EXPORT_OPTIONS,
+    Export,
+    ExportFormat,
+    ExportOption,
+    export_format,
+    export_options,
+    export_scenes,
+)
+
+if TYPE_CHECKING:
+    from ._bvh_read import BvhClip, read_bvh
+    from ._bvh_write import bvh_files, bvh_text
+    from ._clip import ClipPose, clip_pose, cut_frames, resample
+    from ._collect import ModelTake, SceneCollector, SceneTake, collect
+    from ._files import write_files
+    from ._gltf import gltf_bytes, gltf_document
+    from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
+
+#: Name -> the module of this package that defines it, imported on first use.
+_LAZY = {
+    "BvhClip": "_bvh_read",
+    "read_bvh": "_bvh_read",
+    "bvh_files": "_bvh_write",
+    "bvh_text": "_bvh_write",
+    "ModelTake": "_collect",
+    "SceneCollector": "_collect",
+    "SceneTake": "_collect",
+    "collect": "_collect",
+    "write_files": "_files",
+    "gltf_bytes": "_gltf",
+    "gltf_document": "_gltf",
+    "ClipPose": "_clip",
+    "clip_pose": "_clip",
+    "cut_frames": "_clip",
+    "resample": "_clip",
+    "ImportOptions": "_lig_write",
+    "import_library": "_lig_write",
+    "clip_angles": "_lig_write",
+    "lig_library": "_lig_write",
+    "read_root_path": "_lig_write",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
+    "EXPORT_FORMATS",
+    "EXPORT_OPTIONS",
     "BvhClip",
+    "ClipPose",
+    "Export",
+    "ExportFormat",
+    "ExportOption",
+    "ImportOptions",
     "ModelTake",
     "SceneCollector",
     "SceneTake",
     "bvh_files",
     "bvh_text",
     "clip_angles",
+    "clip_pose",
     "collect",
+    "cut_frames",
+    "export_format",
+    "export_options",
+    "export_scenes",
     "gltf_bytes",
     "gltf_document",
+    "import_library",
     "lig_library",
     "read_bvh",
     "read_root_path",
+    "resample",
     "write_files",
 ]

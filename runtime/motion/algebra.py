@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import operator
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
 from liganimate.runtime.motion import path as rp
 from liganimate.runtime.motion import track as tr
+from liganimate.runtime.motion.keyframe import Keyframe
 
 __all__ = [
     "DEFAULT_KEYFRAME_LIMIT",
@@ -79,9 +80,9 @@ def _leaf(joint: int | None, spec) -> tr.Leaf:
     previous = 0.0
     for k, key in enumerate(keys, start=1):
         where = f"{who}, keyframe {k}"
-        if not isinstance(key, Sequence) or len(key) not in (3, 4):
-            raise MotionError(f"{where}: expected (frame, position, method)")
-        frame = _real(key[0], f"{where}: frame")
+        if not isinstance(key, Keyframe):
+            raise MotionError(f"{where}: expected a Keyframe, not {type(key).__name__}")
+        frame = _real(key.frame, f"{where}: frame")
         if frame < 0:
             raise MotionError(
                 f"{where}: frame {frame:g} is negative",
@@ -94,17 +95,17 @@ def _leaf(joint: int | None, spec) -> tr.Leaf:
             )
         previous = frame
         try:
-            method = interpolation.get(key[2])
+            method = interpolation.get(key.method)
         except KeyError:
             raise MotionError(
-                f"{where}: unknown interpolation method {key[2]!r}",
+                f"{where}: unknown interpolation method {key.method!r}",
                 hint="known methods: " + ", ".join(interpolation.names()),
             ) from None
-        ramp = tr.RAMP if len(key) == 3 else _real(key[3], f"{where}: ramp")
+        ramp = _real(key.ramp, f"{where}: ramp")
         if ramp <= 0:
             raise MotionError(f"{where}: ramp {ramp:g} must be positive")
         frames.append(frame)
-        values.append(_vector(key[1], f"{where}: position"))
+        values.append(_vector(key.position, f"{where}: position"))
         methods.append(method)
         ramps.append(ramp)
     positions = np.reshape(values, (-1, 3))
@@ -210,9 +211,7 @@ class Motion:
         ----------
         tracks : mapping of int to (start, keyframes)
             ``start`` is array_like of shape (3,) (or None for the neutral
-            position); ``keyframes`` is a sequence of ``(frame, position,
-            method_name)`` with ``position`` of shape (3,), optionally with a
-            fourth element, the LINEAR ramp in frames (default 3).
+            position); ``keyframes`` is a sequence of :class:`Keyframe`.
         name : str, optional
             Shown by :meth:`describe`.
         root : (start, keyframes), optional
@@ -286,13 +285,13 @@ class Motion:
         _finite(out)
         return out
 
-    def root_keyframes(self, limit: int = DEFAULT_KEYFRAME_LIMIT, with_ramps: bool = False):
+    def root_keyframes(self, limit: int = DEFAULT_KEYFRAME_LIMIT) -> tuple[tuple, list[Keyframe]]:
         """The root path written out as one keyframe list (see :meth:`keyframes`).
 
         Returns
         -------
         start : tuple of 3 float
-        keys : list of (frame, (x, y, z), method_name[, ramp])
+        keys : list of Keyframe
 
         Raises
         ------
@@ -307,7 +306,7 @@ class Motion:
             raise MotionError(
                 f"the root track: {exc.message}", hint="use describe() to see how the motion is built"
             ) from None
-        return start, keys if with_ramps else [k[:3] for k in keys]
+        return start, keys
 
     def track(self, joint: int) -> tr.Track:
         """The track node of one joint (for the runtime and tests).
@@ -628,28 +627,23 @@ class Motion:
 
     # -- inspection -------------------------------------------------------
 
-    def keyframes(
-        self, joint: int, limit: int = DEFAULT_KEYFRAME_LIMIT, with_ramps: bool = False
-    ) -> tuple[tuple[float, float, float], list[tuple]]:
+    def keyframes(self, joint: int, limit: int = DEFAULT_KEYFRAME_LIMIT) -> tuple[tuple, list[Keyframe]]:
         """One joint's track written out as a single keyframe list (for PRINT).
 
         Junctions of ``+`` and ``*`` appear as a repeated keyframe (a
         zero-length step), and holds as a constant LINEAR segment, so the
-        listing fed back to :meth:`from_tracks` (with ``with_ramps=True``)
-        gives the same angles except exactly at left-continuous steps.
+        listing fed back to :meth:`from_tracks` gives the same angles except exactly at left-continuous steps.
 
         Parameters
         ----------
         joint : int
         limit : int
             Most keyframes to produce.
-        with_ramps : bool
-            Append each keyframe's LINEAR ramp as a fourth element.
 
         Returns
         -------
         start : tuple of 3 float
-        keys : list of (frame, (x, y, z), method_name[, ramp])
+        keys : list of Keyframe
 
         Raises
         ------
@@ -664,8 +658,6 @@ class Motion:
             raise MotionError(
                 f"joint {j}: {exc.message}", hint="use describe() to see how the motion is built"
             ) from None
-        if not with_ramps:
-            keys = [k[:3] for k in keys]
         return start, keys
 
     def footprint(self) -> tr.Footprint:

@@ -15,6 +15,7 @@ from liganimate.lang import messages
 from liganimate.lang import numbers as N
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.motion.keyframe import Keyframe
 
 
 class EditError(MotionError):
@@ -116,14 +117,14 @@ def apply(m: KeyframeEdits) -> Motion:
     tracks: dict = {}
     for j in base.joints + ((None,) if base.root is not None else ()):
         # Keep each keyframe's ramp so a stretched motion stays stretched.
-        start, kfs = base.root_keyframes(with_ramps=True) if j is None else base.keyframes(j, with_ramps=True)
-        tracks[j] = [tuple(start), {i + 1: (kf[0], tuple(kf[1]), kf[2], None, kf[3]) for i, kf in enumerate(kfs)}]
+        start, kfs = base.root_keyframes() if j is None else base.keyframes(j)
+        tracks[j] = [tuple(start), {i + 1: (kf, None) for i, kf in enumerate(kfs)}]
     for joint, k, frame, position, method, eat in edits:
         entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
         if k == 0:
             entry[0] = position
         else:
-            entry[1][k] = (frame, position, method or "LINEAR", eat, None)
+            entry[1][k] = (Keyframe(frame, position, method or "LINEAR"), eat)
     spec = {}
     for joint, (start, kfs) in tracks.items():
         numbers = sorted(kfs)
@@ -134,20 +135,20 @@ def apply(m: KeyframeEdits) -> Motion:
             raise EditError(
                 f"keyframe {n} of {_track_name(joint)} is set, but keyframe {first} never is",
                 "number the keyframes of each joint 1, 2, 3, ... without gaps",
-                kfs[n][3],
+                kfs[n][1],
             )
         seq = [kfs[i] for i in numbers]
         previous = 0.0  # keyframe 0, the starting position, is at frame 0
-        for i in range(len(seq)):
-            gap = seq[i][0] - previous
+        for i, (key, eat) in enumerate(seq):
+            gap = key.frame - previous
             if gap < 0:
                 where = f"keyframe {i + 1} of {_track_name(joint)}"
-                raise EditError(messages.keyframes_out_of_order(seq[i][0], previous, where), None, seq[i][3])
+                raise EditError(messages.keyframes_out_of_order(key.frame, previous, where), None, eat)
             if 0 < gap < N.MIN_FRAME_GAP:
                 where = f"keyframe {i + 1} of {_track_name(joint)}"
-                raise EditError(messages.keyframes_too_close(seq[i][0], previous, where), messages.GAP_HINT, seq[i][3])
-            previous = seq[i][0]
-        spec[joint] = (start, [(f, p, meth) if ramp is None else (f, p, meth, ramp) for f, p, meth, _, ramp in seq])
+                raise EditError(messages.keyframes_too_close(key.frame, previous, where), messages.GAP_HINT, eat)
+            previous = key.frame
+        spec[joint] = (start, [key for key, _ in seq])
     root = spec.pop(None, None)
     motion = Motion.from_tracks(spec, root=root)
     m._cache = motion

@@ -22,9 +22,7 @@ import numpy as np
 from liganimate.lang.numbers import MAX_ANGLE, MAX_FRAME, MIN_FRAME_GAP, magnitude
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
-
-RAMP = 3.0
-"""Frames a LINEAR segment spends reaching its cruise speed (before SCALE FRAMES)."""
+from liganimate.runtime.motion.keyframe import RAMP, Keyframe
 
 MAX_PIECES = 64
 """Pieces a flat Concat may hold; longer chains nest, which keeps appends cheap."""
@@ -1355,7 +1353,7 @@ class _Emitter:
     """Collects a flat keyframe listing, refusing to grow past ``limit``."""
 
     def __init__(self, start: np.ndarray, limit: int):
-        self.keys: list = []
+        self.keys: list[Keyframe] = []
         self.limit = limit
         self.cur = start
         self.last = 0.0
@@ -1365,15 +1363,16 @@ class _Emitter:
     def add(self, frame, value, method, ramp):
         if len(self.keys) >= self.limit:
             raise MotionError(f"the keyframe listing exceeds the limit of {self.limit} keyframes")
-        self.keys.append((float(frame), tuple(float(x) for x in value), method, float(ramp)))
+        x, y, z = (float(v) for v in value)
+        self.keys.append(Keyframe(float(frame), (x, y, z), method, float(ramp)))
         self.cur, self.last = value, frame
 
     def _at_step(self) -> bool:
         """True if the last knot is the end of a zero-length segment (a velocity barrier)."""
         if not self.keys:
             return False
-        before = self.keys[-2][0] if len(self.keys) > 1 else 0.0
-        return before == self.keys[-1][0]
+        before = self.keys[-2].frame if len(self.keys) > 1 else 0.0
+        return before == self.keys[-1].frame
 
     def hold_until(self, frame):
         """Constant until ``frame``.
@@ -1402,7 +1401,7 @@ class _Emitter:
             self.add(frame, start, "LINEAR", RAMP)
 
 
-def materialize(track: Track, limit: int) -> tuple[tuple, list]:
+def materialize(track: Track, limit: int) -> tuple[tuple, list[Keyframe]]:
     """Flatten a track into one keyframe list that evaluates to the same angles.
 
     Junctions appear as zero-length steps, which also stop the LINEAR velocity
@@ -1417,7 +1416,7 @@ def materialize(track: Track, limit: int) -> tuple[tuple, list]:
     Returns
     -------
     start : tuple of 3 float
-    keys : list of (frame, (x, y, z), method_name, ramp)
+    keys : list of Keyframe
 
     Raises
     ------

@@ -53,8 +53,8 @@ def plot_motion_figure(motion, title: str):
         except LigError:
             keys, start = None, None  # too many to mark (a long repetition): curves only
         if keys is not None:
-            frames = np.array([0.0] + [k[0] for k in keys])
-            values = np.array([start] + [k[1] for k in keys], dtype=float)
+            frames = np.array([0.0] + [k.frame for k in keys])
+            values = np.array([start] + [k.position for k in keys], dtype=float)
             for k, (_, colour) in enumerate(_AXES):
                 ax.plot(frames, values[:, k], "o", color=colour, ms=4, mfc="white", mew=1.2)
         ax.set_ylabel(f"joint {j}\n(degrees)")

@@ -10,13 +10,15 @@ the viewer itself (``_repr_html_``), in a sandboxed frame.
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, NoReturn
+import warnings
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, format_diagnostic
 
 if TYPE_CHECKING:
     from liganimate.runtime.exchange import SceneTake
     from liganimate.runtime.host import Program
+    from liganimate.runtime.render.options import RenderOptions
 
 __all__ = ["LigProgramError", "LoadedProgram", "View", "load"]
 
@@ -117,6 +119,103 @@ class LoadedProgram:
             raise ValueError("the program shoots no scene, so there is nothing to view")
         title = os.path.basename(self.name) + ("" if scene is None else f", scene {scene}")
         return View(viewer_html(takes, title), height)
+
+    def check(self) -> list[Diagnostic]:
+        """Run every statement and every scene tick without drawing, as ``liganimate check`` does.
+
+        Returns
+        -------
+        list of Diagnostic
+            The warnings of the run (the compiler's are in :attr:`warnings`).
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs.
+        """
+        try:
+            return list(self.program.check())
+        except LigDiagnostics as exc:
+            _reraise(exc)
+
+    def render(
+        self, out: str | os.PathLike[str] | None = None, *, options: RenderOptions | None = None, **fields: Any
+    ) -> None:
+        """Check the program, then draw its scenes to files, as ``liganimate run`` does.
+
+        Parameters
+        ----------
+        out : str or os.PathLike, optional
+            The folder for the PNG frames (``out/scene<ID>/<NNNNN>.png``);
+            None writes only the movies asked for.
+        options : RenderOptions, optional
+            What to write and how, as one value; ``out`` and ``fields`` replace its values.
+        **fields
+            Fields of :class:`liganimate.RenderOptions`, as the command
+            line's options: ``size=(640, 480)``, ``gif=``, ``mp4=``,
+            ``poses=``, ``fps=``, ``aa=``, ``look=`` (``"modern"``, the
+            default, or ``"thesis"``), ``crf=``, ``preset=``,
+            ``workers=``, ``scheduler=``, ``quiet=``.
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs.
+        ValueError
+            When an option cannot be honoured (nothing is written then), or
+            nothing would be written.
+        TypeError
+            When a keyword is not a field of ``RenderOptions``.
+        """
+        if out is not None:
+            fields["out"] = os.fspath(out)
+        try:
+            self.program.render(options=options, **fields)
+        except LigDiagnostics as exc:
+            _reraise(exc)
+
+    def export(self, path: str | os.PathLike[str], **options: Any) -> list[str]:
+        """Write the scenes' models and motion in the format ``path``'s extension chooses.
+
+        The formats and their options are those of ``liganimate export``
+        (``liganimate.runtime.exchange.EXPORT_FORMATS``): ``.glb`` and
+        ``.gltf`` (glTF 2.0; options ``fps``, ``size``) and ``.bvh`` (one
+        file per drawn model; option ``fps``).  Files are written all or
+        none; a format's warnings are issued as :class:`UserWarning`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write (BVH writes several beside it when the scenes
+            draw several models).
+        **options
+            The format's options, for example ``fps=30``, ``size=(1280, 720)``.
+
+        Returns
+        -------
+        list of str
+            The paths written.
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs.
+        ValueError
+            When the extension names no format, an option does not apply to
+            it or is out of range, or the program shoots no scene.
+        """
+        from liganimate.runtime.exchange import export_format, export_options, write_files
+
+        fmt = export_format(path)
+        checked = export_options(fmt, options)
+        takes = self.scenes()
+        if not takes:
+            raise ValueError("the program shoots no scene, so there is nothing to export")
+        written = fmt.write(takes, os.fspath(path), **checked)
+        for note in written.warnings:
+            warnings.warn(note, UserWarning, stacklevel=2)
+        write_files(written.files)
+        return [p for p, _ in written.files]
 
     def _repr_html_(self) -> str:
         return self.view()._repr_html_()

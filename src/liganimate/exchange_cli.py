@@ -12,17 +12,18 @@ import os
 import re
 import sys
 
-_EXPORT_KINDS = {".glb": "glb", ".gltf": "gltf", ".bvh": "bvh"}
 
+def _option_type(option):
+    """An argparse ``type`` for an export option: its ``convert``, errors as usage errors."""
 
-def _fps(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of frames per second") from None
-    if not (value > 0 and value < 1e6):
-        raise argparse.ArgumentTypeError(f"the frame rate must be a positive number, not {text}")
-    return value
+    def convert(text: str):
+        try:
+            return option.convert(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    convert.__name__ = option.name  # argparse names the option's type in some messages
+    return convert
 
 
 def _degrees(text: str) -> float:
@@ -35,32 +36,61 @@ def _degrees(text: str) -> float:
     return value
 
 
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of frames per second") from None
+    if not (0 < value < 1e6):
+        raise argparse.ArgumentTypeError(f"the frame rate must be a positive number, not {text}")
+    return value
+
+
+def _frame_range(text: str) -> tuple:
+    first, sep, last = text.partition(":")
+    try:
+        a = int(first) if first.strip() else 0
+        b = int(last) if last.strip() else None
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a range of frames such as 100:399") from None
+    if not sep or a < 0 or (b is not None and b < a):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a range of frames A:B with 0 <= A <= B")
+    return a, b
+
+
 def add_commands(subparsers) -> None:
     """Add ``export`` and ``import`` to the ``liganimate`` command's subparsers."""
-    from liganimate.cli import _lig_name, _size
+    from liganimate.cli import lig_name
+    from liganimate.runtime import exchange as X
 
+    formats = X.EXPORT_FORMATS
+    suffixes = "|".join("OUT" + s for f in formats for s in f.suffixes)
     p = subparsers.add_parser(
         "export",
-        help="write a program's scenes as glTF 2.0 (.glb, .gltf) or BVH (.bvh)",
-        description="Write every model the program's scenes draw, with their motion, "
-        "to glTF 2.0 or BVH (see docs/exchange.md).",
+        help="write a program's scenes as " + ", ".join(f"{f.name} ({'/'.join(f.suffixes)})" for f in formats),
+        description="Write every model the program's scenes draw, with their motion, in the format "
+        "the output's extension chooses (see docs/exchange.md): "
+        + "; ".join(f"{'/'.join(f.suffixes)}: {f.summary}" for f in formats)
+        + ".",
     )
     p.add_argument("file")
     p.add_argument(
         "-o",
         "--output",
         required=True,
-        metavar="OUT.glb|OUT.gltf|OUT.bvh",
+        metavar=suffixes,
         help="the file to write; its extension chooses the format",
     )
-    p.add_argument("--fps", type=_fps, default=24.0, help="ticks per second of the time axis (default 24)")
-    p.add_argument(
-        "--size",
-        type=_size,
-        default=(640, 480),
-        metavar="WxH",
-        help="image size whose aspect ratio the glTF cameras take (default 640x480)",
-    )
+    for option in X.EXPORT_OPTIONS.values():
+        users = ", ".join(f.name for f in formats if option.name in f.options)
+        p.add_argument(
+            option.flag,
+            dest="export_" + option.name,
+            type=_option_type(option),
+            default=None,
+            metavar=option.metavar,
+            help=f"{option.help}; for {users}",
+        )
     p.add_argument("--quiet", action="store_true", help="do not list the files written")
     p.set_defaults(func=cmd_export)
     p = subparsers.add_parser(
@@ -71,8 +101,8 @@ def add_commands(subparsers) -> None:
     )
     p.add_argument("file", metavar="FILE.bvh")
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
-    p.add_argument("--model", type=_lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
-    p.add_argument("--motion", type=_lig_name, help="the MOTION's name (default: <STEM>)")
+    p.add_argument("--model", type=lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
+    p.add_argument("--motion", type=lig_name, help="the MOTION's name (default: <STEM>)")
     p.add_argument(
         "--tolerance",
         type=_degrees,
@@ -80,44 +110,46 @@ def add_commands(subparsers) -> None:
         metavar="DEG",
         help="drop keyframes while every angle stays within DEG degrees (default 0: every frame)",
     )
+    p.add_argument(
+        "--joint-translation",
+        choices=("error", "drop"),
+        default="error",
+        help="joints other than the ROOT that slide: refuse the file (error, the default) or keep each "
+        "at its first frame's offset (drop); position channels that hold still are always dropped, with a note",
+    )
+    p.add_argument("--frames", type=_frame_range, metavar="A:B", help="import frames A to B only (inclusive)")
+    p.add_argument("--fps", type=_rate, metavar="N", help="resample the capture to N frames per second")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_import)
 
 
 def cmd_export(args) -> int:
     """``liganimate export FILE -o OUT``."""
-    from liganimate.cli import _guarded, _shot_scenes
+    from liganimate.cli import guarded, shot_scenes
 
     def go():
         from liganimate.runtime import exchange as X
-        from liganimate.runtime.errors import LigError
 
-        kind = _EXPORT_KINDS.get(os.path.splitext(args.output)[1].lower())
-        if kind is None:
-            raise LigError(
-                f"cannot tell the format of {args.output} from its extension.",
-                "write to a file ending in .glb, .gltf or .bvh",
-            )
-        scenes = _shot_scenes(args.file, "export")
-        if kind == "bvh":
-            files = X.bvh_files(scenes, args.output, args.fps)
-        else:
-            data, notes = X.gltf_bytes(scenes, kind == "glb", fps=args.fps, size=args.size)
-            for note in notes:
-                sys.stderr.write(f"liganimate: warning: {note}\n")
-            files = [(args.output, data)]
+        # The format and its options are checked before the program runs.
+        fmt = X.export_format(args.output)
+        options = X.export_options(fmt, {o: getattr(args, "export_" + o) for o in X.EXPORT_OPTIONS})
+        scenes = shot_scenes(args.file, "export")
+        export = fmt.write(scenes, args.output, **options)
+        for note in export.warnings:
+            sys.stderr.write(f"liganimate: warning: {note}\n")
+        files = export.files
         X.write_files(files)
         if not args.quiet:
             for path, _ in files:
                 sys.stderr.write(f"wrote {path}\n")
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_import(args) -> int:
     """``liganimate import FILE.bvh -o OUT.lig``."""
-    from liganimate.cli import _guarded
+    from liganimate.cli import guarded
 
     def go():
         from liganimate.runtime import exchange as X
@@ -137,10 +169,21 @@ def cmd_import(args) -> int:
             )
         out = args.output or f"{stem}.lig"
         clip = X.read_bvh(args.file)
-        text = X.lig_library(
-            clip, model=model, motion=motion, source_name=os.path.basename(args.file), tolerance=args.tolerance
+        if args.frames is not None:
+            clip = X.cut_frames(clip, *args.frames)
+        if args.fps is not None:
+            clip = X.resample(clip, args.fps)
+        options = X.ImportOptions(
+            model=model,
+            motion=motion,
+            source_name=os.path.basename(args.file),
+            tolerance=args.tolerance,
+            joint_translation=args.joint_translation,
         )
+        text, notes = X.import_library(clip, options)
         X.write_files([(out, text)])
+        for note in notes:
+            sys.stderr.write(f"liganimate: note: {note}\n")
         if not args.quiet:
             sys.stderr.write(
                 f"wrote {out}: MODEL {model} and MOTION {motion} "
@@ -148,4 +191,4 @@ def cmd_import(args) -> int:
             )
         return 0
 
-    return _guarded(go)
+    return guarded(go)

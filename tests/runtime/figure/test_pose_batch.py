@@ -16,6 +16,7 @@ from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import pose
 from liganimate.runtime.figure.tree import Link, join
 from liganimate.runtime.motion import algebra as M
+from liganimate.runtime.motion.keyframe import Keyframe
 from liganimate.runtime.render.frames import Renderer
 from liganimate.runtime.values import box
 
@@ -26,18 +27,18 @@ def motions():
             1: (
                 (0, 0, 0),
                 [
-                    (3, (10, 20, 30), "LINEAR"),
-                    (7, (0, 5, -10), "ACCDCC"),
-                    (7, (1, 1, 1), "LINEAR"),
-                    (12, (40, 0, 0), "ACCELERATE"),
-                    (12.5, (3, 3, 3), "LINEAR"),
-                    (20, (0, 0, 0), "DECELERATE"),
+                    Keyframe(3, (10, 20, 30), "LINEAR"),
+                    Keyframe(7, (0, 5, -10), "ACCDCC"),
+                    Keyframe(7, (1, 1, 1), "LINEAR"),
+                    Keyframe(12, (40, 0, 0), "ACCELERATE"),
+                    Keyframe(12.5, (3, 3, 3), "LINEAR"),
+                    Keyframe(20, (0, 0, 0), "DECELERATE"),
                 ],
             ),
-            2: ((5, 5, 5), [(4, (0, 0, 90), "DECELERATE")]),
+            2: ((5, 5, 5), [Keyframe(4, (0, 0, 90), "DECELERATE")]),
         }
     )
-    b = M.Motion.from_tracks({2: ((0, 0, 0), [(2, (1, 2, 3), "LINEAR")]), 3: ((1, 1, 1), [])})
+    b = M.Motion.from_tracks({2: ((0, 0, 0), [Keyframe(2, (1, 2, 3), "LINEAR")]), 3: ((1, 1, 1), [])})
     return [
         a,
         a + b,

@@ -10,6 +10,7 @@ from liganimate.runtime.figure import pose as P
 from liganimate.runtime.figure.tree import Figure, Joint, Link
 from liganimate.runtime.ik.reach import GoalError, PointGoal, reach, reach_keyframes, solve_pose
 from liganimate.runtime.motion import algebra as M
+from liganimate.runtime.motion.keyframe import Keyframe
 
 EXT = [(-120, 120)] * 3
 
@@ -49,14 +50,16 @@ def test_reach_goes_from_the_start_pose_at_frame_0_to_the_solved_pose_at_frame_n
     assert r.converged and r.residuals[0] < 1e-4
     # The chosen method shapes the way there: ACCDCC starts slowly.
     start, keys = r.motion.keyframes(2)
-    assert keys[-1][2] == "ACCDCC"
+    assert keys[-1].method == "ACCDCC"
     moved = np.abs(angles - angles[0]).max(axis=(1, 2))
     assert moved[1] < 0.02 * moved[24]
 
 
 def test_a_start_motion_lends_its_final_pose_and_its_joints():
     fig = body()
-    wave = M.Motion.from_tracks({1: (None, [(10, (0, 0, 60), "LINEAR")]), 11: (None, [(10, (0, 0, 30), "LINEAR")])})
+    wave = M.Motion.from_tracks(
+        {1: (None, [Keyframe(10, (0, 0, 60), "LINEAR")]), 11: (None, [Keyframe(10, (0, 0, 30), "LINEAR")])}
+    )
     r = reach(fig, [GOAL], 12, start=wave, movable=[2, 3])
     assert r.joints == (1, 2, 3, 11)  # the movable joints and the start motion's
     whole = wave + r.motion
@@ -72,7 +75,7 @@ def test_a_start_motion_lends_its_final_pose_and_its_joints():
 def test_goal_made_motions_take_the_algebra():
     fig = body()
     arm = reach(fig, [GOAL], 10, movable=3).motion
-    kick = M.Motion.from_tracks({11: (None, [(5, (0, 0, 40), "ACCDCC"), (10, (0, 0, 0), "ACCDCC")])})
+    kick = M.Motion.from_tracks({11: (None, [Keyframe(5, (0, 0, 40), "ACCDCC"), Keyframe(10, (0, 0, 0), "ACCDCC")])})
     both = M.synchronize(arm, kick)
     assert both.joints == (1, 2, 3, 11) and both.length == 10
     there_and_back = arm + arm.scale_frames(-1)

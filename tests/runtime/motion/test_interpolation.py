@@ -10,6 +10,7 @@ import pytest
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation as I
 from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.motion.keyframe import Keyframe
 
 BUILTINS = ["LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"]
 U = np.linspace(0.0, 1.0, 101)
@@ -96,7 +97,7 @@ def test_register_rejects_a_clash_and_bad_objects(fresh_registry):
 
 def test_a_registered_method_drives_a_motion(fresh_registry):
     I.register(make_smoothstep())
-    m = Motion.from_tracks({1: ((0, 0, 0), [(10.0, (100.0, 0, -50.0), "smoothstep")])})
+    m = Motion.from_tracks({1: ((0, 0, 0), [Keyframe(10.0, (100.0, 0, -50.0), "smoothstep")])})
     x, v, a = m.evaluate_full(np.array([0.0, 2.5, 5.0, 7.5, 10.0]))
     u = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
     np.testing.assert_allclose(x[:, 0, 0], 100 * u * u * (3 - 2 * u))
@@ -107,12 +108,12 @@ def test_a_registered_method_drives_a_motion(fresh_registry):
     back = m.scale_frames(-1)
     t = np.linspace(0, 10, 41)
     np.testing.assert_allclose(back.evaluate(t), m.evaluate(10 - t), atol=1e-12)
-    assert back.keyframes(1)[1][-1][2] == "SMOOTHSTEP"
+    assert back.keyframes(1)[1][-1].method == "SMOOTHSTEP"
 
 
 def test_unknown_method_in_a_motion_is_a_motion_error_listing_known_ones(fresh_registry):
     with pytest.raises(MotionError) as err:
-        Motion.from_tracks({4: ((0, 0, 0), [(1.0, (1, 2, 3), "LINEAR"), (2.0, (0, 0, 0), "WOBBLE")])})
+        Motion.from_tracks({4: ((0, 0, 0), [Keyframe(1.0, (1, 2, 3), "LINEAR"), Keyframe(2.0, (0, 0, 0), "WOBBLE")])})
     assert "joint 4" in err.value.message and "keyframe 2" in err.value.message
     assert "WOBBLE" in err.value.message and "ACCDCC" in err.value.hint
 
@@ -146,7 +147,7 @@ def test_plugins_load_lazily_from_entry_points(fresh_registry, monkeypatch):
     with pytest.raises(KeyError):
         I.get("STILL-UNKNOWN")
     assert groups == [I.ENTRY_POINT_GROUP], "entry points are scanned only once"
-    m = Motion.from_tracks({1: (None, [(4.0, (8, 0, 0), "smoothstep")])})
+    m = Motion.from_tracks({1: (None, [Keyframe(4.0, (8, 0, 0), "smoothstep")])})
     assert m.evaluate([2.0])[0, 0, 0] == pytest.approx(4.0)
 
 

@@ -15,6 +15,7 @@ from liganimate.runtime.motion.algebra import (
     strip,
     synchronize,
 )
+from liganimate.runtime.motion.keyframe import Keyframe
 
 
 def one(method="LINEAR", start=(0, 0, 0), *keys):
@@ -42,7 +43,7 @@ def walk():
         frames = np.cumsum(rng.choice([2.0, 4.0, 6.0], size=4))
         values = rng.uniform(-60, 60, size=(4, 3))
         methods = ["ACCDCC", "LINEAR", "LINEAR", "DECELERATE"]
-        spec[j] = (values[-1], [(f, v, m) for f, v, m in zip(frames, values, methods)])
+        spec[j] = (values[-1], [Keyframe(f, v, m) for f, v, m in zip(frames, values, methods)])
     return Motion.from_tracks(spec, name="walk")
 
 
@@ -52,8 +53,8 @@ def walk():
 def test_from_tracks_basic_properties():
     m = Motion.from_tracks(
         {
-            7: ((0, 0, 0), [(4.0, (10, 0, 0), "LINEAR")]),
-            2: (None, [(1.5, (0, 5, 0), "accelerate"), (9.0, (0, 0, 0), "ACCDCC")]),
+            7: ((0, 0, 0), [Keyframe(4.0, (10, 0, 0), "LINEAR")]),
+            2: (None, [Keyframe(1.5, (0, 5, 0), "accelerate"), Keyframe(9.0, (0, 0, 0), "ACCDCC")]),
             3: ((1, 2, 3), []),
         }
     )
@@ -74,13 +75,13 @@ def test_empty_motion():
 @pytest.mark.parametrize(
     "keys, words",
     [
-        ([(5.0, (0, 0, 0), "LINEAR"), (4.0, (1, 1, 1), "LINEAR")], ["joint 3", "keyframe 2", "before"]),
-        ([(-1.0, (0, 0, 0), "LINEAR")], ["joint 3", "keyframe 1", "negative"]),
-        ([(1.0, (0, 0, 0), "LINEAR"), (2.0, (0, 0, 0), "BOUNCE")], ["joint 3", "keyframe 2", "BOUNCE"]),
-        ([(1.0, (0, 0), "LINEAR")], ["joint 3", "keyframe 1", "position"]),
-        ([(float("nan"), (0, 0, 0), "LINEAR")], ["joint 3", "keyframe 1", "finite"]),
-        ([(1.0, (0, 0, 0), "LINEAR", 0.0)], ["joint 3", "keyframe 1", "ramp"]),
-        ([(1.0, (0, 0, 0))], ["joint 3", "keyframe 1"]),
+        ([Keyframe(5.0, (0, 0, 0), "LINEAR"), Keyframe(4.0, (1, 1, 1), "LINEAR")], ["joint 3", "keyframe 2", "before"]),
+        ([Keyframe(-1.0, (0, 0, 0), "LINEAR")], ["joint 3", "keyframe 1", "negative"]),
+        ([Keyframe(1.0, (0, 0, 0), "LINEAR"), Keyframe(2.0, (0, 0, 0), "BOUNCE")], ["joint 3", "keyframe 2", "BOUNCE"]),
+        ([Keyframe(1.0, (0, 0), "LINEAR")], ["joint 3", "keyframe 1", "position"]),
+        ([Keyframe(float("nan"), (0, 0, 0), "LINEAR")], ["joint 3", "keyframe 1", "finite"]),
+        ([Keyframe(1.0, (0, 0, 0), "LINEAR", 0.0)], ["joint 3", "keyframe 1", "ramp"]),
+        ([(1.0, (0, 0, 0), "LINEAR")], ["joint 3", "keyframe 1", "expected a Keyframe"]),
     ],
 )
 def test_from_tracks_errors_name_joint_and_keyframe(keys, words):
@@ -114,7 +115,7 @@ def test_motions_are_immutable(walk):
 
 
 def test_before_first_keyframe_interpolates_from_the_start_and_holds_after_the_last():
-    m = one("", (10, 0, 0), (4.0, (20, 0, 0), "ACCELERATE"))
+    m = one("", (10, 0, 0), Keyframe(4.0, (20, 0, 0), "ACCELERATE"))
     assert x(m, -5)[0] == 10 and x(m, 0)[0] == 10
     assert x(m, 2)[0] == pytest.approx(10 + 10 * 0.25)
     assert x(m, 4)[0] == 20 and x(m, 50)[0] == 20
@@ -122,20 +123,26 @@ def test_before_first_keyframe_interpolates_from_the_start_and_holds_after_the_l
 
 
 def test_equal_frames_make_a_right_continuous_step():
-    m = one("", (0, 0, 0), (2.0, (10, 0, 0), "ACCDCC"), (2.0, (50, 0, 0), "LINEAR"), (6.0, (50, 0, 0), "LINEAR"))
+    m = one(
+        "",
+        (0, 0, 0),
+        Keyframe(2.0, (10, 0, 0), "ACCDCC"),
+        Keyframe(2.0, (50, 0, 0), "LINEAR"),
+        Keyframe(6.0, (50, 0, 0), "LINEAR"),
+    )
     assert x(m, 2.0 - 1e-12)[0] == pytest.approx(10)
     assert x(m, 2.0)[0] == 50
     assert vel(m, 2.0)[0] == 0
 
 
 def test_no_wrapping_two_turns_are_two_turns():
-    m = one("", (0, 0, 0), (8.0, (720, 0, 0), "ACCDCC"))
+    m = one("", (0, 0, 0), Keyframe(8.0, (720, 0, 0), "ACCDCC"))
     assert x(m, 4.0)[0] == 360.0
     assert x(m, 8.0)[0] == 720.0
 
 
 def test_each_axis_is_interpolated_independently():
-    m = one("", (0, 0, 0), (4.0, (8, -4, 0), "ACCELERATE"))
+    m = one("", (0, 0, 0), Keyframe(4.0, (8, -4, 0), "ACCELERATE"))
     np.testing.assert_allclose(m.evaluate([2.0])[0, 0], [2, -1, 0])
 
 
@@ -144,7 +151,7 @@ def test_each_axis_is_interpolated_independently():
 
 def test_linear_trapezoid_numbers():
     # 70 degrees in 10 frames, ramps of 3 frames at rest ends: cruise c = 70 / (10 - 3) = 10.
-    m = one("", (0, 0, 0), (10.0, (70, 0, 0), "LINEAR"))
+    m = one("", (0, 0, 0), Keyframe(10.0, (70, 0, 0), "LINEAR"))
     assert x(m, 3.0)[0] == pytest.approx(15.0)
     assert x(m, 5.0)[0] == pytest.approx(35.0)
     assert x(m, 1.5)[0] == pytest.approx(10 * 1.5**2 / 6)
@@ -155,47 +162,51 @@ def test_linear_trapezoid_numbers():
 
 
 def test_short_linear_segment_ramps_over_half_its_length():
-    m = one("", (0, 0, 0), (4.0, (20, 0, 0), "LINEAR"))  # r = min(3, 2) = 2, c = 20 / (4 - 2)
+    m = one("", (0, 0, 0), Keyframe(4.0, (20, 0, 0), "LINEAR"))  # r = min(3, 2) = 2, c = 20 / (4 - 2)
     assert vel(m, 2.0)[0] == pytest.approx(10.0)
     assert x(m, 2.0)[0] == pytest.approx(10.0)
 
 
 def test_linear_junction_velocity_is_the_harmonic_mean_of_slopes():
-    m = one("", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"), (20.0, (40, 0, 0), "LINEAR"))
+    m = one("", (0, 0, 0), Keyframe(10.0, (30, 0, 0), "LINEAR"), Keyframe(20.0, (40, 0, 0), "LINEAR"))
     assert vel(m, 10.0)[0] == pytest.approx(2 * 3 * 1 / (3 + 1))
     assert vel(m, 10.0 - 1e-9)[0] == pytest.approx(1.5, abs=1e-6)
     # Opposite slopes: the joint stops at the extreme.
-    n = one("", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"), (20.0, (0, 0, 0), "LINEAR"))
+    n = one("", (0, 0, 0), Keyframe(10.0, (30, 0, 0), "LINEAR"), Keyframe(20.0, (0, 0, 0), "LINEAR"))
     assert vel(n, 10.0)[0] == 0 and vel(n, 10.0 - 1e-9)[0] == pytest.approx(0, abs=1e-6)
 
 
 def test_linear_meets_a_fixed_shape_neighbour_at_its_natural_velocity():
     # DECELERATE leaves its start at 2 D / T = 2 * 20 / 4 = 10 deg/frame.
-    m = one("", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"), (14.0, (50, 0, 0), "DECELERATE"))
+    m = one("", (0, 0, 0), Keyframe(10.0, (30, 0, 0), "LINEAR"), Keyframe(14.0, (50, 0, 0), "DECELERATE"))
     assert vel(m, 10.0 - 1e-9)[0] == pytest.approx(10.0, abs=1e-6)
     assert vel(m, 10.0)[0] == pytest.approx(10.0)
     # ACCELERATE arrives at its end at 2 D / T = 2 * 30 / 10 = 6; the LINEAR after it starts there.
-    n = one("", (0, 0, 0), (10.0, (30, 0, 0), "ACCELERATE"), (20.0, (50, 0, 0), "LINEAR"))
+    n = one("", (0, 0, 0), Keyframe(10.0, (30, 0, 0), "ACCELERATE"), Keyframe(20.0, (50, 0, 0), "LINEAR"))
     assert vel(n, 10.0 - 1e-9)[0] == pytest.approx(6.0, abs=1e-6)
     assert vel(n, 10.0)[0] == pytest.approx(6.0)
 
 
 def test_linear_stops_at_steps_and_at_junctions_where_the_poses_differ():
-    a = one("", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"))
-    b = one("", (40, 0, 0), (10.0, (60, 0, 0), "LINEAR"))
+    a = one("", (0, 0, 0), Keyframe(10.0, (30, 0, 0), "LINEAR"))
+    b = one("", (40, 0, 0), Keyframe(10.0, (60, 0, 0), "LINEAR"))
     assert vel(a + b, 10.0)[0] == 0  # the adjustment never crosses a junction with a jump
     assert vel(a + b, 10.0 - 1e-9)[0] == pytest.approx(0, abs=1e-6)
     assert vel(2 * a, 10.0)[0] == 0  # a does not end where it starts
     stepped = one(
-        "", (0, 0, 0), (10.0, (30, 0, 0), "LINEAR"), (10.0, (30, 0, 0), "LINEAR"), (20.0, (60, 0, 0), "LINEAR")
+        "",
+        (0, 0, 0),
+        Keyframe(10.0, (30, 0, 0), "LINEAR"),
+        Keyframe(10.0, (30, 0, 0), "LINEAR"),
+        Keyframe(20.0, (60, 0, 0), "LINEAR"),
     )
     assert vel(stepped, 10.0)[0] == 0
 
 
 def test_a_junction_where_the_poses_meet_passes_through_like_one_keyframe_list():
-    a = one("", (0, 0, 0), (8.0, (80, 0, 0), "LINEAR"))
-    b = one("", (80, 0, 0), (8.0, (160, 0, 0), "LINEAR"))
-    joined = one("", (0, 0, 0), (8.0, (80, 0, 0), "LINEAR"), (16.0, (160, 0, 0), "LINEAR"))
+    a = one("", (0, 0, 0), Keyframe(8.0, (80, 0, 0), "LINEAR"))
+    b = one("", (80, 0, 0), Keyframe(8.0, (160, 0, 0), "LINEAR"))
+    joined = one("", (0, 0, 0), Keyframe(8.0, (80, 0, 0), "LINEAR"), Keyframe(16.0, (160, 0, 0), "LINEAR"))
     t = np.linspace(-1.0, 17.0, 73)
     np.testing.assert_allclose((a + b).evaluate(t), joined.evaluate(t), atol=1e-12)
     assert vel(a + b, 8.0)[0] == pytest.approx(10.0)
@@ -203,7 +214,13 @@ def test_a_junction_where_the_poses_meet_passes_through_like_one_keyframe_list()
 
 
 def test_a_cycle_repeated_keeps_its_velocity_across_every_junction():
-    cycle = one("", (0, 0, 0), (4.0, (20, 0, 0), "LINEAR"), (8.0, (-20, 0, 0), "LINEAR"), (12.0, (0, 0, 0), "LINEAR"))
+    cycle = one(
+        "",
+        (0, 0, 0),
+        Keyframe(4.0, (20, 0, 0), "LINEAR"),
+        Keyframe(8.0, (-20, 0, 0), "LINEAR"),
+        Keyframe(12.0, (0, 0, 0), "LINEAR"),
+    )
     m = 10 * cycle
     for k in range(1, 10):
         assert vel(m, 12.0 * k)[0] == pytest.approx(5.0)
@@ -217,10 +234,10 @@ def test_a_cycle_repeated_keeps_its_velocity_across_every_junction():
 
 
 def test_ramps_stretch_with_scale_frames():
-    m = one("", (0, 0, 0), (10.0, (70, 0, 0), "LINEAR"))
+    m = one("", (0, 0, 0), Keyframe(10.0, (70, 0, 0), "LINEAR"))
     s = m.scale_frames(2.5)
-    _, keys = s.keyframes(1, with_ramps=True)
-    assert keys[0][3] == 7.5
+    _, keys = s.keyframes(1)
+    assert keys[0].ramp == 7.5
     t = np.linspace(0, 10, 23)
     np.testing.assert_allclose(s.evaluate(2.5 * t), m.evaluate(t), atol=1e-12)
 
@@ -229,8 +246,8 @@ def test_ramps_stretch_with_scale_frames():
 
 
 def test_concat_for_joints_driven_by_one_operand():
-    a = Motion.from_tracks({1: ((0, 0, 0), [(4.0, (40, 0, 0), "LINEAR")])})
-    b = Motion.from_tracks({2: ((5, 0, 0), [(6.0, (65, 0, 0), "ACCDCC")])})
+    a = Motion.from_tracks({1: ((0, 0, 0), [Keyframe(4.0, (40, 0, 0), "LINEAR")])})
+    b = Motion.from_tracks({2: ((5, 0, 0), [Keyframe(6.0, (65, 0, 0), "ACCDCC")])})
     m = a + b
     assert m.length == 10.0
     assert x(m, [0, 2, 4, 7, 10, 20], joint=1).tolist() == [0, 20, 40, 40, 40, 40]  # a's end held during b
@@ -241,8 +258,8 @@ def test_concat_for_joints_driven_by_one_operand():
 
 
 def test_concat_junction_is_right_continuous():
-    a = one("", (0, 0, 0), (4.0, (40, 0, 0), "LINEAR"))
-    b = one("", (100, 0, 0), (4.0, (0, 0, 0), "LINEAR"))
+    a = one("", (0, 0, 0), Keyframe(4.0, (40, 0, 0), "LINEAR"))
+    b = one("", (100, 0, 0), Keyframe(4.0, (0, 0, 0), "LINEAR"))
     m = a + b
     assert x(m, 4.0)[0] == 100
     assert x(m, 4.0 - 1e-9)[0] == pytest.approx(40)
@@ -251,9 +268,9 @@ def test_concat_junction_is_right_continuous():
 
 def test_concat_pads_short_tracks_of_a():
     a = Motion.from_tracks(
-        {1: ((0, 0, 0), [(2.0, (10, 0, 0), "LINEAR")]), 2: ((0, 0, 0), [(6.0, (0, 0, 6), "LINEAR")])}
+        {1: ((0, 0, 0), [Keyframe(2.0, (10, 0, 0), "LINEAR")]), 2: ((0, 0, 0), [Keyframe(6.0, (0, 0, 6), "LINEAR")])}
     )
-    b = Motion.from_tracks({1: ((50, 0, 0), [(1.0, (60, 0, 0), "LINEAR")])})
+    b = Motion.from_tracks({1: ((50, 0, 0), [Keyframe(1.0, (60, 0, 0), "LINEAR")])})
     m = a + b
     assert x(m, [2, 4, 5.99]).tolist() == [10, 10, 10]  # joint 1 holds until len(a) = 6
     assert x(m, 6)[0] == 50 and x(m, 7)[0] == 60 and m.length == 7
@@ -263,14 +280,14 @@ def test_concat_pads_short_tracks_of_a():
 
 
 def test_repeat_zero_holds_start_values():
-    a = one("", (3, 2, 1), (4.0, (40, 0, 0), "LINEAR"))
+    a = one("", (3, 2, 1), Keyframe(4.0, (40, 0, 0), "LINEAR"))
     z = 0 * a
     assert z.length == 0 and z.joints == (1,)
     np.testing.assert_array_equal(z.evaluate([0.0, 2.0, 9.0])[:, 0], [[3, 2, 1]] * 3)
 
 
 def test_repeat_final_frame_and_junctions():
-    a = one("", (0, 0, 0), (4.0, (40, 0, 0), "ACCELERATE"))
+    a = one("", (0, 0, 0), Keyframe(4.0, (40, 0, 0), "ACCELERATE"))
     m = 3 * a
     assert m.length == 12
     assert x(m, [4.0, 8.0, 12.0, 13.0]).tolist() == [0, 0, 40, 40]
@@ -327,7 +344,7 @@ def test_huge_listing_is_refused_before_it_is_built(walk):
 
 
 def test_doubling_sixty_times_stays_small():
-    m = one("", (0, 0, 0), (1.0, (1, 0, 0), "LINEAR"))
+    m = one("", (0, 0, 0), Keyframe(1.0, (1, 0, 0), "LINEAR"))
     for _ in range(60):
         m = m + m
     assert m.length == 2.0**60
@@ -339,7 +356,7 @@ def test_doubling_sixty_times_stays_small():
 
 
 def test_long_chains_of_concatenation_do_not_recurse_deeply():
-    step = one("", (0, 0, 0), (1.0, (1, 0, 0), "LINEAR"))
+    step = one("", (0, 0, 0), Keyframe(1.0, (1, 0, 0), "LINEAR"))
     m = Motion.empty()
     for _ in range(3000):
         m = m + step
@@ -385,18 +402,22 @@ def test_scale_frames_rejects_zero_and_non_numbers(walk):
 
 def test_reversal_swaps_accelerate_and_decelerate():
     m = one(
-        "", (0, 0, 0), (4.0, (40, 0, 0), "ACCELERATE"), (8.0, (0, 0, 0), "ACCDCC"), (12.0, (10, 0, 0), "DECELERATE")
+        "",
+        (0, 0, 0),
+        Keyframe(4.0, (40, 0, 0), "ACCELERATE"),
+        Keyframe(8.0, (0, 0, 0), "ACCDCC"),
+        Keyframe(12.0, (10, 0, 0), "DECELERATE"),
     )
     start, keys = m.scale_frames(-1).keyframes(1)
     assert start == (10.0, 0.0, 0.0)
-    assert [k[2] for k in keys] == ["ACCELERATE", "ACCDCC", "DECELERATE"]
-    assert [k[0] for k in keys] == [4.0, 8.0, 12.0]
-    assert [k[1][0] for k in keys] == [0.0, 40.0, 0.0]
+    assert [k.method for k in keys] == ["ACCELERATE", "ACCDCC", "DECELERATE"]
+    assert [k.frame for k in keys] == [4.0, 8.0, 12.0]
+    assert [k.position[0] for k in keys] == [0.0, 40.0, 0.0]
 
 
 def test_reversal_moves_holds_to_the_start():
     m = Motion.from_tracks(
-        {1: ((0, 0, 0), [(2.0, (20, 0, 0), "LINEAR")]), 2: ((0, 0, 0), [(10.0, (0, 0, 0), "LINEAR")])}
+        {1: ((0, 0, 0), [Keyframe(2.0, (20, 0, 0), "LINEAR")]), 2: ((0, 0, 0), [Keyframe(10.0, (0, 0, 0), "LINEAR")])}
     )
     r = m.scale_frames(-1)
     assert x(r, [0, 4, 8]).tolist() == [20, 20, 20]  # joint 1 finished early: it now waits at the start
@@ -405,11 +426,17 @@ def test_reversal_moves_holds_to_the_start():
 
 
 def test_reversal_flips_the_side_of_steps_and_junctions():
-    m = one("", (0, 0, 0), (2.0, (10, 0, 0), "LINEAR"), (2.0, (50, 0, 0), "LINEAR"), (4.0, (60, 0, 0), "LINEAR"))
+    m = one(
+        "",
+        (0, 0, 0),
+        Keyframe(2.0, (10, 0, 0), "LINEAR"),
+        Keyframe(2.0, (50, 0, 0), "LINEAR"),
+        Keyframe(4.0, (60, 0, 0), "LINEAR"),
+    )
     r = m.scale_frames(-1)
     assert x(m, 2.0)[0] == 50 and x(r, 2.0)[0] == 50  # pose(r, t) = pose(m, 4 - t) even on the step
-    a = one("", (0, 0, 0), (2.0, (10, 0, 0), "LINEAR"))
-    b = one("", (90, 0, 0), (2.0, (80, 0, 0), "LINEAR"))
+    a = one("", (0, 0, 0), Keyframe(2.0, (10, 0, 0), "LINEAR"))
+    b = one("", (90, 0, 0), Keyframe(2.0, (80, 0, 0), "LINEAR"))
     j = (a + b).scale_frames(-1)
     assert x(a + b, 2.0)[0] == 90 and x(j, 2.0)[0] == 90
 
@@ -439,13 +466,13 @@ def test_evaluate_orders_joints_and_checks_them(walk):
 
 
 def test_keyframe_listing_of_a_composite(walk):
-    a = one("", (0, 0, 0), (2.0, (10, 0, 0), "ACCELERATE"))
+    a = one("", (0, 0, 0), Keyframe(2.0, (10, 0, 0), "ACCELERATE"))
     start, keys = (a + a).keyframes(1)
     assert start == (0.0, 0.0, 0.0)
     assert keys == [
-        (2.0, (10.0, 0.0, 0.0), "ACCELERATE"),
-        (2.0, (0.0, 0.0, 0.0), "LINEAR"),  # the junction: a step back to a's start
-        (4.0, (10.0, 0.0, 0.0), "ACCELERATE"),
+        Keyframe(2.0, (10.0, 0.0, 0.0), "ACCELERATE"),
+        Keyframe(2.0, (0.0, 0.0, 0.0), "LINEAR"),  # the junction: a step back to a's start
+        Keyframe(4.0, (10.0, 0.0, 0.0), "ACCELERATE"),
     ]
     with pytest.raises(MotionError, match="joint 5"):
         walk.keyframes(5)
@@ -458,7 +485,7 @@ def test_describe_renders_the_expression(walk):
         "3 * (walk + STRIP(walk, 1, 2) <SCALE FRAMES -2>) + "
         "SYNCHRONIZE(STRIP(walk, 3), STRIP(walk, 4)) <SCALE EXTREMES 0.5>"
     )
-    assert "keyframes[1 joints, 1 keyframes]" in one("", (0, 0, 0), (1.0, (0, 0, 0), "LINEAR")).describe()
+    assert "keyframes[1 joints, 1 keyframes]" in one("", (0, 0, 0), Keyframe(1.0, (0, 0, 0), "LINEAR")).describe()
     assert "walk" in repr(walk)
 
 
@@ -472,8 +499,8 @@ def clock():
         keys = []
         for minute in range(121):
             angle = 6.0 * minute if hand == 1 else 30.0 * minute / 60.0
-            keys.append((24.0 * minute, (0.0, 0.0, angle % 360.0), "LINEAR"))
-        spec[hand] = (keys[0][1], keys[1:])
+            keys.append(Keyframe(24.0 * minute, (0.0, 0.0, angle % 360.0), "LINEAR"))
+        spec[hand] = (keys[0].position, keys[1:])
     return Motion.from_tracks(spec)
 
 
@@ -490,10 +517,10 @@ def test_unwrapping_lets_the_clock_run_forwards():
 
 
 def test_unwrapping_keeps_a_half_turn_direction_and_fixed_axes():
-    m = one("", (0, 0, 0), (1.0, (180, 350, -180), "LINEAR"), (2.0, (-170, 10, 200), "LINEAR"))
+    m = one("", (0, 0, 0), Keyframe(1.0, (180, 350, -180), "LINEAR"), Keyframe(2.0, (-170, 10, 200), "LINEAR"))
     u = m.unwrapped({1: (True, False, True)})
     _, keys = u.keyframes(1)
-    assert [k[1] for k in keys] == [(180.0, 350.0, -180.0), (190.0, 10.0, -160.0)]
+    assert [k.position for k in keys] == [(180.0, 350.0, -180.0), (190.0, 10.0, -160.0)]
 
 
 def test_motions_pickle_by_method_name(walk):

@@ -8,13 +8,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.motion.keyframe import Keyframe
 
 METHODS = ["LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"]
 
 
 def track(*keys, start=0.0):
     """Joint 1 driven about Z by keyframes (frame, angle, method)."""
-    return Motion.from_tracks({1: ((0, 0, start), [(f, (0, 0, v), m) for f, v, m in keys])})
+    return Motion.from_tracks({1: ((0, 0, start), [Keyframe(f, (0, 0, v), m) for f, v, m in keys])})
 
 
 def z(m, t):

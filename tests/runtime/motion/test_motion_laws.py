@@ -22,6 +22,7 @@ from liganimate.runtime.motion.algebra import (
     strip,
     synchronize,
 )
+from liganimate.runtime.motion.keyframe import Keyframe
 
 METHODS = ["LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"]
 JOINTS = [1, 2, 3]
@@ -61,7 +62,7 @@ def leaf_tracks(draw, joints=None):
         values = rng.integers(-720, 721, size=(n, 3)) / 2.0
         methods = rng.choice(METHODS, size=n)
         start = tuple(float(x) for x in rng.integers(-720, 721, size=3) / 2.0)
-        keys = [(float(f), tuple(float(x) for x in v), str(m)) for f, v, m in zip(frames, values, methods)]
+        keys = [Keyframe(float(f), tuple(float(x) for x in v), str(m)) for f, v, m in zip(frames, values, methods)]
         spec[j] = (start, keys)
     return spec
 
@@ -132,7 +133,7 @@ def knots(m: Motion) -> np.ndarray:
     frames = [0.0, m.length]
     for j in m.joints:
         _, keys = m.keyframes(j, limit=5000)
-        frames += [k[0] for k in keys]
+        frames += [k.frame for k in keys]
     return np.unique(frames)
 
 
@@ -335,8 +336,9 @@ def test_keyframes_are_hit_exactly(spec, r):
     m = Motion.from_tracks(spec).scale_frames(r)
     for j, (start, keys) in spec.items():
         assert np.array_equal(m.evaluate([-0.5], [j])[0, 0], start)
-        for k, (f, v, _) in enumerate(keys):
-            if k + 1 < len(keys) and keys[k + 1][0] == f:
+        for k, key in enumerate(keys):
+            f, v = key.frame, key.position
+            if k + 1 < len(keys) and keys[k + 1].frame == f:
                 continue  # inside a step the last keyframe at that frame wins
             assert np.array_equal(m.evaluate([f * r], [j])[0, 0], v), (j, k)
 
@@ -360,9 +362,9 @@ def test_holds_after_the_end(a):
 def test_leaf_holds_last_keyframe(spec):
     m = Motion.from_tracks(spec)
     for j, (start, keys) in spec.items():
-        want = keys[-1][1] if keys else start
+        want = keys[-1].position if keys else start
         assert np.array_equal(m.evaluate([m.length + 7.25], [j])[0, 0], want)
-        assert strip(m, [j]).length == (keys[-1][0] if keys else 0.0)
+        assert strip(m, [j]).length == (keys[-1].frame if keys else 0.0)
 
 
 def breakpoints(spec) -> np.ndarray:
@@ -370,7 +372,8 @@ def breakpoints(spec) -> np.ndarray:
     pts = [0.0]
     for start, keys in spec.values():
         f0 = 0.0
-        for f, _, method in keys:
+        for key in keys:
+            f = key.frame
             T = f - f0
             r = min(tr.RAMP, T / 2)
             pts += [f0, f, f0 + r, f - r, f0 + T / 2]
@@ -398,8 +401,8 @@ def test_velocity_and_acceleration_match_finite_differences(spec):
 def test_velocity_is_continuous_where_linear_adjusts(spec):
     m = Motion.from_tracks(spec)
     for j, (start, keys) in spec.items():
-        frames = [0.0] + [k[0] for k in keys]
-        meths = [k[2] for k in keys]
+        frames = [0.0] + [k.frame for k in keys]
+        meths = [k.method for k in keys]
         for i in range(1, len(keys)):  # knot i joins segment i-1 and segment i
             T1, T2 = frames[i] - frames[i - 1], frames[i + 1] - frames[i]
             if T1 > 0 and T2 > 0 and "LINEAR" in (meths[i - 1], meths[i]):
@@ -412,10 +415,10 @@ def test_velocity_is_continuous_where_linear_adjusts(spec):
 @PROFILE
 @given(leaf_tracks())
 def test_linear_chains_never_overshoot(spec):
-    spec = {j: (s, [(f, v, "LINEAR") for f, v, _ in keys]) for j, (s, keys) in spec.items()}
+    spec = {j: (s, [Keyframe(k.frame, k.position, "LINEAR") for k in keys]) for j, (s, keys) in spec.items()}
     m = Motion.from_tracks(spec)
     for j, (start, keys) in spec.items():
-        knots_ = [(0.0, np.array(start))] + [(f, np.array(v)) for f, v, _ in keys]
+        knots_ = [(0.0, np.array(start))] + [(k.frame, np.array(k.position)) for k in keys]
         for (f0, v0), (f1, v1) in zip(knots_, knots_[1:]):
             if f1 == f0:
                 continue
@@ -434,9 +437,10 @@ def test_hand_reversed_keyframes_give_the_mirrored_motion(spec):
     m = Motion.from_tracks(spec)
     E = m.length
     rev_name = {"ACCELERATE": "DECELERATE", "DECELERATE": "ACCELERATE"}
-    knots_ = [(0.0, start)] + [(f, v) for f, v, _ in keys]
+    knots_ = [(0.0, start)] + [(k.frame, k.position) for k in keys]
     back = [
-        (E - knots_[i][0], knots_[i][1], rev_name.get(keys[i][2], keys[i][2])) for i in range(len(keys) - 1, -1, -1)
+        Keyframe(E - knots_[i][0], knots_[i][1], rev_name.get(keys[i].method, keys[i].method))
+        for i in range(len(keys) - 1, -1, -1)
     ]
     hand = Motion.from_tracks({1: (knots_[-1][1], back)})
     steps = {f for (f, _), (g, _) in zip(knots_, knots_[1:]) if f == g}
@@ -448,7 +452,7 @@ def test_hand_reversed_keyframes_give_the_mirrored_motion(spec):
 @PROFILE
 @given(motions())
 def test_keyframe_listing_round_trips(m):
-    spec = {j: m.keyframes(j, limit=5000, with_ramps=True) for j in m.joints}
+    spec = {j: m.keyframes(j, limit=5000) for j in m.joints}
     back = Motion.from_tracks(spec)
     assert back.length == m.length
     t = np.random.default_rng(5).uniform(-1.0, m.length + 1.0, 60)
@@ -467,9 +471,9 @@ def test_unwrapping_takes_the_short_way_in_each_leaf(spec, data):
         ustart, ukeys = u.keyframes(j)
         assert ustart == tuple(start)
         previous = np.array(start)
-        for (f, v, meth), (g, w, _) in zip(ukeys, keys):
-            v, d = np.array(v), np.subtract(v, w)
-            assert f == g
+        for key, original in zip(ukeys, keys):
+            v, d = np.array(key.position), np.subtract(key.position, original.position)
+            assert key.frame == original.frame
             assert np.all(d[~free] == 0)
             assert np.all(d[free] % 360.0 == 0)
             assert np.all(np.abs(v - previous)[free] <= 180.0)

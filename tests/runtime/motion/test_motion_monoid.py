@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from test_motion_laws import FEW, PROFILE, assert_close, motions, probe_times
 
 from liganimate.runtime.motion.algebra import Motion, strip, synchronize
+from liganimate.runtime.motion.keyframe import Keyframe
 
 
 def same(m: Motion, n: Motion, extra=()) -> None:
@@ -28,9 +29,9 @@ def test_plus_is_associative_even_for_joints_some_operands_do_not_drive(a, b, c)
 
 
 def test_a_joint_driven_by_the_first_and_last_operand_holds_the_first_ones_end_either_way():
-    a = Motion.from_tracks({1: ((0, 0, 0), [(4.0, (40, 0, 0), "LINEAR")])})
-    b = Motion.from_tracks({2: ((0, 0, 0), [(4.0, (0, 9, 0), "LINEAR")])})
-    c = Motion.from_tracks({1: ((90, 0, 0), [(4.0, (0, 0, 0), "LINEAR")])})
+    a = Motion.from_tracks({1: ((0, 0, 0), [Keyframe(4.0, (40, 0, 0), "LINEAR")])})
+    b = Motion.from_tracks({2: ((0, 0, 0), [Keyframe(4.0, (0, 9, 0), "LINEAR")])})
+    c = Motion.from_tracks({1: ((90, 0, 0), [Keyframe(4.0, (0, 0, 0), "LINEAR")])})
     for m in ((a + b) + c, a + (b + c)):
         assert m.evaluate([6.0], [1])[0, 0, 0] == 40.0  # the previous driven value, not c's start
 
@@ -41,10 +42,10 @@ def test_a_gap_that_spans_an_operand_and_the_start_of_the_next_is_refilled_whole
     # first took a's end value: joint 1 jumped to c's value a frame early.
     # (A random search found it; the derandomized examples hit it only in
     # some suite orders.)
-    a = Motion.from_tracks({1: ((0, 0, 0), [(4.0, (40, 0, 0), "LINEAR")])})
-    b = Motion.from_tracks({2: ((0, 0, 0), [(1.0, (0, 9, 0), "LINEAR")])})
-    c = Motion.from_tracks({2: ((0, 0, 0), [(1.0, (0, 5, 0), "LINEAR")])}) + Motion.from_tracks(
-        {1: ((90, 0, 0), [(4.0, (0, 0, 0), "LINEAR")])}
+    a = Motion.from_tracks({1: ((0, 0, 0), [Keyframe(4.0, (40, 0, 0), "LINEAR")])})
+    b = Motion.from_tracks({2: ((0, 0, 0), [Keyframe(1.0, (0, 9, 0), "LINEAR")])})
+    c = Motion.from_tracks({2: ((0, 0, 0), [Keyframe(1.0, (0, 5, 0), "LINEAR")])}) + Motion.from_tracks(
+        {1: ((90, 0, 0), [Keyframe(4.0, (0, 0, 0), "LINEAR")])}
     )
     t = [4.5, 5.0, 5.5, 5.99]
     for m in ((a + b) + c, a + (b + c)):
@@ -59,7 +60,7 @@ def test_the_empty_motion_is_an_identity(a):
     e = Motion.empty()
     same(e + a, a)
     same(a + e, a)
-    b = Motion.from_tracks({1: ((5, 5, 5), [(2.0, (1, 2, 3), "LINEAR")])})
+    b = Motion.from_tracks({1: ((5, 5, 5), [Keyframe(2.0, (1, 2, 3), "LINEAR")])})
     same(b + (e + a), b + a, [b.length])
 
 

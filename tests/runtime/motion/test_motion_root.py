@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion.algebra import Motion, synchronize
+from liganimate.runtime.motion.keyframe import Keyframe
 
 METHODS = ["LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"]
 
@@ -17,10 +18,13 @@ def walk(step=1.6, length=16.0, start=(0.0, 0.0, 0.0), method="LINEAR") -> Motio
     """A joint swinging and a root advancing ``step`` along X over ``length`` frames."""
     s = np.asarray(start)
     return Motion.from_tracks(
-        {1: ((0, 0, 0), [(length / 2, (0, 0, 10), "LINEAR"), (length, (0, 0, 0), "LINEAR")])},
+        {1: ((0, 0, 0), [Keyframe(length / 2, (0, 0, 10), "LINEAR"), Keyframe(length, (0, 0, 0), "LINEAR")])},
         root=(
             tuple(s),
-            [(length / 2, tuple(s + (step / 2, 0.1, 0)), method), (length, tuple(s + (step, 0, 0)), method)],
+            [
+                Keyframe(length / 2, tuple(s + (step / 2, 0.1, 0)), method),
+                Keyframe(length, tuple(s + (step, 0, 0)), method),
+            ],
         ),
     )
 
@@ -32,8 +36,8 @@ def rooted(draw):
     if draw(st.booleans()):
         frames.append(frames[-1])  # a step at the path's end: where reversal used to round
     pos = st.tuples(*[st.floats(-5.0, 5.0)] * 3)
-    keys = [(f, draw(pos), draw(st.sampled_from(METHODS))) for f in frames]
-    joint = {2: ((0, 0, 0), [(draw(st.floats(0.5, 20.0)), (0, 0, 5), "LINEAR")])}
+    keys = [Keyframe(f, draw(pos), draw(st.sampled_from(METHODS))) for f in frames]
+    joint = {2: ((0, 0, 0), [Keyframe(draw(st.floats(0.5, 20.0)), (0, 0, 5), "LINEAR")])}
     return Motion.from_tracks(joint, root=(draw(pos), keys))
 
 
@@ -76,11 +80,11 @@ def test_reversal_twice_is_the_identity(a):
 def stepping(end: float, length: float) -> Motion:
     """A path that ends with a step at ``end`` (two keyframes on one frame), in a motion of ``length``."""
     keys = [
-        (end / 2, (1.0, 2.0, 0.0), "DECELERATE"),
-        (end, (3.0, 0.0, 1.0), "ACCELERATE"),
-        (end, (5.0, 1.0, 0.0), "LINEAR"),
+        Keyframe(end / 2, (1.0, 2.0, 0.0), "DECELERATE"),
+        Keyframe(end, (3.0, 0.0, 1.0), "ACCELERATE"),
+        Keyframe(end, (5.0, 1.0, 0.0), "LINEAR"),
     ]
-    return Motion.from_tracks({2: ((0, 0, 0), [(length, (0, 0, 5), "LINEAR")])}, root=((0.0, 0.0, 0.0), keys))
+    return Motion.from_tracks({2: ((0, 0, 0), [Keyframe(length, (0, 0, 5), "LINEAR")])}, root=((0.0, 0.0, 0.0), keys))
 
 
 def around(frames) -> np.ndarray:
@@ -155,7 +159,7 @@ def test_reversal_of_a_sum_is_the_sum_of_the_reversals():
 
 
 def test_a_motion_without_a_path_stands_still_where_the_neighbour_is():
-    still = Motion.from_tracks({3: ((0, 0, 0), [(5.0, (0, 0, 20), "LINEAR")])})
+    still = Motion.from_tracks({3: ((0, 0, 0), [Keyframe(5.0, (0, 0, 20), "LINEAR")])})
     w = walk(start=(1.0, 2.0, 3.0))
     np.testing.assert_allclose((still + w).root_offset([0.0, 5.0]), [[1, 2, 3], [1, 2, 3]])
     np.testing.assert_allclose((w + still).root_offset([16.0, 21.0]), [[2.6, 2, 3], [2.6, 2, 3]])
@@ -173,7 +177,7 @@ def test_strip_keeps_and_scale_extremes_leaves_the_path():
 
 def test_synchronize_keeps_one_path_and_refuses_two():
     w = walk()
-    arms = Motion.from_tracks({7: ((0, 0, 0), [(4.0, (0, 0, 9), "LINEAR")])})
+    arms = Motion.from_tracks({7: ((0, 0, 0), [Keyframe(4.0, (0, 0, 9), "LINEAR")])})
     same_path(synchronize(arms, w), w)
     same_path(synchronize(w.strip([1]), w.strip([])), w)  # the same path twice is one path
     with pytest.raises(MotionError, match="root track is driven by both operand 1 and operand 2"):
@@ -183,8 +187,8 @@ def test_synchronize_keeps_one_path_and_refuses_two():
 def test_root_keyframes_list_the_continued_path():
     start, keys = (2 * walk()).root_keyframes()
     assert start == (0.0, 0.0, 0.0)
-    assert [k[0] for k in keys] == [8.0, 16.0, 24.0, 32.0]
-    np.testing.assert_allclose([k[1] for k in keys], [[0.8, 0.1, 0], [1.6, 0, 0], [2.4, 0.1, 0], [3.2, 0, 0]])
+    assert [k.frame for k in keys] == [8.0, 16.0, 24.0, 32.0]
+    np.testing.assert_allclose([k.position for k in keys], [[0.8, 0.1, 0], [1.6, 0, 0], [2.4, 0.1, 0], [3.2, 0, 0]])
     rebuilt = Motion.from_tracks({}, root=(start, keys))
     np.testing.assert_allclose(
         rebuilt.root_offset(np.arange(0.0, 33.0))[::8], (2 * walk()).root_offset(np.arange(0.0, 33.0))[::8]
@@ -193,7 +197,7 @@ def test_root_keyframes_list_the_continued_path():
 
 def test_root_positions_beyond_the_geometry_limit_are_refused():
     with pytest.raises(MotionError, match="geometry limit"):
-        Motion.from_tracks({}, root=((0, 0, 0), [(1.0, (2e12, 0, 0), "LINEAR")]))
+        Motion.from_tracks({}, root=((0, 0, 0), [Keyframe(1.0, (2e12, 0, 0), "LINEAR")]))
 
 
 @pytest.mark.parametrize("n", [0, 1])
@@ -216,7 +220,7 @@ def test_pickled_motions_keep_their_path():
 
 def test_every_method_interpolates_a_root_track_like_a_joint_track():
     for method in METHODS:
-        keys = [(4.0, (0.0, 0.0, 40.0), method), (8.0, (0.0, 0.0, 80.0), method)]
+        keys = [Keyframe(4.0, (0.0, 0.0, 40.0), method), Keyframe(8.0, (0.0, 0.0, 80.0), method)]
         joint = Motion.from_tracks({1: ((0, 0, 0), keys)})
         root = Motion.from_tracks({}, root=((0, 0, 0), keys))
         t = np.linspace(0.0, 8.0, 33)

@@ -18,6 +18,7 @@ from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render import frames
 from liganimate.runtime.render.camera import Camera
 from liganimate.runtime.render.look import MODERN, check_look, draw_modern
+from liganimate.runtime.render.options import RenderOptions
 from liganimate.runtime.render.raster import rasterize
 
 SIZE = (160, 120)
@@ -126,7 +127,7 @@ def test_a_look_that_does_not_exist_is_refused():
     with pytest.raises(RenderError, match="--look fancy is not a look; give one of modern, thesis"):
         check_look("fancy")
     with pytest.raises(RenderError, match="look='x' is not a look"):
-        frames.Renderer(None, mp4=None, gif="x.gif", look="x")
+        frames.Renderer(RenderOptions(gif="x.gif", look="x"))
 
 
 def test_the_command_line_refuses_an_unknown_look(tmp_path):
