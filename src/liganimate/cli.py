@@ -408,10 +408,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE.png")
     p.set_defaults(func=cmd_plot)
     # Export/import and the browser tools register their own subcommands.
-    from liganimate import exchange_cli, view_cli
+    from liganimate import exchange_cli, fmt_cli, view_cli
 
     exchange_cli.add_commands(sub)
     view_cli.add_commands(sub)
+    fmt_cli.add_commands(sub)
     p = sub.add_parser("lsp", help="serve the LIG language to an editor (the Language Server Protocol, over stdio)")
     p.set_defaults(func=cmd_lsp)
     return parser
