@@ -214,7 +214,7 @@ class LoadedProgram:
         written = fmt.write(takes, os.fspath(path), **checked)
         for note in written.warnings:
             warnings.warn(note, UserWarning, stacklevel=2)
-        write_files(written.files)
+        write_files(written.files, written.folders)
         return [p for p, _ in written.files]
 
     def _repr_html_(self) -> str:
