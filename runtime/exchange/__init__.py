@@ -44,6 +44,8 @@ if TYPE_CHECKING:
     from ._files import write_files
     from ._gltf import gltf_bytes, gltf_document
     from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
+    from ._onto import OntoOptions, retarget_library
+    from ._retarget import RetargetOptions
 
 #: Name -> the module of this package that defines it, imported on first use.
 _LAZY = {
@@ -63,6 +65,9 @@ _LAZY = {
     "cut_frames": "_clip",
     "resample": "_clip",
     "ImportOptions": "_lig_write",
+    "OntoOptions": "_onto",
+    "retarget_library": "_onto",
+    "RetargetOptions": "_retarget",
     "import_library": "_lig_write",
     "clip_angles": "_lig_write",
     "lig_library": "_lig_write",
@@ -89,6 +94,8 @@ __all__ = [
     "ExportOption",
     "ImportOptions",
     "ModelTake",
+    "OntoOptions",
+    "RetargetOptions",
     "SceneCollector",
     "SceneTake",
     "bvh_files",
@@ -107,5 +114,6 @@ __all__ = [
     "read_bvh",
     "read_root_path",
     "resample",
+    "retarget_library",
     "write_files",
 ]

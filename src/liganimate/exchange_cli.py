@@ -119,6 +119,15 @@ def add_commands(subparsers) -> None:
     )
     p.add_argument("--frames", type=_frame_range, metavar="A:B", help="import frames A to B only (inclusive)")
     p.add_argument("--fps", type=_rate, metavar="N", help="resample the capture to N frames per second")
+    p.add_argument(
+        "--onto",
+        metavar="LIBRARY",
+        help="retarget the capture onto a figure of this library (a standard library's name, or FILE.lig); "
+        "the output then holds only the MOTION",
+    )
+    p.add_argument("--onto-model", type=_lig_name, metavar="NAME", help="the model of --onto's library")
+    p.add_argument("--map", metavar="FILE", help="joint map for --onto: 'capture joint = figure link' lines")
+    p.add_argument("--scale", type=_rate, metavar="R", help="with --onto: scale the capture's lengths by R")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_import)
 
@@ -173,6 +182,12 @@ def cmd_import(args) -> int:
             clip = X.cut_frames(clip, *args.frames)
         if args.fps is not None:
             clip = X.resample(clip, args.fps)
+        if args.onto is not None:
+            return _retarget(args, X, clip, out, base)
+        if args.onto_model or args.map or args.scale:
+            from liganimate.runtime.errors import LigError
+
+            raise LigError("--onto-model, --map and --scale go with --onto.", "add --onto LIBRARY")
         options = X.ImportOptions(
             model=model,
             motion=motion,
@@ -192,3 +207,23 @@ def cmd_import(args) -> int:
         return 0
 
     return _guarded(go)
+
+
+def _retarget(args, X, clip, out: str, base: str) -> int:
+    """``import --onto``: write the retargeted MOTION and print the report."""
+    options = X.OntoOptions(
+        library=args.onto,
+        model=args.onto_model,
+        map_file=args.map,
+        motion=args.motion or base,
+        source_name=os.path.basename(args.file),
+        retarget=X.RetargetOptions(scale=args.scale, joint_translation=args.joint_translation),
+        tolerance=args.tolerance,
+    )
+    text, report, _ = X.retarget_library(clip, options)
+    X.write_files([(out, text)])
+    if not args.quiet:
+        for line in report:
+            sys.stderr.write(line + "\n")
+        sys.stderr.write(f"wrote {out}: MOTION {options.motion} ({clip.data.shape[0]} frames)\n")
+    return 0
