@@ -503,12 +503,14 @@ class Checker(NodeVisitor):
         self._define_as(name, T.MODEL, "{name} is {noun}, not a MODEL")
 
     def _joint_args(self, args: list, node, in_block: bool) -> None:
+        if node.axis is not None:
+            self._want(node.axis, T.VECTOR, "an axis (x, y, z)")
         if len(args) < 6 or len(args) > 8:
             self.err(
                 node,
                 f"JOINT takes an identifier, a primary segment and its location, a secondary segment "
                 f"and its location, and one to three extreme pairs: {len(args)} values given",
-                "JOINT id, primary, (x, y, z), secondary, (x, y, z), (min, max), (min, max), (min, max)",
+                "JOINT id, primary, (x, y, z), secondary, (x, y, z), [SLIDE] (min, max), (min, max), (min, max)",
             )
             for a in args:
                 self.expr(a)

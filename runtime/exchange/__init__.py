@@ -11,12 +11,15 @@ This sub-package owns the exchange formats and nothing else:
 * turning a BVH capture into a LIG library text (:func:`lig_library`);
 * writing several files all or nothing (:func:`write_files`).
 
-It may import the runtime (figure, kinematics, pose, motion, camera, values,
+It is one of the tools, a layer above the runtime core (docs/architecture.md):
+it may import the runtime (figure, kinematics, pose, motion, camera, values,
 errors), ``liganimate.lang.diagnostics`` and ``liganimate.lang.ast`` for
-diagnostics, ``liganimate.compiler.types`` for the names of the built-in
-functions (which imported segment names avoid), numpy and pygltflib.  Nothing in the runtime, the compiler or
-the language imports it; the command line reaches it through
-``liganimate.exchange_cli``.  See ``docs/exchange.md``.
+diagnostics, ``liganimate.compiler.names`` for the names a program may not
+define (which imported segment names avoid), numpy and pygltflib.  The
+runtime core, the compiler and the language never import it; of the other
+tools the viewer and the studio do (to run a program's scenes); the
+command line reaches it through ``liganimate.exchange_cli``, Python through
+``liganimate.api``.  See ``docs/exchange.md``.
 """
 
 from importlib import import_module
@@ -42,7 +45,7 @@ if TYPE_CHECKING:
     from ._clip import ClipPose, clip_pose, cut_frames, resample
     from ._collect import ModelTake, SceneCollector, SceneTake, collect
     from ._files import write_files
-    from ._gltf import gltf_bytes, gltf_document
+    from ._gltf import RIGS, gltf_bytes, gltf_document, key_times
     from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
     from ._onto import OntoOptions, retarget_library
     from ._retarget import RetargetOptions
@@ -60,6 +63,8 @@ _LAZY = {
     "write_files": "_files",
     "gltf_bytes": "_gltf",
     "gltf_document": "_gltf",
+    "key_times": "_gltf",
+    "RIGS": "_gltf",
     "ClipPose": "_clip",
     "clip_pose": "_clip",
     "cut_frames": "_clip",
@@ -87,6 +92,7 @@ def __getattr__(name: str) -> Any:
 __all__ = [
     "EXPORT_FORMATS",
     "EXPORT_OPTIONS",
+    "RIGS",
     "BvhClip",
     "ClipPose",
     "Export",
@@ -110,6 +116,7 @@ __all__ = [
     "gltf_bytes",
     "gltf_document",
     "import_library",
+    "key_times",
     "lig_library",
     "read_bvh",
     "read_root_path",

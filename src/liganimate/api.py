@@ -18,6 +18,7 @@ from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, format_diagn
 if TYPE_CHECKING:
     from liganimate.runtime.exchange import SceneTake
     from liganimate.runtime.host import Program
+    from liganimate.runtime.render.options import RenderOptions
 
 __all__ = ["LigProgramError", "LoadedProgram", "View", "load"]
 
@@ -118,6 +119,59 @@ class LoadedProgram:
             raise ValueError("the program shoots no scene, so there is nothing to view")
         title = os.path.basename(self.name) + ("" if scene is None else f", scene {scene}")
         return View(viewer_html(takes, title), height)
+
+    def check(self) -> list[Diagnostic]:
+        """Run every statement and every scene tick without drawing, as ``liganimate check`` does.
+
+        Returns
+        -------
+        list of Diagnostic
+            The warnings of the run (the compiler's are in :attr:`warnings`).
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs.
+        """
+        try:
+            return list(self.program.check())
+        except LigDiagnostics as exc:
+            _reraise(exc)
+
+    def render(
+        self, out: str | os.PathLike[str] | None = None, *, options: RenderOptions | None = None, **fields: Any
+    ) -> None:
+        """Check the program, then draw its scenes to files, as ``liganimate run`` does.
+
+        Parameters
+        ----------
+        out : str or os.PathLike, optional
+            The folder for the PNG frames (``out/scene<ID>/<NNNNN>.png``);
+            None writes only the movies asked for.
+        options : RenderOptions, optional
+            What to write and how, as one value; ``out`` and ``fields`` replace its values.
+        **fields
+            Fields of :class:`liganimate.RenderOptions`, as the command
+            line's options: ``size=(640, 480)``, ``gif=``, ``mp4=``,
+            ``poses=``, ``fps=``, ``aa=``, ``crf=``, ``preset=``,
+            ``workers=``, ``scheduler=``, ``quiet=``.
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs.
+        ValueError
+            When an option cannot be honoured (nothing is written then), or
+            nothing would be written.
+        TypeError
+            When a keyword is not a field of ``RenderOptions``.
+        """
+        if out is not None:
+            fields["out"] = os.fspath(out)
+        try:
+            self.program.render(options=options, **fields)
+        except LigDiagnostics as exc:
+            _reraise(exc)
 
     def export(self, path: str | os.PathLike[str], **options: Any) -> list[str]:
         """Write the scenes' models and motion in the format ``path``'s extension chooses.

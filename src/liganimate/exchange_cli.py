@@ -60,7 +60,7 @@ def _frame_range(text: str) -> tuple:
 
 def add_commands(subparsers) -> None:
     """Add ``export`` and ``import`` to the ``liganimate`` command's subparsers."""
-    from liganimate.cli import _lig_name
+    from liganimate.cli import lig_name
     from liganimate.runtime import exchange as X
 
     formats = X.EXPORT_FORMATS
@@ -101,8 +101,8 @@ def add_commands(subparsers) -> None:
     )
     p.add_argument("file", metavar="FILE.bvh")
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
-    p.add_argument("--model", type=_lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
-    p.add_argument("--motion", type=_lig_name, help="the MOTION's name (default: <STEM>)")
+    p.add_argument("--model", type=lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
+    p.add_argument("--motion", type=lig_name, help="the MOTION's name (default: <STEM>)")
     p.add_argument(
         "--tolerance",
         type=_degrees,
@@ -125,7 +125,7 @@ def add_commands(subparsers) -> None:
         help="retarget the capture onto a figure of this library (a standard library's name, or FILE.lig); "
         "the output then holds only the MOTION",
     )
-    p.add_argument("--onto-model", type=_lig_name, metavar="NAME", help="the model of --onto's library")
+    p.add_argument("--onto-model", type=lig_name, metavar="NAME", help="the model of --onto's library")
     p.add_argument("--map", metavar="FILE", help="joint map for --onto: 'capture joint = figure link' lines")
     p.add_argument("--scale", type=_rate, metavar="R", help="with --onto: scale the capture's lengths by R")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
@@ -134,7 +134,7 @@ def add_commands(subparsers) -> None:
 
 def cmd_export(args) -> int:
     """``liganimate export FILE -o OUT``."""
-    from liganimate.cli import _guarded, _shot_scenes
+    from liganimate.cli import guarded, shot_scenes
 
     def go():
         from liganimate.runtime import exchange as X
@@ -142,7 +142,7 @@ def cmd_export(args) -> int:
         # The format and its options are checked before the program runs.
         fmt = X.export_format(args.output)
         options = X.export_options(fmt, {o: getattr(args, "export_" + o) for o in X.EXPORT_OPTIONS})
-        scenes = _shot_scenes(args.file, "export")
+        scenes = shot_scenes(args.file, "export")
         export = fmt.write(scenes, args.output, **options)
         for note in export.warnings:
             sys.stderr.write(f"liganimate: warning: {note}\n")
@@ -153,12 +153,12 @@ def cmd_export(args) -> int:
                 sys.stderr.write(f"wrote {path}\n")
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_import(args) -> int:
     """``liganimate import FILE.bvh -o OUT.lig``."""
-    from liganimate.cli import _guarded
+    from liganimate.cli import guarded
 
     def go():
         from liganimate.runtime import exchange as X
@@ -206,7 +206,7 @@ def cmd_import(args) -> int:
             )
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def _retarget(args, X, clip, out: str, base: str) -> int:
