@@ -17,7 +17,15 @@ ROOT = pathlib.Path(ROOT_DIR)
 FOLDERS = {"lang": "liganimate.lang", "compiler": "liganimate.compiler", "runtime": "liganimate.runtime"}
 
 #: The command line and the tools above the runtime: nothing below imports them.
-ABOVE = ("liganimate.cli", "liganimate.__main__", "liganimate.api", "liganimate.exchange_cli", "liganimate.view_cli")
+ABOVE = (
+    "liganimate.cli",
+    "liganimate.__main__",
+    "liganimate.api",
+    "liganimate.exchange_cli",
+    "liganimate.view_cli",
+    "liganimate.lsp",
+    "liganimate.highlighting",
+)
 
 #: Package -> the modules (and packages, with everything in them) it may import, besides itself
 #: and ``liganimate`` (the version). The most specific package of a module applies.

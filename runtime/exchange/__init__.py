@@ -45,7 +45,7 @@ if TYPE_CHECKING:
     from ._clip import ClipPose, clip_pose, cut_frames, resample
     from ._collect import ModelTake, SceneCollector, SceneTake, collect
     from ._files import write_files
-    from ._gltf import gltf_bytes, gltf_document
+    from ._gltf import RIGS, gltf_bytes, gltf_document, key_times
     from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
 
 #: Name -> the module of this package that defines it, imported on first use.
@@ -61,6 +61,8 @@ _LAZY = {
     "write_files": "_files",
     "gltf_bytes": "_gltf",
     "gltf_document": "_gltf",
+    "key_times": "_gltf",
+    "RIGS": "_gltf",
     "ClipPose": "_clip",
     "clip_pose": "_clip",
     "cut_frames": "_clip",
@@ -85,6 +87,7 @@ def __getattr__(name: str) -> Any:
 __all__ = [
     "EXPORT_FORMATS",
     "EXPORT_OPTIONS",
+    "RIGS",
     "BvhClip",
     "ClipPose",
     "Export",
@@ -106,6 +109,7 @@ __all__ = [
     "gltf_bytes",
     "gltf_document",
     "import_library",
+    "key_times",
     "lig_library",
     "read_bvh",
     "read_root_path",
