@@ -186,10 +186,11 @@ class LoadedProgram:
         options : RenderOptions, optional
             What to write and how, as one value; ``out`` and ``fields`` replace its values.
         **fields
-            Fields of :class:`RenderOptions`, the command line's options:
-            ``size=(640, 480)``, ``gif=``, ``mp4=``, ``poses=``, ``fps=``,
-            ``aa=``, ``crf=``, ``preset=``, ``scheduler=``, ``quiet=``, and
-            ``workers=``.
+            Fields of :class:`liganimate.RenderOptions`, as the command
+            line's options: ``size=(640, 480)``, ``gif=``, ``mp4=``,
+            ``poses=``, ``fps=``, ``aa=``, ``look=`` (``"modern"``, the
+            default, or ``"thesis"``), ``crf=``, ``preset=``,
+            ``workers=``, ``scheduler=``, ``quiet=``.
 
         Raises
         ------
