@@ -153,7 +153,8 @@ class LoadedProgram:
         **fields
             Fields of :class:`liganimate.RenderOptions`, as the command
             line's options: ``size=(640, 480)``, ``gif=``, ``mp4=``,
-            ``poses=``, ``fps=``, ``aa=``, ``crf=``, ``preset=``,
+            ``poses=``, ``fps=``, ``aa=``, ``look=`` (``"modern"``, the
+            default, or ``"thesis"``), ``crf=``, ``preset=``,
             ``workers=``, ``scheduler=``, ``quiet=``.
 
         Raises

@@ -23,7 +23,8 @@ def _type_of(a: Analysis, key: tuple) -> str | None:
     scope, name = key
     checked = a.checked
     if checked is None:
-        return None
+        # The checks failed elsewhere: the type the text shows (the value's kind).
+        return _kind_of(a.env.values.get(name)) if scope == I.MAIN and a.env is not None else None
     if scope == I.MAIN:
         found = checked.main.types.get(name)
         return found
@@ -31,6 +32,17 @@ def _type_of(a: Analysis, key: tuple) -> str | None:
     if entry is not None and entry[2] is not None:
         return entry[2].types.get(name)
     return None
+
+
+def _kind_of(value) -> str | None:
+    if isinstance(value, statics.ModelValue):
+        return "MODEL"
+    if isinstance(value, statics.MotionValue):
+        return "MOTION"
+    if isinstance(value, statics.Graphic):
+        return "GRAPHICAL"
+    # A number's type may change with a later assignment (INTEGER, then REAL): only the checker settles it.
+    return "VECTOR" if isinstance(value, tuple) and len(value) == 3 else None
 
 
 def _signature(a: Analysis | None, name: str):
