@@ -176,6 +176,15 @@ def _scan_loads(source: Source, path: str, stack: tuple, opened: dict | None = N
     return names, failed
 
 
+def loaded_primitive_names(source: Source, path: str) -> set:
+    """Names of the primitives the LOAD statements of ``source`` (a file at ``path``) bring in.
+
+    The lexer must know them to parse the source; ``liganimate fmt`` parses
+    without checking, so it asks here.
+    """
+    return _scan_loads(source, path, ())[0]
+
+
 def _loaded_primitive_names(source: Source, path: str, stack: tuple) -> set:
     """Names of the primitives the source's LOAD statements bring (see :func:`_scan_loads`)."""
     return _scan_loads(source, path, stack)[0]

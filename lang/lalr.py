@@ -121,12 +121,15 @@ class Driver:
             callback = _inlined(callback)
         return size, rule.origin.name, callback
 
-    def parse(self, text: str, primitives: frozenset):
+    def parse(self, text: str, primitives: frozenset, tokens: list | None = None):
         """Parse ``text``; a NAME in ``primitives`` is a PRIM_NAME. Returns the start rule's value.
 
         The only loop that cuts the text, and the LALR loop, in one: a
         generator between them cost a fifth of the time. What a word or an
         operator is in a state is the :class:`~.lexer.Scanner`'s decision.
+        ``tokens``, when given, receives every :class:`~.lexer.Tok` in
+        order, each with the type the parser's state gave it (the
+        formatter, lang/formatter.py, lays a program out by them).
         """
         actions = self.actions
         rules = self.rules
@@ -203,6 +206,8 @@ class Driver:
                 column = start - line_start + 1
                 tok = _new_tuple(Tok, (ttype, value, start, line, column, column + end - start, end))
                 pos = end
+                if tokens is not None:
+                    tokens.append(tok)
             # ------------------------------------------------ feed it
             while True:
                 code = actions[state].get(ttype)

@@ -23,6 +23,7 @@ ABOVE = (
     "liganimate.api",
     "liganimate.exchange_cli",
     "liganimate.view_cli",
+    "liganimate.fmt_cli",
     "liganimate.lsp",
     "liganimate.highlighting",
 )

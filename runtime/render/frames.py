@@ -53,6 +53,7 @@ from liganimate.runtime.figure.pose import (
 from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
 from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
+from liganimate.runtime.render.look import DEFAULT_LOOK, draw_modern, look_params
 from liganimate.runtime.render.options import RenderOptions, checked, executor_for
 from liganimate.runtime.render.outputs import OutputLock
 from liganimate.runtime.render.raster import Framebuffer, rasterize
@@ -118,6 +119,7 @@ class Renderer:
         self.out_dir = options.out
         self.size = options.size
         self.aa = options.aa
+        self.look = options.look
         self.fps = options.fps
         self.quiet = options.quiet
         self.workers = options.workers if options.workers is not None else min(os.cpu_count() or 1, 8)
@@ -322,7 +324,7 @@ class Renderer:
         if not chunk:
             return
         names = [name for name, _ in chunk]
-        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want)
+        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want, self.look)
         if self.pool is None and self.executor is not None:
             self.pool = self.executor
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
@@ -544,7 +546,7 @@ def _worker_init(parent: int) -> None:
     mallopt(M_TRIM_THRESHOLD, 256 << 20)
 
 
-def draw_images(size, draws_list, aa=1, png=True, raw=False) -> list:
+def draw_images(size, draws_list, aa=1, png=True, raw=False, look=DEFAULT_LOOK) -> list:
     """Draw several images (a worker's task): ``draws_list`` holds each image's draws (see :func:`draw`).
 
     Returns
@@ -555,20 +557,21 @@ def draw_images(size, draws_list, aa=1, png=True, raw=False) -> list:
     """
     out = []
     for draws in draws_list:
-        image = draw(size, draws, aa)
+        image = draw(size, draws, aa, look)
         out.append((encode_png(image) if png else None, image if raw else None))
     return out
 
 
-def draw_image(path, size, draws, aa=1) -> None:
+def draw_image(path, size, draws, aa=1, look=DEFAULT_LOOK) -> None:
     """Rasterize one image and write it atomically."""
-    write_png(path, draw(size, draws, aa))
+    write_png(path, draw(size, draws, aa, look))
 
 
-def draw(size, draws, aa=1) -> np.ndarray:
+def draw(size, draws, aa=1, look=DEFAULT_LOOK) -> np.ndarray:
     """Rasterize one image from its draws: a list of (camera, parts).
 
-    ``aa`` is the anti-aliasing factor (1: none).  The result is an array
+    ``aa`` is the anti-aliasing factor (1: none), ``look`` the name of the
+    look (:mod:`.look`: ``"modern"`` or ``"thesis"``).  The result is an array
     of shape (H, W) (grey levels) or (H, W, 3) (colour), uint8.
 
     Consecutive draws seen by the same camera (the background and every tick
@@ -584,6 +587,9 @@ def draw(size, draws, aa=1) -> np.ndarray:
             merged[-1][1].extend(parts)
         else:
             merged.append((camera, list(parts)))
+    params = look_params(look)
+    if params is not None:
+        return draw_modern(size, [(_camera(c, size), p) for c, p in merged], aa, params)
     if len(merged) == 1:
         # The usual case: a fresh image, whose depth buffer need only cover what is drawn.
         camera, parts = merged[0]
