@@ -143,11 +143,10 @@ def grammar_keywords() -> list:
     """The grammar's keywords, the built-in functions, the interpolation methods and the solvers: what hover explains."""
     from liganimate.lang.parser import build_parser
     from liganimate.lang.vocabulary import FUNCTIONS
-
-    from .completion import keyword_terminals
-
     from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS
     from liganimate.runtime.motion.interpolation import names
+
+    from .completion import keyword_terminals
 
     words = set(keyword_terminals(build_parser()).keys())
     return sorted(words | set(FUNCTIONS) | set(names()) | set(SOLVER_KEYWORDS))
