@@ -420,6 +420,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Entry point of the ``liganimate`` command."""
+    if argv is None:
+        # This process is the command's own: freeze each compile's survivors
+        # (lang/collector.py). Never done for a library user's process.
+        from liganimate.lang import collector
+
+        collector.freeze_survivors()
 
     def go():
         args = build_parser().parse_args(argv)
