@@ -50,6 +50,8 @@ if TYPE_CHECKING:
     from ._files import write_files
     from ._gltf import RIGS, gltf_bytes, gltf_document, key_times
     from ._lig_write import ImportOptions, clip_angles, import_library, lig_library, read_root_path
+    from ._onto import OntoOptions, retarget_library
+    from ._retarget import RetargetOptions
     from ._urdf_lig import MESH_TRIANGLES, UrdfImportOptions, import_urdf, robot_model_name
     from ._urdf_read import Urdf, read_urdf
 
@@ -73,6 +75,9 @@ _LAZY = {
     "cut_frames": "_clip",
     "resample": "_clip",
     "ImportOptions": "_lig_write",
+    "OntoOptions": "_onto",
+    "retarget_library": "_onto",
+    "RetargetOptions": "_retarget",
     "import_library": "_lig_write",
     "clip_angles": "_lig_write",
     "lig_library": "_lig_write",
@@ -112,6 +117,8 @@ __all__ = [
     "ExportOption",
     "ImportOptions",
     "ModelTake",
+    "OntoOptions",
+    "RetargetOptions",
     "SceneCollector",
     "SceneTake",
     "bvh_files",
@@ -131,5 +138,6 @@ __all__ = [
     "read_bvh",
     "read_root_path",
     "resample",
+    "retarget_library",
     "write_files",
 ]

@@ -332,12 +332,9 @@ class Renderer:
             # The first submit forks the workers.  With SIGINT and SIGTERM blocked
             # meanwhile, a signal cannot reach a worker before it has set itself to
             # ignore them; this process receives it once the mask is restored.
-            old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
-            try:
+            with _signals_blocked():
                 self.futures.append((self.pool.submit(draw_images, *args), names))
                 self._worker_procs = list((getattr(self.pool, "_processes", None) or {}).values())
-            finally:
-                signal.pthread_sigmask(signal.SIG_SETMASK, old)
             return
         if self.pool is None:
             self._deliver(names, draw_images(*args))
@@ -510,6 +507,19 @@ def _result(future):
         ) from None
 
 
+@contextlib.contextmanager
+def _signals_blocked():
+    """SIGINT and SIGTERM held back in this thread (where the system can: not on Windows)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def _worker_init(parent: int) -> None:
     """Set up a worker process: signals are the parent's business, die with it, keep freed memory for reuse.
 
@@ -528,14 +538,15 @@ def _worker_init(parent: int) -> None:
     """
     for s in _SIGNALS:
         signal.signal(s, signal.SIG_IGN)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent while it forked us
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent while it forked us
     try:
         import ctypes
 
         libc = ctypes.CDLL(None)
         mallopt = libc.mallopt
-    except (OSError, AttributeError):
-        return  # not glibc
+    except (OSError, AttributeError, TypeError, ImportError):
+        return  # not glibc (Windows' CDLL takes no None)
     if sys.platform.startswith("linux"):
         PR_SET_PDEATHSIG = 1
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)

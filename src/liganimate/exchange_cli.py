@@ -120,6 +120,15 @@ def add_commands(subparsers) -> None:
     p.add_argument("--frames", type=_frame_range, metavar="A:B", help="import frames A to B only (inclusive)")
     p.add_argument("--fps", type=_rate, metavar="N", help="resample the capture to N frames per second")
     p.add_argument(
+        "--onto",
+        metavar="LIBRARY",
+        help="retarget the capture onto a figure of this library (a standard library's name, or FILE.lig); "
+        "the output then holds only the MOTION",
+    )
+    p.add_argument("--onto-model", type=lig_name, metavar="NAME", help="the model of --onto's library")
+    p.add_argument("--map", metavar="FILE", help="joint map for --onto: 'capture joint = figure link' lines")
+    p.add_argument("--scale", type=_rate, metavar="R", help="with --onto: scale the capture's lengths by R")
+    p.add_argument(
         "--mesh-triangles",
         type=_count,
         default=None,
@@ -151,6 +160,8 @@ def _import_urdf(args) -> int:
         ("--fps", args.fps),
         ("--tolerance", args.tolerance or None),
         ("--joint-translation", None if args.joint_translation == "error" else args.joint_translation),
+        ("--onto", args.onto),
+        ("--map", args.map),
     ):
         if value is not None:
             raise LigError(f"{flag} applies to BVH captures; a URDF file holds a robot, not a motion.")
@@ -228,6 +239,12 @@ def cmd_import(args) -> int:
             clip = X.cut_frames(clip, *args.frames)
         if args.fps is not None:
             clip = X.resample(clip, args.fps)
+        if args.onto is not None:
+            return _retarget(args, X, clip, out, base)
+        if args.onto_model or args.map or args.scale:
+            from liganimate.runtime.errors import LigError
+
+            raise LigError("--onto-model, --map and --scale go with --onto.", "add --onto LIBRARY")
         options = X.ImportOptions(
             model=model,
             motion=motion,
@@ -247,3 +264,23 @@ def cmd_import(args) -> int:
         return 0
 
     return guarded(go)
+
+
+def _retarget(args, X, clip, out: str, base: str) -> int:
+    """``import --onto``: write the retargeted MOTION and print the report."""
+    options = X.OntoOptions(
+        library=args.onto,
+        model=args.onto_model,
+        map_file=args.map,
+        motion=args.motion or base,
+        source_name=os.path.basename(args.file),
+        retarget=X.RetargetOptions(scale=args.scale, joint_translation=args.joint_translation),
+        tolerance=args.tolerance,
+    )
+    text, report, _ = X.retarget_library(clip, options)
+    X.write_files([(out, text)])
+    if not args.quiet:
+        for line in report:
+            sys.stderr.write(line + "\n")
+        sys.stderr.write(f"wrote {out}: MOTION {options.motion} ({clip.data.shape[0]} frames)\n")
+    return 0
