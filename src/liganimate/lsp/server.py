@@ -29,7 +29,7 @@ from . import completion as C
 from . import hover as H
 from . import navigation as N
 from . import outline, scan
-from .analysis import Analysis, analyse
+from .analysis import COMPILER_LOCK, Analysis, analyse
 from .lookup import target
 from .text import Text
 
@@ -322,7 +322,8 @@ def _load_items(context: tuple, path: str | None) -> list:
     kind, value = context
     if kind == "library":
         return C.library_files(os.path.dirname(path) if path else None)
-    info = libraries.open_library(value, path)
+    with COMPILER_LOCK:  # opening a library compiles it: not beside an analysis
+        info = libraries.open_library(value, path)
     if info is None:
         return []
     return [C.Item(n, "variable", info.offered[n] + " " + info.descriptions.get(n, "")) for n in sorted(info.offered)]
