@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from liganimate.compiler import NotParsed, parse_program
 from liganimate.compiler.check import Checked, check
 from liganimate.lang import ast as A
+from liganimate.lang import collector
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 from liganimate.lang.source import MAX_SOURCE_BYTES, prepare
 
@@ -79,7 +80,10 @@ def analyse(
         them, then calls :func:`complete`); True also builds the index and
         the values.
     """
-    with COMPILER_LOCK:
+    # The stages build trees, not cycles: the cyclic collector is paused while
+    # they run, as the compiler pauses it (lang/collector.py), so that the
+    # trees of earlier analyses the server still holds are not walked again and again.
+    with COMPILER_LOCK, collector.paused():
         return _analyse(source, path, version, encoding, whole)
 
 
