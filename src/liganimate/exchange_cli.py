@@ -73,7 +73,7 @@ def add_commands(subparsers) -> None:
         + "; ".join(f"{'/'.join(f.suffixes)}: {f.summary}" for f in formats)
         + ".",
     )
-    p.add_argument("file")
+    p.add_argument("file", help="the LIG program whose scenes to export")
     p.add_argument(
         "-o",
         "--output",
@@ -99,7 +99,7 @@ def add_commands(subparsers) -> None:
         description="Write a library file that LOAD takes, with the capture's skeleton as "
         "a MODEL and its frames as a MOTION (see docs/exchange.md).",
     )
-    p.add_argument("file", metavar="FILE.bvh")
+    p.add_argument("file", metavar="FILE.bvh", help="the BVH capture to read")
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
     p.add_argument("--model", type=lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
     p.add_argument("--motion", type=lig_name, help="the MOTION's name (default: <STEM>)")
