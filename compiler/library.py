@@ -95,6 +95,20 @@ class Library:
         return "PRIMITIVE" if name in self.signatures else self.types[name]
 
 
+def _extra(row) -> list:
+    """A name-table row's URDF columns (joint name, rpy) for the cache's JSON."""
+    joint = row[3] if len(row) > 3 else None
+    rpy = row[4] if len(row) > 4 else None
+    return [joint, None if rpy is None else list(rpy)]
+
+
+def _extra_back(row) -> tuple:
+    """:func:`_extra` read back (a row cached before the columns existed has neither)."""
+    joint = row[3] if len(row) > 3 else None
+    rpy = row[4] if len(row) > 4 else None
+    return (joint, None if rpy is None else tuple(rpy))
+
+
 def stdlib_dir() -> Path:
     """The folder of the standard library's ``.lig`` files."""
     from liganimate import stdlib
@@ -233,7 +247,7 @@ def _to_json(lib: Library) -> dict:
         "types": lib.types,
         "descriptions": lib.descriptions,
         "names": {
-            m: {k: [v[0], list(v[1]), None if v[2] is None else list(v[2])] for k, v in rows.items()}
+            m: {k: [v[0], list(v[1]), None if v[2] is None else list(v[2]), *_extra(v)] for k, v in rows.items()}
             for m, rows in lib.names.items()
         },
         "scenes": lib.scenes,
@@ -286,7 +300,7 @@ def _from_json(obj: dict) -> Library:
         descriptions=dict(obj["descriptions"]),
         warnings=warnings,
         names={
-            m: {k: (v[0], tuple(v[1]), None if v[2] is None else tuple(v[2])) for k, v in rows.items()}
+            m: {k: (v[0], tuple(v[1]), None if v[2] is None else tuple(v[2]), *_extra_back(v)) for k, v in rows.items()}
             for m, rows in obj.get("names", {}).items()
         },
         deps=tuple((p, h) for p, h in obj["deps"]),

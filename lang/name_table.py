@@ -12,7 +12,10 @@ back, one row per link::
 
 A row is the segment's LIG name, its source name as a JSON string (any
 character, ``}`` written ``\\u007d``), its BVH channels in the source's
-order, and ``END x y z`` for a leaf's End Site.  A link the source did not
+order, and ``END x y z`` for a leaf's End Site.  A robot imported from
+URDF adds ``JOINT "name"``, the URDF joint that attaches the link, and
+``RPY r p y``, the URDF link frame's turn from the LIG link's (radians),
+which URDF export reads back.  A link the source did not
 have (the importer's ``ORIGIN``) has no row.  The table is a comment, so a
 library with one still reads as before everywhere else; ``LOAD`` hands the
 rows to the model's links (``Link.source``), and BVH and glTF export use
@@ -30,6 +33,7 @@ CHANNELS = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zr
 
 _TABLE = re.compile(r"\{@names[ \t]+([A-Za-z][A-Za-z0-9_]*)[ \t]*\n([^}]*)\}")
 _ROW = re.compile(r"[ \t]*([A-Za-z][A-Za-z0-9_]*)[ \t]+(\"(?:[^\"\\\n]|\\.)*\")(.*)")
+_JOINT = re.compile(r"[ \t]JOINT[ \t]+(\"(?:[^\"\\\n]|\\.)*\")")
 _DECODE = json.JSONDecoder()
 
 
@@ -44,8 +48,10 @@ def format_table(model: str, rows) -> str:
     ----------
     model : str
         The MODEL's LIG name.
-    rows : iterable of (segment, source name, channels, end)
-        ``channels`` a sequence of channel names, ``end`` None or 3 numbers.
+    rows : iterable of (segment, source name, channels, end[, joint, rpy])
+        ``channels`` a sequence of channel names, ``end`` None or 3 numbers,
+        ``joint`` None or the attaching joint's source name, ``rpy`` None or
+        3 numbers.
 
     Returns
     -------
@@ -53,12 +59,17 @@ def format_table(model: str, rows) -> str:
         ``{@names MODEL`` ... ``}``, ending with a newline.
     """
     out = [f"{{@names {model}"]
-    for segment, name, channels, end in rows:
+    for segment, name, channels, end, *more in rows:
+        joint, rpy = (list(more) + [None, None])[:2]
         row = f"  {segment} {_quoted(name)}"
         if channels:
             row += " " + " ".join(channels)
         if end is not None:
             row += " END " + " ".join(repr(float(x) + 0.0) for x in end)
+        if joint is not None:
+            row += " JOINT " + _quoted(joint)
+        if rpy is not None:
+            row += " RPY " + " ".join(repr(float(x) + 0.0) for x in rpy)
         out.append(row)
     out.append("}")
     return "\n".join(out) + "\n"
@@ -74,7 +85,9 @@ def read_tables(text: str) -> dict:
     Returns
     -------
     dict
-        ``{MODEL: {SEGMENT: (source name, channels tuple, end tuple or None)}}``
+        ``{MODEL: {SEGMENT: (source name, channels tuple, end tuple or None)}}``,
+        with ``joint name or None, rpy tuple or None`` after them on a row
+        that has either
         in capitals; rows that do not follow the format are left out (a
         table is a comment: it never stops a library from loading).
     """
@@ -97,9 +110,19 @@ def _row(line: str):
         name, _ = _DECODE.raw_decode(m.group(2))
     except ValueError:
         return None
-    words = m.group(3).split()
+    rest = m.group(3)
+    joint = None
+    jm = _JOINT.search(rest)
+    if jm is not None:
+        try:
+            joint, _ = _DECODE.raw_decode(jm.group(1))
+        except ValueError:
+            return None
+        rest = rest[: jm.start()] + rest[jm.end() :]
+    words = rest.split()
     channels = []
     end = None
+    rpy = None
     while words:
         w = words.pop(0)
         if w in CHANNELS and w not in channels and end is None:
@@ -110,6 +133,14 @@ def _row(line: str):
             except ValueError:
                 return None
             del words[:3]
+        elif w == "RPY" and rpy is None and len(words) >= 3:
+            try:
+                rpy = tuple(float(x) for x in words[:3])
+            except ValueError:
+                return None
+            del words[:3]
         else:
             return None
-    return m.group(1).upper(), name, tuple(channels), end
+    if joint is None and rpy is None:
+        return m.group(1).upper(), name, tuple(channels), end
+    return m.group(1).upper(), name, tuple(channels), end, joint, rpy

@@ -44,6 +44,7 @@ __all__ = [
     "comment_text",
     "import_library",
     "lig_library",
+    "motion_library",
     "read_root_path",
     "reduce_keyframes",
 ]
@@ -247,11 +248,12 @@ def _name_rows(clip, links: list) -> list:
     return rows
 
 
-def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None) -> bytes:
+def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None, ids=None) -> bytes:
     """STARTMOTION ... ENDMOTION: keyframes at every frame (or at ``keep[j]``) for every joint that moves.
 
     ``path`` (F, 3), if given, is the ROOT track: its start position, then a
-    keyframe at every frame if it moves.
+    keyframe at every frame if it moves.  ``ids`` are the joints' identifiers
+    (default 1, 2, ...).
     """
     F, J = angles.shape[:2]
     parts = [f"      STARTMOTION {name}\n".encode("ascii")]
@@ -262,7 +264,8 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
     for j in range(J):
         if not rotating[j] and not moving[j]:
             continue
-        start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {j + 1} POSITION", suffix="\n")
+        jid = j + 1 if ids is None else ids[j]
+        start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {jid} POSITION", suffix="\n")
         parts.append(start)
         if moving[j]:
             rows = np.arange(1, F) if keep is None else keep[j][keep[j] > 0]
@@ -273,6 +276,31 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
             parts.append(_keyframe_rows(frames, path[1:]))
     parts.append(b"      ENDMOTION\n")
     return b"".join(parts)
+
+
+def motion_library(
+    name: str, angles: np.ndarray, ids: list, path: np.ndarray, comments: list, tolerance: float = 0.0
+) -> bytes:
+    """A library holding one MOTION: ``comments`` (lines) first, then its declaration and keyframes.
+
+    Parameters
+    ----------
+    name : str
+    angles : ndarray, shape (F, J, 3)
+        Per frame, the angles of joints ``ids``.
+    ids : list of int
+    path : ndarray, shape (F, 3)
+        The ROOT track.
+    comments : list of str
+        Written as ``C`` lines (made safe for a brace comment).
+    tolerance : float
+        As :class:`ImportOptions`'.
+    """
+    head = [("C " + comment_text(c)).rstrip() for c in comments]
+    head += ["", f"      MOTION {name}", ""]
+    keep = reduce_keyframes(angles, tolerance) if tolerance > 0 else None
+    rotating = np.ones(angles.shape[1], dtype=bool)
+    return ("\n".join(head) + "\n").encode("utf-8") + _motion_text(name, angles, rotating, keep, path, ids)
 
 
 def read_root_path(path: str) -> np.ndarray:

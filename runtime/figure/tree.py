@@ -240,11 +240,19 @@ class LinkSource(NamedTuple):
         Its BVH channels in the source's order (empty when unknown).
     end : tuple of 3 floats or None
         Its BVH End Site offset, for a leaf that had one.
+    joint : str or None
+        The name of the source's joint that attaches it (URDF).
+    rpy : tuple of 3 floats or None
+        The source link frame's turn from this link's frame, as URDF roll,
+        pitch and yaw in radians (URDF: LIG link frames keep their
+        primary's orientation at neutral, a URDF link's need not).
     """
 
     name: str
     channels: tuple = ()
     end: tuple | None = None
+    joint: str | None = None
+    rpy: tuple | None = None
 
 
 @dataclass(frozen=True, eq=False)

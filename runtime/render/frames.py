@@ -52,7 +52,9 @@ from liganimate.runtime.figure.pose import (
 )
 from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
+from liganimate.runtime.render.framing import framing_view
 from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
+from liganimate.runtime.render.look import DEFAULT_LOOK, draw_modern, look_params
 from liganimate.runtime.render.options import RenderOptions, checked, executor_for
 from liganimate.runtime.render.outputs import OutputLock
 from liganimate.runtime.render.raster import Framebuffer, rasterize
@@ -118,6 +120,8 @@ class Renderer:
         self.out_dir = options.out
         self.size = options.size
         self.aa = options.aa
+        self.look = options.look
+        self._framed: dict = {}  # (scene id, size) -> default framing view
         self.fps = options.fps
         self.quiet = options.quiet
         self.workers = options.workers if options.workers is not None else min(os.cpu_count() or 1, 8)
@@ -194,13 +198,13 @@ class Renderer:
 
     def add_tick(self, state, rt) -> None:
         with self._failing():
-            self._add_tick(state)
+            self._add_tick(state, rt.program.framings)
 
-    def _add_tick(self, state) -> None:
+    def _add_tick(self, state, framings) -> None:
         tick, k = state.tick, state.sameframe
         image = tick // k
         self.scene_total = -(-state.length // k)
-        camera = (tuple(float(x) for x in state.view_point), float(state.view_width))
+        camera = self._view(state, framings)
         if self.current is None or self.current["image"] != image:
             if self.current is not None:
                 self.pending.append(self.current)
@@ -216,6 +220,20 @@ class Renderer:
             self.current = None
             if len(self.pending) >= BATCH:
                 self.flush()
+
+    def _view(self, state, framings) -> tuple:
+        """The scene's camera: VIEW's, or in the modern look, for a scene without VIEW, the default framing.
+
+        The framing needs the box of what the scene draws, which checking
+        the program gathers (:mod:`.framing`); unchecked, the thesis' camera stays.
+        """
+        if self.look != "thesis" and not state.viewed and framings.get(state.id) is not None:
+            key = (state.id, self.size)
+            view = self._framed.get(key)
+            if view is None:
+                view = self._framed[key] = framing_view(framings[state.id], self.size)
+            return view
+        return (tuple(float(x) for x in state.view_point), float(state.view_width))
 
     def _background(self, state, camera):
         parts = []
@@ -322,7 +340,7 @@ class Renderer:
         if not chunk:
             return
         names = [name for name, _ in chunk]
-        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want)
+        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want, self.look)
         if self.pool is None and self.executor is not None:
             self.pool = self.executor
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
@@ -330,12 +348,9 @@ class Renderer:
             # The first submit forks the workers.  With SIGINT and SIGTERM blocked
             # meanwhile, a signal cannot reach a worker before it has set itself to
             # ignore them; this process receives it once the mask is restored.
-            old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
-            try:
+            with _signals_blocked():
                 self.futures.append((self.pool.submit(draw_images, *args), names))
                 self._worker_procs = list((getattr(self.pool, "_processes", None) or {}).values())
-            finally:
-                signal.pthread_sigmask(signal.SIG_SETMASK, old)
             return
         if self.pool is None:
             self._deliver(names, draw_images(*args))
@@ -508,6 +523,19 @@ def _result(future):
         ) from None
 
 
+@contextlib.contextmanager
+def _signals_blocked():
+    """SIGINT and SIGTERM held back in this thread (where the system can: not on Windows)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def _worker_init(parent: int) -> None:
     """Set up a worker process: signals are the parent's business, die with it, keep freed memory for reuse.
 
@@ -526,14 +554,15 @@ def _worker_init(parent: int) -> None:
     """
     for s in _SIGNALS:
         signal.signal(s, signal.SIG_IGN)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent while it forked us
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent while it forked us
     try:
         import ctypes
 
         libc = ctypes.CDLL(None)
         mallopt = libc.mallopt
-    except (OSError, AttributeError):
-        return  # not glibc
+    except (OSError, AttributeError, TypeError, ImportError):
+        return  # not glibc (Windows' CDLL takes no None)
     if sys.platform.startswith("linux"):
         PR_SET_PDEATHSIG = 1
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
@@ -544,7 +573,7 @@ def _worker_init(parent: int) -> None:
     mallopt(M_TRIM_THRESHOLD, 256 << 20)
 
 
-def draw_images(size, draws_list, aa=1, png=True, raw=False) -> list:
+def draw_images(size, draws_list, aa=1, png=True, raw=False, look=DEFAULT_LOOK) -> list:
     """Draw several images (a worker's task): ``draws_list`` holds each image's draws (see :func:`draw`).
 
     Returns
@@ -555,20 +584,21 @@ def draw_images(size, draws_list, aa=1, png=True, raw=False) -> list:
     """
     out = []
     for draws in draws_list:
-        image = draw(size, draws, aa)
+        image = draw(size, draws, aa, look)
         out.append((encode_png(image) if png else None, image if raw else None))
     return out
 
 
-def draw_image(path, size, draws, aa=1) -> None:
+def draw_image(path, size, draws, aa=1, look=DEFAULT_LOOK) -> None:
     """Rasterize one image and write it atomically."""
-    write_png(path, draw(size, draws, aa))
+    write_png(path, draw(size, draws, aa, look))
 
 
-def draw(size, draws, aa=1) -> np.ndarray:
+def draw(size, draws, aa=1, look=DEFAULT_LOOK) -> np.ndarray:
     """Rasterize one image from its draws: a list of (camera, parts).
 
-    ``aa`` is the anti-aliasing factor (1: none).  The result is an array
+    ``aa`` is the anti-aliasing factor (1: none), ``look`` the name of the
+    look (:mod:`.look`: ``"modern"`` or ``"thesis"``).  The result is an array
     of shape (H, W) (grey levels) or (H, W, 3) (colour), uint8.
 
     Consecutive draws seen by the same camera (the background and every tick
@@ -584,6 +614,9 @@ def draw(size, draws, aa=1) -> np.ndarray:
             merged[-1][1].extend(parts)
         else:
             merged.append((camera, list(parts)))
+    params = look_params(look)
+    if params is not None:
+        return draw_modern(size, [(_camera(c, size), p) for c, p in merged], aa, params)
     if len(merged) == 1:
         # The usual case: a fresh image, whose depth buffer need only cover what is drawn.
         camera, parts = merged[0]
@@ -613,13 +646,13 @@ _cameras: dict = {}
 
 
 def _camera(camera, size) -> Camera:
-    """The :class:`Camera` of a ``((x, y, z), width)`` view, remembered (a few)."""
+    """The :class:`Camera` of a ``((x, y, z), width)`` or ``((x, y, z), width, target)`` view, remembered (a few)."""
     key = (camera, size)
     cam = _cameras.get(key)
     if cam is None:
         if len(_cameras) >= 64:
             _cameras.clear()
-        cam = _cameras[key] = Camera(camera[0], camera[1], size)
+        cam = _cameras[key] = Camera(camera[0], camera[1], size, target=camera[2] if len(camera) > 2 else None)
     return cam
 
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from liganimate.runtime.errors import RenderError
+from liganimate.runtime.render.look import DEFAULT_LOOK, check_look
 from liganimate.runtime.render.outputs import check_fps, check_outputs
 from liganimate.runtime.render.raster import MAX_AA
 from liganimate.runtime.render.video import (
@@ -71,6 +72,10 @@ class RenderOptions:
         Frame rate of the movies, 0.01 to 1000.
     aa : int
         Anti-aliasing factor, 1 (none) to 8: each pixel is the mean of ``aa x aa`` samples.
+    look : str
+        ``"modern"`` (the default: lit faces, outlines, a contact shadow,
+        smoothed edges) or ``"thesis"`` (flat shades on white, the thesis'
+        own look, byte for byte); see :mod:`.look`.
     crf, preset : int, str
         x264's quality (0 to 51, lower is better and larger) and speed
         (``ultrafast`` to ``veryslow``) for the MP4.
@@ -90,6 +95,7 @@ class RenderOptions:
     poses: str | None = None
     fps: float = 24.0
     aa: int = 1
+    look: str = DEFAULT_LOOK
     crf: int = DEFAULT_CRF
     preset: str = DEFAULT_PRESET
     workers: int | None = None
@@ -232,6 +238,7 @@ def checked(options: RenderOptions, names: Mapping[str, str] = KEYWORD_NAMES, ma
         size=_size(options.size, names["size"]),
         fps=check_fps(options.fps, names["fps"]),
         aa=check_aa(options.aa, names["aa"]),
+        look=check_look(options.look, names["look"]),
         crf=check_crf(options.crf, names["crf"]),
         preset=check_preset(options.preset, names["preset"]),
         workers=_workers(options.workers, names["workers"]),

@@ -4,7 +4,7 @@ Every user error is printed as a diagnostic (``file:line:col``, the line, a
 caret, a sentence, a hint) and the command exits with status 1; no Python
 traceback reaches the user, and nothing is written when a program is wrong.
 Output options (``-o``, ``--gif``, ``--mp4``, ``--poses``, ``--fps``,
-``--aa``, ``--crf``, ``--preset``, ``--scheduler``) are checked before the
+``--aa``, ``--look``, ``--crf``, ``--preset``, ``--scheduler``) are checked before the
 program is compiled.  SIGINT and SIGTERM stop a command
 cleanly (exit status 130 and 143), leaving only whole files.
 """
@@ -108,6 +108,12 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fps", default="24", help="frame rate of the GIF and MP4, 0.01 to 1000 (default 24)")
     p.add_argument(
         "--aa", default="1", metavar="N", help="anti-aliasing: draw N times finer and average, 1 to 8 (default 1, off)"
+    )
+    p.add_argument(
+        "--look",
+        default=None,
+        metavar="NAME",
+        help="modern (default: lit, outlined, shadowed, smooth edges) or thesis (flat shades on white, as in the thesis)",
     )
     p.add_argument(
         "--scheduler",
@@ -509,6 +515,12 @@ def cmd_completion(args) -> int:
 
 def main(argv=None) -> int:
     """Entry point of the ``liganimate`` command."""
+    if argv is None:
+        # This process is the command's own: freeze each compile's survivors
+        # (lang/collector.py). Never done for a library user's process.
+        from liganimate.lang import collector
+
+        collector.freeze_survivors()
 
     def go():
         args = build_parser().parse_args(argv)

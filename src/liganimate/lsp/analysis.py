@@ -54,7 +54,9 @@ def _too_large(filename: str) -> Diagnostic:
     )
 
 
-def analyse(source: str, path: str | None, version: int | None = None, encoding: str | None = None) -> Analysis:
+def analyse(
+    source: str, path: str | None, version: int | None = None, encoding: str | None = None, *, whole: bool = True
+) -> Analysis:
     """Analyse document text.
 
     Parameters
@@ -67,6 +69,10 @@ def analyse(source: str, path: str | None, version: int | None = None, encoding:
         The editor's version of the text.
     encoding : str, optional
         The position encoding agreed with the client.
+    whole : bool
+        False stops once the diagnostics are known (the server publishes
+        them, then calls :func:`complete`); True also builds the index and
+        the values.
     """
     text = Text(source) if encoding is None else Text(source, encoding)
     filename = path or "<untitled>"
@@ -84,10 +90,18 @@ def analyse(source: str, path: str | None, version: int | None = None, encoding:
         result.diagnostics = list(prepared.warnings) + list(result.checked.warnings)
     except LigDiagnostics as exc:
         result.diagnostics = list(exc.diagnostics)
-    result.index = I.build(program, text)
-    result.libraries = libraries.libraries_of(program, where)
-    result.env = statics.evaluate(program, libraries.loaded_values(program, where))
-    return result
+    return complete(result) if whole else result
 
 
-__all__ = ["Analysis", "analyse"]
+def complete(a: Analysis) -> Analysis:
+    """Build the index, the libraries and the values of an analysis whose text parsed (in place; returns it)."""
+    if a.program is None or a.index is not None:
+        return a
+    where = a.path if a.path is not None else os.path.join(os.getcwd(), "<untitled>")
+    a.index = I.build(a.program, a.text)
+    a.libraries = libraries.libraries_of(a.program, where)
+    a.env = statics.evaluate(a.program, libraries.loaded_values(a.program, where))
+    return a
+
+
+__all__ = ["Analysis", "analyse", "complete"]

@@ -163,8 +163,9 @@ async def did_change(ls: LigServer, params: lsp.DidChangeTextDocumentParams) -> 
 
 @server.feature(lsp.TEXT_DOCUMENT_DID_SAVE)
 async def did_save(ls: LigServer, params: lsp.DidSaveTextDocumentParams) -> None:
-    """Analyse again on save: a library it LOADs may have changed."""
-    _schedule(ls, params.text_document.uri)
+    """Analyse every open document again on save: the saved file may be a library the others LOAD."""
+    for uri in list(ls.workspace.text_documents):
+        _schedule(ls, uri)
 
 
 @server.feature(lsp.TEXT_DOCUMENT_DID_CLOSE)
@@ -248,7 +249,14 @@ def _completions(source: str, offset: int, good: Analysis | None, path: str | No
     loaded_prims = {n for n, info in (good.libraries if good else {}).items() if info.offered.get(n) == "PRIMITIVE"}
     primitives = frozenset(BUILTIN_PRIMITIVES | prepare(source, "").primitive_names() | loaded_prims)
     terminals = C.terminals_at(source, start, primitives)
-    items = [C.Item(k, "keyword") for k in C.keywords_for(terminals)]
+    keywords = C.keywords_for(terminals)
+    narrowed = C.modifier_words(source[max(0, start - 400) : start], _type_before(source, start, good))
+    if narrowed is not None:
+        words, value = narrowed
+        keywords = [k for k in keywords if k in words]
+        if not value:
+            terminals = terminals - {"NAME", "PRIM_NAME"}
+    items = [C.Item(k, "keyword") for k in keywords]
     if "NAME" in terminals and good is not None and good.index is not None:
         scope = good.index.scope_at(min(start, len(good.text.source)))
         types = good.checked.main.types if good.checked is not None else {}
@@ -259,6 +267,21 @@ def _completions(source: str, offset: int, good: Analysis | None, path: str | No
     if "CLAUSE_NAME" in terminals:
         items += _clause_items(source, start, primitives, good)
     return items
+
+
+def _type_of_name(good: Analysis | None, name: str) -> str | None:
+    if good is None:
+        return None
+    if good.checked is not None and name in good.checked.main.types:
+        return good.checked.main.types[name]
+    info = good.libraries.get(name)
+    return info.offered.get(name) if info is not None else None
+
+
+def _type_before(source: str, start: int, good: Analysis | None) -> str | None:
+    """The type of the name a ``<`` list before ``start`` modifies, if the last good analysis knows it."""
+    m = C._MODIFIER_TARGET.search(source[max(0, start - 400) : start])
+    return _type_of_name(good, m.group(1).upper()) if m is not None else None
 
 
 def _in_comment_or_string(source: str, offset: int) -> bool:

@@ -95,8 +95,8 @@ def test_aa_reaches_the_rasterizer(monkeypatch):
     import numpy as np
 
     part = (np.zeros((1, 3, 3)), np.zeros(1, np.uint8), np.zeros(1, bool))
-    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 3)
-    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 1)
+    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 3, "thesis")
+    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 1, "thesis")
     assert seen == [{"aa": 3}, {"aa": 1}]
 
 
@@ -104,7 +104,21 @@ def test_run_with_aa_smooths_the_edges(tmp_path):
     src = program(tmp_path, 2)
     for aa in ("1", "3"):
         r = subprocess.run(
-            [sys.executable, "-m", "liganimate", "run", str(src), "-o", f"aa{aa}", "--size", "64x48", "--aa", aa],
+            [
+                sys.executable,
+                "-m",
+                "liganimate",
+                "run",
+                str(src),
+                "-o",
+                f"aa{aa}",
+                "--size",
+                "64x48",
+                "--aa",
+                aa,
+                "--look",
+                "thesis",
+            ],
             capture_output=True,
             text=True,
             cwd=tmp_path,
