@@ -32,6 +32,7 @@ from liganimate.runtime.library import Library  # noqa: F401  (generated modules
 from liganimate.runtime.motion import algebra as M
 from liganimate.runtime.motion import edits as E
 from liganimate.runtime.motion.keyframe import Keyframe
+from liganimate.runtime.render import framing
 from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
 if TYPE_CHECKING:
@@ -126,6 +127,9 @@ class Program:
         self._positions = positions
         self.main = main
         self.source = source
+        # Scene id -> world box (lo, hi) of what the scene draws, or None when
+        # it sets VIEW: gathered by check, read by the renderer's default framing.
+        self.framings: dict = {}
 
     @property
     def positions(self) -> tuple:
@@ -263,6 +267,7 @@ class Runtime(Arithmetic):
         self.scene = None
         self.view_point = Vec(0.0, 0.0, 10.0)
         self.view_width = 10.0
+        self.viewed = False  # a VIEW statement has run (outside a scene)
         self.variables: dict = {}
         self._bind_cache: dict = {}
         self.echo_print = False
@@ -600,8 +605,10 @@ class Runtime(Arithmetic):
             target = "view_width"
         if self.scene is not None:
             setattr(self.scene, target, value)
+            self.scene.viewed = True
         else:
             setattr(self, target, value)
+            self.viewed = True
 
     def define_scene(self, scene_id, fn, snapshot, at):
         if scene_id in self.scenes:
@@ -612,10 +619,13 @@ class Runtime(Arithmetic):
         for scene_id in sorted(self.scenes):
             fn, snapshot, sat = self.scenes[scene_id]
             self.scene = SceneState(scene_id, self.view_point, self.view_width, sat)
+            self.scene.viewed = self.viewed
             if self.renderer is not None:
                 self.renderer.begin_scene(scene_id)
             try:
                 fn(snapshot)
+                if self.mode == "check":
+                    self.program.framings[scene_id] = None if self.scene.viewed else self.scene.extent
             finally:
                 if self.renderer is not None:
                     self.renderer.end_scene()
@@ -694,6 +704,8 @@ class Runtime(Arithmetic):
         for name, value in pairs:
             if isinstance(value, Posed):
                 state.drawn.append((name, _rooted(value)))
+        if self.mode == "check" and not state.viewed and framing.sampled(state.tick, state.length):
+            state.measure()
         if self.renderer is not None:
             self.renderer.add_tick(state, self)
         state.drawn = []
@@ -745,6 +757,17 @@ class SceneState:
         self.length = 0
         self.sameframe = 1
         self.at = at
+        self.viewed = False  # a VIEW statement has run before or in the scene
+        self.extent = None  # world box of what is drawn at the ticks measured
+
+    def measure(self) -> None:
+        """Add this tick's drawing (and the background) to :attr:`extent`, for the default framing."""
+        for item in self.background:
+            tris = item.triangles if isinstance(item, Graphical) else P.static_triangles(item)[0]
+            self.extent = framing.union(self.extent, framing.extent(tris))
+        for _name, posed in self.drawn:
+            tris = P.posed_graphical(posed.figure, posed.motion, posed.frame).triangles
+            self.extent = framing.union(self.extent, framing.extent(tris))
 
 
 def _rooted(posed: Posed) -> Posed:

@@ -52,6 +52,7 @@ from liganimate.runtime.figure.pose import (
 )
 from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
+from liganimate.runtime.render.framing import framing_view
 from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
 from liganimate.runtime.render.look import DEFAULT_LOOK, draw_modern, look_params
 from liganimate.runtime.render.options import RenderOptions, checked, executor_for
@@ -120,6 +121,7 @@ class Renderer:
         self.size = options.size
         self.aa = options.aa
         self.look = options.look
+        self._framed: dict = {}  # (scene id, size) -> default framing view
         self.fps = options.fps
         self.quiet = options.quiet
         self.workers = options.workers if options.workers is not None else min(os.cpu_count() or 1, 8)
@@ -196,13 +198,13 @@ class Renderer:
 
     def add_tick(self, state, rt) -> None:
         with self._failing():
-            self._add_tick(state)
+            self._add_tick(state, rt.program.framings)
 
-    def _add_tick(self, state) -> None:
+    def _add_tick(self, state, framings) -> None:
         tick, k = state.tick, state.sameframe
         image = tick // k
         self.scene_total = -(-state.length // k)
-        camera = (tuple(float(x) for x in state.view_point), float(state.view_width))
+        camera = self._view(state, framings)
         if self.current is None or self.current["image"] != image:
             if self.current is not None:
                 self.pending.append(self.current)
@@ -218,6 +220,20 @@ class Renderer:
             self.current = None
             if len(self.pending) >= BATCH:
                 self.flush()
+
+    def _view(self, state, framings) -> tuple:
+        """The scene's camera: VIEW's, or in the modern look, for a scene without VIEW, the default framing.
+
+        The framing needs the box of what the scene draws, which checking
+        the program gathers (:mod:`.framing`); unchecked, the thesis' camera stays.
+        """
+        if self.look != "thesis" and not state.viewed and framings.get(state.id) is not None:
+            key = (state.id, self.size)
+            view = self._framed.get(key)
+            if view is None:
+                view = self._framed[key] = framing_view(framings[state.id], self.size)
+            return view
+        return (tuple(float(x) for x in state.view_point), float(state.view_width))
 
     def _background(self, state, camera):
         parts = []
@@ -630,13 +646,13 @@ _cameras: dict = {}
 
 
 def _camera(camera, size) -> Camera:
-    """The :class:`Camera` of a ``((x, y, z), width)`` view, remembered (a few)."""
+    """The :class:`Camera` of a ``((x, y, z), width)`` or ``((x, y, z), width, target)`` view, remembered (a few)."""
     key = (camera, size)
     cam = _cameras.get(key)
     if cam is None:
         if len(_cameras) >= 64:
             _cameras.clear()
-        cam = _cameras[key] = Camera(camera[0], camera[1], size)
+        cam = _cameras[key] = Camera(camera[0], camera[1], size, target=camera[2] if len(camera) > 2 else None)
     return cam
 
 
