@@ -264,6 +264,8 @@ class Runtime(Arithmetic):
         self.warnings: list = []
         self._warned: set = set()
         self.scenes: dict = {}
+        #: How many scenes SHOOTSCENES has shot (none: the program draws nothing, a library say).
+        self.shot = 0
         self.scene = None
         self.view_point = Vec(0.0, 0.0, 10.0)
         self.view_width = 10.0
@@ -522,9 +524,14 @@ class Runtime(Arithmetic):
 
     # ------------------------------------------------------------- REACH
     def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
-        """A STARTREACH block: (the motion to the solved pose, the solved translation)."""
+        """A STARTREACH block: (the motion to the solved pose, the solved translation).
+
+        The arguments are the block's, as the lowering writes them; its
+        options travel on as one ``ReachOptions`` (``ik.language.block_options``).
+        """
         from liganimate.runtime.ik import language as RL
 
+        options = RL.block_options(movable, translate, solver, tolerance, iterations)
         fig = self._model(model, at, "the model of a REACH")
         start_motion = self._motion(start, at) if start is not None else None
         self._guard(at, RL.check_frames, frames)
@@ -539,18 +546,7 @@ class Runtime(Arithmetic):
             built.append(goal)
         block = self._guard(
             at,
-            lambda: RL.reach_block(
-                fig,
-                built,
-                frames,
-                method,
-                start=start_motion,
-                movable=movable,
-                translate=translate,
-                solver=solver,
-                tolerance=tolerance,
-                iterations=iterations,
-            ),
+            lambda: RL.reach_block(fig, built, frames, method, start=start_motion, options=options),
         )
         for w in block.warnings:
             self.warn(at if w.goal is None else goals[w.goal].at, _sentence(w.sentence), w.hint)
@@ -619,6 +615,7 @@ class Runtime(Arithmetic):
         for scene_id in sorted(self.scenes):
             fn, snapshot, sat = self.scenes[scene_id]
             self.scene = SceneState(scene_id, self.view_point, self.view_width, sat)
+            self.shot += 1
             self.scene.viewed = self.viewed
             if self.renderer is not None:
                 self.renderer.begin_scene(scene_id)
@@ -786,8 +783,7 @@ def _joint_kind(kind) -> F.JointKind:
 
 
 def _sentence(message: str) -> str:
-    """Runtime libraries write sentences; diagnostics print them without the final period."""
-    message = message.strip()
-    if message.endswith(".") and not message.endswith(".."):
-        message = message[:-1]
-    return message[:1].lower() + message[1:] if message[:2] != message[:2].upper() else message
+    """Runtime libraries write sentences; diagnostics print them without the final period (messages.sentence)."""
+    from liganimate.lang.messages import sentence
+
+    return sentence(message)
