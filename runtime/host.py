@@ -264,6 +264,8 @@ class Runtime(Arithmetic):
         self.warnings: list = []
         self._warned: set = set()
         self.scenes: dict = {}
+        #: How many scenes SHOOTSCENES has shot (none: the program draws nothing, a library say).
+        self.shot = 0
         self.scene = None
         self.view_point = Vec(0.0, 0.0, 10.0)
         self.view_width = 10.0
@@ -619,6 +621,7 @@ class Runtime(Arithmetic):
         for scene_id in sorted(self.scenes):
             fn, snapshot, sat = self.scenes[scene_id]
             self.scene = SceneState(scene_id, self.view_point, self.view_width, sat)
+            self.shot += 1
             self.scene.viewed = self.viewed
             if self.renderer is not None:
                 self.renderer.begin_scene(scene_id)
@@ -786,8 +789,7 @@ def _joint_kind(kind) -> F.JointKind:
 
 
 def _sentence(message: str) -> str:
-    """Runtime libraries write sentences; diagnostics print them without the final period."""
-    message = message.strip()
-    if message.endswith(".") and not message.endswith(".."):
-        message = message[:-1]
-    return message[:1].lower() + message[1:] if message[:2] != message[:2].upper() else message
+    """Runtime libraries write sentences; diagnostics print them without the final period (messages.sentence)."""
+    from liganimate.lang.messages import sentence
+
+    return sentence(message)

@@ -47,7 +47,7 @@ def add_commands(subparsers) -> None:
         description="Run the program once without drawing and write a self-contained "
         "HTML page that shows its scenes in 3D (see docs/viewer.md).",
     )
-    p.add_argument("file")
+    p.add_argument("file", help="the LIG program whose scenes to show")
     p.add_argument("-o", "--output", metavar="OUT.html", help="default: <stem>.html in the current folder")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_view)
