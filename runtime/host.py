@@ -524,9 +524,14 @@ class Runtime(Arithmetic):
 
     # ------------------------------------------------------------- REACH
     def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
-        """A STARTREACH block: (the motion to the solved pose, the solved translation)."""
+        """A STARTREACH block: (the motion to the solved pose, the solved translation).
+
+        The arguments are the block's, as the lowering writes them; its
+        options travel on as one ``ReachOptions`` (``ik.language.block_options``).
+        """
         from liganimate.runtime.ik import language as RL
 
+        options = RL.block_options(movable, translate, solver, tolerance, iterations)
         fig = self._model(model, at, "the model of a REACH")
         start_motion = self._motion(start, at) if start is not None else None
         self._guard(at, RL.check_frames, frames)
@@ -541,18 +546,7 @@ class Runtime(Arithmetic):
             built.append(goal)
         block = self._guard(
             at,
-            lambda: RL.reach_block(
-                fig,
-                built,
-                frames,
-                method,
-                start=start_motion,
-                movable=movable,
-                translate=translate,
-                solver=solver,
-                tolerance=tolerance,
-                iterations=iterations,
-            ),
+            lambda: RL.reach_block(fig, built, frames, method, start=start_motion, options=options),
         )
         for w in block.warnings:
             self.warn(at if w.goal is None else goals[w.goal].at, _sentence(w.sentence), w.hint)
@@ -692,6 +686,10 @@ class Runtime(Arithmetic):
                 f"the motion drives joint{'s' if len(missing) > 1 else ''} "
                 f"{', '.join(map(str, missing))}, which the model does not have",
             )
+        if fig.slides.any():
+            problem = P.slide_out_of_range(fig, motion)
+            if problem is not None:
+                self.fail(at, *problem)
 
     def background(self, items, at):
         out = []

@@ -12,17 +12,23 @@ program text; ``liganimate check`` still does that.
 from __future__ import annotations
 
 import os
+import threading
 from dataclasses import dataclass, field
 
 from liganimate.compiler import NotParsed, parse_program
 from liganimate.compiler.check import Checked, check
 from liganimate.lang import ast as A
+from liganimate.lang import collector
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 from liganimate.lang.source import MAX_SOURCE_BYTES, prepare
 
 from . import index as I
 from . import libraries, statics
 from .text import Text
+
+#: Held while the compiler works (parsing, checking, opening libraries): it pauses and freezes the
+#: process's garbage collector (lang/collector.py) and keeps caches, so two threads must not run it at once.
+COMPILER_LOCK = threading.RLock()
 
 
 @dataclass
@@ -74,6 +80,14 @@ def analyse(
         them, then calls :func:`complete`); True also builds the index and
         the values.
     """
+    # The stages build trees, not cycles: the cyclic collector is paused while
+    # they run, as the compiler pauses it (lang/collector.py), so that the
+    # trees of earlier analyses the server still holds are not walked again and again.
+    with COMPILER_LOCK, collector.paused():
+        return _analyse(source, path, version, encoding, whole)
+
+
+def _analyse(source: str, path: str | None, version: int | None, encoding: str | None, whole: bool) -> Analysis:
     text = Text(source) if encoding is None else Text(source, encoding)
     filename = path or "<untitled>"
     if len(source) > MAX_SOURCE_BYTES or len(source.encode("utf-8", errors="replace")) > MAX_SOURCE_BYTES:
@@ -98,10 +112,11 @@ def complete(a: Analysis) -> Analysis:
     if a.program is None or a.index is not None:
         return a
     where = a.path if a.path is not None else os.path.join(os.getcwd(), "<untitled>")
-    a.index = I.build(a.program, a.text)
-    a.libraries = libraries.libraries_of(a.program, where)
-    a.env = statics.evaluate(a.program, libraries.loaded_values(a.program, where))
+    with COMPILER_LOCK:
+        a.index = I.build(a.program, a.text)
+        a.libraries = libraries.libraries_of(a.program, where)
+        a.env = statics.evaluate(a.program, libraries.loaded_values(a.program, where))
     return a
 
 
-__all__ = ["Analysis", "analyse", "complete"]
+__all__ = ["COMPILER_LOCK", "Analysis", "analyse", "complete"]
