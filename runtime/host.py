@@ -686,6 +686,10 @@ class Runtime(Arithmetic):
                 f"the motion drives joint{'s' if len(missing) > 1 else ''} "
                 f"{', '.join(map(str, missing))}, which the model does not have",
             )
+        if fig.slides.any():
+            problem = P.slide_out_of_range(fig, motion)
+            if problem is not None:
+                self.fail(at, *problem)
 
     def background(self, items, at):
         out = []

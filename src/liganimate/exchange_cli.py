@@ -198,7 +198,7 @@ def cmd_export(args) -> int:
         for note in export.warnings:
             sys.stderr.write(f"liganimate: warning: {note}\n")
         files = export.files
-        X.write_files(files)
+        X.write_files(files, export.folders)
         if not args.quiet:
             for path, _ in files:
                 sys.stderr.write(f"wrote {path}\n")
