@@ -35,7 +35,6 @@ ALLOWED: dict[tuple[str, str], str] = {
     ("compiler/check.py", "Checker._e_BinOp"): "arch-check",
     ("runtime/motion/algebra.py", "Motion.describe.render"): "arch-check",
     ("runtime/values.py", "_solid_orientation"): "arch-check",
-    ("runtime/render/raster.py", "_spans"): "arch-options",
 }
 
 
