@@ -822,7 +822,7 @@ def _next_attempt(st: _State, attempt: tuple) -> tuple[tuple, int]:
     """Hand an attempt that ended unconverged to the attempts' :class:`_State`: the attempt to go on with, restarts left."""
     st.put(0, **dict(zip(_ATTEMPT, attempt)))
     st.end_attempts(_ONE)
-    return st.get(0, *_ATTEMPT), int(st.attempts_left[0])
+    return tuple(st.get(0, *_ATTEMPT)), int(st.attempts_left[0])
 
 
 def _dls_one(

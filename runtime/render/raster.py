@@ -535,8 +535,8 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     found = _trapezoids(_pixel_vertices(cam, camera), front, src, first_index, (W, H))
     if found is None:
         return None
-    table, nrows, bounds = _banded(*found, band_rows, H)
-    total = found[3]
+    table, first_row, nrows, total = found
+    table, nrows, bounds = _banded(table, first_row, nrows, total, band_rows, H)
 
     # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
     # spreads per-trapezoid values over them: it costs a few instructions
@@ -723,10 +723,8 @@ def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple):
     table[13, 1] = upper[13]
     table[6:11, 1] = upper[6:11]
     table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
-    table = table.reshape(15, 2 * m)
     first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
-
-    return table, first_row, nrows, total
+    return table.reshape(15, 2 * m), first_row, nrows, total
 
 
 def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: int, band_rows, H: int):
