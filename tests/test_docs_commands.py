@@ -9,7 +9,7 @@ bash, with this test run's ``liganimate`` and ``python`` first on the PATH:
   ``pip install`` and ``python -m pytest`` are not run (this is the
   installed package and its test suite), nor the servers (``--watch``,
   ``studio``: tests/runtime/view/test_view_watch.py and the studio's tests
-  drive them), nor a synopsis line (one with ``[...]``). README's
+  drive them); a synopsis line runs without its optional ``[...]`` parts. README's
   placeholders stand for its own example: ``scene.lig`` is the program README
   shows, ``MOTION`` its WALK, ``DIR`` a folder;
 * a program is saved under the name the text gives it ("Save it as
@@ -20,7 +20,7 @@ bash, with this test run's ``liganimate`` and ``python`` first on the PATH:
 
 Then the claims: each file an option names (``-o``, ``--gif``, ``--mp4``,
 ``--poses``, ``.save("...")``), the default outputs (``<stem>_frames``,
-``<stem>.py``), and every path the text after the block names in backticks
+``<stem>.py``, ``<stem>.html``), and every path the text after the block names in backticks
 (`appendix_a_frames/scene1/00000.png`) exist; "and nothing else" means
 nothing else was written.
 """
@@ -42,6 +42,8 @@ _BLOCK = re.compile(r"```(\w*)\n(.*?)```", re.S)
 _CLAIMED = re.compile(r"`([\w./-]+(?:\.(?:png|gif|mp4|html|py|lig|glb|gltf|bvh|jsonl)|_frames/))`")
 _NOT_RUN = re.compile(r"^(pip install|python -m pytest)\b|--watch|\bliganimate studio\b|\bliganimate lsp\b")
 _OUTPUT_OPTIONS = ("-o", "--output", "--gif", "--mp4", "--poses")
+# An optional part of a synopsis line (liganimate run scene.lig [-o DIR]): run without it.
+_SYNOPSIS_OPTION = re.compile(r" \[[^\]'\"]*\]")
 # README's placeholders, bound to its own example program.
 _PLACEHOLDERS = {"MOTION": "WALK", "DIR": "out_frames"}
 
@@ -79,6 +81,8 @@ def _outputs(command: str) -> list:
         out.append(Path(words[2]).stem + "_frames")
     if words[:2] == ["liganimate", "compile"] and "-o" not in words:
         out.append(Path(words[2]).stem + ".py")
+    if words[:2] == ["liganimate", "view"] and "-o" not in words:
+        out.append(Path(words[2]).stem + ".html")
     return out
 
 
@@ -145,8 +149,7 @@ def test_every_command_and_program_of_the_doc_runs_and_writes_what_the_text_clai
         before = {p.name for p in cwd.iterdir()}
         if language == "sh":
             for line in code.splitlines():
-                if "[" not in line.split(" #", 1)[0]:
-                    _run_line(line, cwd, ran)
+                _run_line(_SYNOPSIS_OPTION.sub("", line), cwd, ran)
         elif language == "lig" or (language == "" and "SHOOTSCENES" in code):
             name = "scene.lig" if language == "" else _program_name(code, after, n)
             (cwd / name).write_text(code)
