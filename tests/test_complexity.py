@@ -30,9 +30,6 @@ MAX_COMPLEXITY = 25
 ALLOWED: dict[tuple[str, str], str] = {
     ("lang/lalr.py", "Driver.parse"): "arch-check",
     ("lang/parser.py", "_syntax_diagnostic"): "arch-check",
-    ("compiler/check.py", "Checker._loads"): "arch-check",
-    ("compiler/check.py", "Checker._s_ReachBlock"): "arch-check",
-    ("compiler/check.py", "Checker._e_BinOp"): "arch-check",
     ("runtime/motion/algebra.py", "Motion.describe.render"): "arch-check",
     ("runtime/values.py", "_solid_orientation"): "arch-check",
     ("runtime/exchange/_bvh_read.py", "parse_bvh"): "retarget",
