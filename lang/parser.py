@@ -369,24 +369,8 @@ def _bracket_hint(text: str, upto: int, after: int = -1):
 
 def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
     text = source.lexed
-    line, col = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
-    hint = None
     if isinstance(exc, UnexpectedCharacters):
-        at = exc.pos_in_stream
-        assert at is not None  # Optional on UnexpectedInput; UnexpectedCharacters always sets it
-        ch = text[at] if at < len(text) else ""
-        if ch == "$":
-            message = "names beginning with $ are reserved for liganimate"
-            hint = "rename it; only PRINT $model uses a $"
-        elif ch == "{":
-            message = "this { comment is never closed with }"
-            hint = "a comment runs from { to the next }; add the }"
-        elif ch == "'":
-            message = "this quoted word is never closed with ' on the same line"
-            hint = "a quoted word ends with ' before the end of its line"
-        else:
-            message = f"unexpected character {ch!r}"
-        return Diagnostic(source.filename, A.Pos(line, col, line, col + 1), message, hint, source=source.text)
+        return _character_diagnostic(exc, source)
     assert isinstance(exc, UnexpectedToken)
     tok = exc.token
     expected = set(exc.expected) if exc.expected else set()
@@ -401,25 +385,51 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
             return d
     if tok.type == "$END":
         return _end_of_file(tok, expected, text, source)
-    pos = _token_pos(tok)
-    if tok.type == "DOLLAR_NAME":
+    message, hint = _token_message(tok, expected, text)
+    return Diagnostic(source.filename, _token_pos(tok), message, hint, source=source.text)
+
+
+def _character_diagnostic(exc: UnexpectedCharacters, source: Source) -> Diagnostic:
+    """A character no token starts with: a $ name, an unclosed comment or quoted word, or a stray symbol."""
+    text = source.lexed
+    line, col = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
+    at = exc.pos_in_stream
+    assert at is not None  # Optional on UnexpectedInput; UnexpectedCharacters always sets it
+    ch = text[at] if at < len(text) else ""
+    hint = None
+    if ch == "$":
         message = "names beginning with $ are reserved for liganimate"
         hint = "rename it; only PRINT $model uses a $"
-    elif tok.type == "PRIM_NAME" and "NAME" in expected:
-        message = f"{tok.value.upper()} is a primitive, so it cannot be used as a variable name here"
-        hint = "choose another name"
+    elif ch == "{":
+        message = "this { comment is never closed with }"
+        hint = "a comment runs from { to the next }; add the }"
+    elif ch == "'":
+        message = "this quoted word is never closed with ' on the same line"
+        hint = "a quoted word ends with ' before the end of its line"
     else:
-        message = f"unexpected {_describe_token(tok)}; expected {_describe_expected(expected)}"
-        closers = {e for e in expected if e.startswith("END")}
-        if (tok.type.startswith("END") and tok.type not in expected) or closers:
-            opened = _open_blocks(text, tok.start_pos)
-            if opened:
-                word, at = opened[-1]
-                oline, _ = _line_col(text, at)
-                hint = f"the {_shown(word)} opened at line {oline} is not closed; add {_CLOSER[word]}"
-        if hint is None and expected & {"RPAR", "RSQB"}:
-            hint = _bracket_hint(text, tok.start_pos)
-    return Diagnostic(source.filename, pos, message, hint, source=source.text)
+        message = f"unexpected character {ch!r}"
+    return Diagnostic(source.filename, A.Pos(line, col, line, col + 1), message, hint, source=source.text)
+
+
+def _token_message(tok, expected: set, text: str) -> tuple:
+    """The message and hint for a token the grammar does not take here (not the end of the file)."""
+    if tok.type == "DOLLAR_NAME":
+        return "names beginning with $ are reserved for liganimate", "rename it; only PRINT $model uses a $"
+    if tok.type == "PRIM_NAME" and "NAME" in expected:
+        message = f"{tok.value.upper()} is a primitive, so it cannot be used as a variable name here"
+        return message, "choose another name"
+    message = f"unexpected {_describe_token(tok)}; expected {_describe_expected(expected)}"
+    hint = None
+    closers = {e for e in expected if e.startswith("END")}
+    if (tok.type.startswith("END") and tok.type not in expected) or closers:
+        opened = _open_blocks(text, tok.start_pos)
+        if opened:
+            word, at = opened[-1]
+            oline, _ = _line_col(text, at)
+            hint = f"the {_shown(word)} opened at line {oline} is not closed; add {_CLOSER[word]}"
+    if hint is None and expected & {"RPAR", "RSQB"}:
+        hint = _bracket_hint(text, tok.start_pos)
+    return message, hint
 
 
 # When the file ends inside a block the scan did not see, the closer to suggest.
