@@ -54,18 +54,55 @@ def compile_source(
     LigDiagnostics
         Any other error.
     """
-    path = path if path is not None else source.filename
     # The stages build trees and tables, not cycles: see lang/collector.py.
     with collector.paused():
-        opened: dict = {}  # library name -> Library or its failure, for this compile (library.open_library)
-        names, failed = _scan_loads(source, path, stack, opened)
-        try:
-            program = parse_source(source, names)
-        except LigDiagnostics as exc:
-            raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
-        checked = check(program, path=path, stack=stack, opened=opened)
+        checked = check_source(source, path=path, stack=stack)
         python = lower(checked, module_name or source.filename, consume)
     return Compiled(python, list(source.warnings) + checked.warnings, checked)
+
+
+def check_source(source: Source, *, path: str | None = None, stack: tuple = ()) -> Checked:
+    """Open the LOADed libraries, parse and check a prepared source, without lowering it.
+
+    Every static diagnostic :func:`compile_source` reports, at the same
+    cost minus the lowering. Nothing is executed (a library is compiled,
+    never run). The warnings of reading the source are ``source.warnings``,
+    those of the check ``Checked.warnings``.
+
+    Raises
+    ------
+    NotParsed
+        The source does not parse (a LigDiagnostics).
+    LigDiagnostics
+        Any other error.
+    """
+    with collector.paused():
+        program, opened = parse_program(source, path=path, stack=stack)
+        return check(program, path=path if path is not None else source.filename, stack=stack, opened=opened)
+
+
+def parse_program(source: Source, *, path: str | None = None, stack: tuple = ()) -> tuple:
+    """Open the libraries a source LOADs and parse it: ``(Program, opened)``, for :func:`check`.
+
+    ``opened`` holds the libraries opened for the parse (library name ->
+    Library, or the exception it failed with), which :func:`check` takes
+    so that a library is opened once. The language server calls this and
+    :func:`check` apart, to keep the syntax tree of a program that parses
+    but fails its checks.
+
+    Raises
+    ------
+    NotParsed
+        The source does not parse.
+    """
+    path = path if path is not None else source.filename
+    opened: dict = {}  # library name -> Library or its failure, for this compile (library.open_library)
+    names, failed = _scan_loads(source, path, stack, opened)
+    try:
+        program = parse_source(source, names)
+    except LigDiagnostics as exc:
+        raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
+    return program, opened
 
 
 def compile_text(text: str, filename: str = "<string>") -> Compiled:
@@ -137,6 +174,15 @@ def _scan_loads(source: Source, path: str, stack: tuple, opened: dict | None = N
             continue
         names.update(n for n in (wanted if wanted is not None else lib.signatures) if n in lib.signatures)
     return names, failed
+
+
+def loaded_primitive_names(source: Source, path: str) -> set:
+    """Names of the primitives the LOAD statements of ``source`` (a file at ``path``) bring in.
+
+    The lexer must know them to parse the source; ``liganimate fmt`` parses
+    without checking, so it asks here.
+    """
+    return _scan_loads(source, path, ())[0]
 
 
 def _loaded_primitive_names(source: Source, path: str, stack: tuple) -> set:

@@ -264,12 +264,14 @@ class ExpressionTyper(NodeVisitor):
     # ------------------------------------------------------------ joints
     def joint_args(self, args: list, node, in_block: bool) -> None:
         """The values of a JOINT (an expression, or a line of a STARTMODEL block)."""
+        if node.axis is not None:
+            self.want(node.axis, T.VECTOR, "an axis (x, y, z)")
         if len(args) < 6 or len(args) > 8:
             self.st.out.error(
                 node,
                 f"JOINT takes an identifier, a primary segment and its location, a secondary segment "
                 f"and its location, and one to three extreme pairs: {len(args)} values given",
-                "JOINT id, primary, (x, y, z), secondary, (x, y, z), (min, max), (min, max), (min, max)",
+                "JOINT id, primary, (x, y, z), secondary, (x, y, z), [SLIDE] (min, max), (min, max), (min, max)",
             )
             for a in args:
                 self.expr(a)

@@ -32,6 +32,7 @@ from pathlib import Path
 from liganimate import __version__
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
+from liganimate.lang.name_table import read_tables
 from liganimate.lang.source import SourceFileError, lig_text, read_source_bytes
 
 from . import library_cache
@@ -74,6 +75,8 @@ class Library:
     signatures: dict  # own PRIMITIVE NAME -> Signature (no defaults: they live in ``python``)
     descriptions: dict  # NAME -> one-line description from its {@ NAME: ...} comments
     warnings: list = field(default_factory=list)
+    # MODEL -> {SEGMENT: (source name, channels, end)}: its {@names ...} tables (lang/name_table.py)
+    names: dict = field(default_factory=dict)
     deps: tuple = ()  # ((absolute path, sha256 of its bytes), ...) of every file it loads, recursively
     scenes: bool = False  # whether it defines or shoots scenes (then it is a program, not a library)
 
@@ -90,6 +93,20 @@ class Library:
     def kind_of(self, name: str) -> str:
         """``PRIMITIVE`` or the type of an offered name."""
         return "PRIMITIVE" if name in self.signatures else self.types[name]
+
+
+def _extra(row) -> list:
+    """A name-table row's URDF columns (joint name, rpy) for the cache's JSON."""
+    joint = row[3] if len(row) > 3 else None
+    rpy = row[4] if len(row) > 4 else None
+    return [joint, None if rpy is None else list(rpy)]
+
+
+def _extra_back(row) -> tuple:
+    """:func:`_extra` read back (a row cached before the columns existed has neither)."""
+    joint = row[3] if len(row) > 3 else None
+    rpy = row[4] if len(row) > 4 else None
+    return (joint, None if rpy is None else tuple(rpy))
 
 
 def stdlib_dir() -> Path:
@@ -229,6 +246,10 @@ def _to_json(lib: Library) -> dict:
         "python": lib.python,
         "types": lib.types,
         "descriptions": lib.descriptions,
+        "names": {
+            m: {k: [v[0], list(v[1]), None if v[2] is None else list(v[2]), *_extra(v)] for k, v in rows.items()}
+            for m, rows in lib.names.items()
+        },
         "scenes": lib.scenes,
         "deps": [list(d) for d in lib.deps],
         "signatures": [
@@ -279,6 +300,10 @@ def _from_json(obj: dict) -> Library:
         signatures=sigs,
         descriptions=dict(obj["descriptions"]),
         warnings=warnings,
+        names={
+            m: {k: (v[0], tuple(v[1]), None if v[2] is None else tuple(v[2]), *_extra_back(v)) for k, v in rows.items()}
+            for m, rows in obj.get("names", {}).items()
+        },
         deps=tuple((p, h) for p, h in obj["deps"]),
         scenes=bool(obj["scenes"]),
     )
@@ -370,6 +395,7 @@ def _compile(name: str, path: str, data: bytes, stack: tuple) -> Library:
         signatures=sigs,
         descriptions=descriptions(source.text),
         warnings=list(compiled.warnings),
+        names={m: rows for m, rows in read_tables(source.text).items() if types.get(m) == T.MODEL},
         deps=tuple(dict.fromkeys(deps)),
         scenes=_has_scenes(checked.program.body),
     )

@@ -133,7 +133,8 @@ class Lowerer(NodeVisitor):
         for i, lib in enumerate(self.c.libraries):
             # The library's own compiled module travels inside this one, so the
             # generated file stays standalone; it runs once, when first needed.
-            self.emit(f"_LIB{i} = _host.Library({lib.display!r}, {lib.python!r})")
+            names = f", names={lib.names!r}" if lib.names else ""
+            self.emit(f"_LIB{i} = _host.Library({lib.display!r}, {lib.python!r}{names})")
         for name, i in sorted(self.c.loaded_primitives.items()):
             self.emit(f"_prim_{name} = _LIB{i}.primitive({name!r})")
         if self.c.libraries:
@@ -341,7 +342,8 @@ class Lowerer(NodeVisitor):
             specs.append(
                 f"_host.JointArgs(jid={self.expr(a[0])}, primary_name={pname!r}, primary={self.expr(a[1])}, "
                 f"primary_location={self.expr(a[2])}, secondary={self.expr(a[3])}, secondary_name={sname!r}, "
-                f"secondary_location={self.expr(a[4])}, extremes=({exts},), at={self.at(j)})"
+                f"secondary_location={self.expr(a[4])}, extremes=({exts},), at={self.at(j)}"
+                f"{self.joint_kind(j, ', kind=')})"
             )
         self.emit(f"{s.name.name} = rt.model_block({s.name.name!r}, (")
         for sp in specs:
@@ -610,8 +612,16 @@ class Lowerer(NodeVisitor):
         exts = "".join(self.expr(x) + ", " for x in a[5:])
         return (
             f"rt.joint({self.expr(a[0])}, {self.expr(a[1])}, {self.expr(a[2])}, {self.expr(a[3])}, "
-            f"{self.expr(a[4])}, ({exts}), ({bindings.plain_name(a[1])!r}, {bindings.plain_name(a[3])!r}), {self.at(e)})"
+            f"{self.expr(a[4])}, ({exts}), ({bindings.plain_name(a[1])!r}, {bindings.plain_name(a[3])!r}), {self.at(e)}"
+            f"{self.joint_kind(e, ', kind=')})"
         )
+
+    def joint_kind(self, j, lead: str) -> str:
+        """``lead`` and the (slide, axis) pair of a JOINT that says SLIDE or AXIS; nothing for the thesis' joint."""
+        if not j.slide and j.axis is None:
+            return ""
+        axis = "None" if j.axis is None else self.expr(j.axis)
+        return f"{lead}({j.slide!r}, {axis})"
 
     def e_Strip(self, e):
         joints = "".join(self.expr(j) + ", " for j in e.joints)

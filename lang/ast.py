@@ -216,6 +216,8 @@ class PrimCall(Node):
 @dataclass(slots=True)
 class JointExpr(Node):
     args: list
+    slide: bool = False  # SLIDE before the extremes: a prismatic joint
+    axis: Node | None = None  # AXIS (x, y, z) after them
 
 
 @dataclass(slots=True)
@@ -324,6 +326,8 @@ class If(Node):
 @dataclass(slots=True)
 class JointStmt(Node):
     args: list
+    slide: bool = False  # as in JointExpr
+    axis: Node | None = None
 
 
 @dataclass(slots=True)

@@ -55,15 +55,19 @@ def _driver() -> Driver:
     return Driver(build_parser())
 
 
-def parse_source(source: Source, primitives: frozenset | set = frozenset()) -> A.Program:
-    """Parse a prepared source; ``primitives`` are extra primitive names (e.g. from a library)."""
+def parse_source(source: Source, primitives: frozenset | set = frozenset(), tokens: list | None = None) -> A.Program:
+    """Parse a prepared source; ``primitives`` are extra primitive names (e.g. from a library).
+
+    ``tokens``, when given, receives the tokens in order, each typed as the
+    parser took it (see :meth:`.lalr.Driver.parse`).
+    """
     names = frozenset(set(BUILTIN_PRIMITIVES) | set(primitives) | source.primitive_names())
     # The parse makes trees, never cycles: the cyclic collector would walk
     # the growing tree again and again for nothing (on a million-line
     # program, a third of the time).
     with collector.paused():
         try:
-            body = _driver().parse(source.lexed, names)
+            body = _driver().parse(source.lexed, names, tokens)
         except UnexpectedInput as exc:
             raise LigDiagnostics([_syntax_diagnostic(exc, source)]) from None
         body = group_blocks(body, source)

@@ -271,7 +271,8 @@ class ToAst(Transformer):
         return A.ModelBlock(span(children), _name(children[1]), _nodes(children[2:]))
 
     def joint_stmt(self, children):
-        return A.JointStmt(span(children), children[1])
+        args, slide, axis = children[1]
+        return A.JointStmt(span(children), args, slide, axis)
 
     def motion_block(self, children):
         return A.MotionBlock(span(children), _name(children[1]), _nodes(children[2:]))
@@ -411,10 +412,17 @@ class ToAst(Transformer):
 
     # -------------------------------------------------------- expressions
     def joint_expr(self, children):
-        return A.JointExpr(span(children), children[1])
+        args, slide, axis = children[1]
+        return A.JointExpr(span(children), args, slide, axis)
 
     def joint_args(self, children):
-        return list(children)
+        # (the expressions, whether SLIDE was written, the AXIS expression or None)
+        slide = any(type(c) is Tok and c[0] == "SLIDE" for c in children)
+        axis = children[-1][1] if children and type(children[-1]) is tuple else None  # from joint_axis
+        return [c for c in children if isinstance(c, A.Node)], slide, axis
+
+    def joint_axis(self, children):
+        return ("AXIS", children[1])
 
     def strip_expr(self, children):
         return A.Strip(span(children), children[1], list(children[2:]))

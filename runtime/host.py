@@ -10,9 +10,11 @@ written unless the whole program is sound; then in *render* mode.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import sys
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -31,6 +33,9 @@ from liganimate.runtime.motion import algebra as M
 from liganimate.runtime.motion import edits as E
 from liganimate.runtime.motion.keyframe import Keyframe
 from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
+
+if TYPE_CHECKING:
+    from liganimate.runtime.render.options import RenderOptions
 
 #: How often a long scene reports its progress while it is checked, in ticks.
 PROGRESS_TICKS = 4096
@@ -74,6 +79,7 @@ class JointArgs:
     secondary_location: object
     extremes: tuple
     at: int
+    kind: tuple = (False, None)  # (SLIDE written, the AXIS vector or None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -175,19 +181,53 @@ class Program:
             return self.execute("check", stdout=io.StringIO(), progress=progress).warnings
         return self.execute("check", stdout=stdout, echo_print=True, progress=progress).warnings
 
-    def render(self, out_dir: str, checked: bool = False, **options) -> Runtime:
-        """Check, then render every scene to ``out_dir`` (see :class:`~.render.Renderer`).
+    def render(
+        self,
+        out_dir: str | None = None,
+        checked: bool = False,
+        *,
+        options: RenderOptions | None = None,
+        stdout=None,
+        progress=None,
+        executor=None,
+        **fields,
+    ) -> Runtime:
+        """Check, then render every scene (see :class:`~.render.frames.Renderer`).
 
-        ``checked=True`` says the caller has just run :meth:`check` itself
-        (the command line does, to show its warnings first), so it is not run twice.
+        Parameters
+        ----------
+        out_dir : str or None
+            The frames folder (``RenderOptions.out``); None writes only the movies asked for.
+        checked : bool
+            The caller has just run :meth:`check` itself (the command line
+            does, to show its warnings first), so it is not run twice.
+        options : RenderOptions, optional
+            What to write and how; ``out_dir`` and ``fields`` replace its values.
+        stdout : text stream, optional
+            Where PRINT writes (default ``sys.stdout``).
+        progress, executor
+            As :class:`~.render.frames.Renderer` takes them.
+        **fields
+            Fields of :class:`~.render.options.RenderOptions` (``size=``, ``gif=``, ``fps=``...).
         """
-        from liganimate.runtime.render.frames import Renderer
+        import dataclasses
 
+        from liganimate.runtime.render.frames import Renderer
+        from liganimate.runtime.render.options import RenderOptions
+
+        base = options if options is not None else RenderOptions()
+        if out_dir is not None:
+            fields["out"] = out_dir
+        try:
+            chosen = dataclasses.replace(base, **fields)
+        except TypeError:
+            unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(RenderOptions)})
+            raise TypeError(f"render() got unknown options: {', '.join(unknown)}") from None
         if not checked:
             self.check()
-        renderer = Renderer(out_dir, **options)
+        renderer = Renderer(chosen, progress=progress, executor=executor)
         try:
-            rt = self.execute("render", renderer=renderer, stdout=options.get("stdout"))
+            rt = self.execute("render", renderer=renderer, stdout=stdout)
             renderer.finish()
         finally:
             renderer.close()
@@ -385,10 +425,10 @@ class Runtime(Arithmetic):
             self.fail(at, f"{name or 'a model'} is used before it has a value")
         return F.Link(name, value)
 
-    def joint(self, jid, primary, loc1, secondary, loc2, extremes, names, at):
+    def joint(self, jid, primary, loc1, secondary, loc2, extremes, names, at, kind=(False, None)):
         p = self._segment(primary, names[0], at)
         s = self._segment(secondary, names[1], at)
-        fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes)
+        fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes, _joint_kind(kind))
         return self._guard(at, limits.check_figure, fig, "the joined model")
 
     def model_block(self, name, specs, at):
@@ -413,6 +453,7 @@ class Runtime(Arithmetic):
                     j.secondary_location,
                     j.extremes,
                     index,
+                    *dataclasses.astuple(_joint_kind(j.kind)),
                 )
             )
         try:
@@ -713,6 +754,12 @@ def _rooted(posed: Posed) -> Posed:
     fig = posed.figure
     placed = P.rooted_placements(np.asarray(fig.placement)[None], posed.motion, np.array([posed.frame]))[0]
     return posed.with_figure(fig.with_placement(placed))
+
+
+def _joint_kind(kind) -> F.JointKind:
+    """The runtime's JointKind from the ``(slide, axis)`` pair a compiled JOINT passes."""
+    slide, axis = kind
+    return F.JointKind(bool(slide), None if axis is None else tuple(float(x) for x in axis))
 
 
 def _sentence(message: str) -> str:

@@ -14,6 +14,7 @@ import hashlib
 import io
 
 from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure.tree import Figure, LinkSource
 from liganimate.runtime.loader import exec_module
 
 _runs: dict = {}  # sha256 of the module text -> (namespace, variables, warnings)
@@ -30,9 +31,12 @@ class Library:
         Its compiled module text.
     """
 
-    def __init__(self, name: str, python: str):
+    def __init__(self, name: str, python: str, names: dict | None = None):
         self.name = name
         self.python = python
+        # MODEL -> {SEGMENT: (source name, channels, end)}: the library's name tables
+        # (lang/name_table.py), handed to the model's links as it is loaded.
+        self.names = names or {}
         self._key = hashlib.sha256(python.encode()).hexdigest()
 
     def _namespace(self) -> dict:
@@ -66,9 +70,13 @@ class Library:
             seen.add(self._key)
             rt.warnings.extend(w for w in warnings if w not in rt.warnings)
         try:
-            return values[name]
+            value = values[name]
         except KeyError:
             raise LigError(f"{self.name} no longer defines {name}", "recompile the program") from None
+        table = self.names.get(name.upper())
+        if table and isinstance(value, Figure):
+            value = value.with_sources({seg: LinkSource(*row) for seg, row in table.items()})
+        return value
 
     def primitive(self, name: str):
         """A callable ``f(rt, **arguments)`` drawing the library's PRIMITIVE ``name``.

@@ -167,3 +167,191 @@ def pose_records(program, tmp_path) -> list:
     program.render(str(tmp_path / "frames"), size=(8, 6), poses=poses, quiet=True, workers=1)
     with open(poses, encoding="utf-8") as fh:
         return [json.loads(line) for line in fh]
+
+
+# -- programs the exchange tests export ---------------------------------------------
+
+# Two scenes: a figure scaled unevenly, turned and moved every tick, with a
+# clamped joint and a free axis; a mirrored copy re-rooted at its forearm
+# that is drawn only from tick 3 to 8; a camera that follows; a second scene
+# with SAMEFRAME 2 (STEP sampling).
+EDGES = """\
+      GRAPHICAL A, B, C, FLOOR
+      MODEL ARM, MIRROR
+      MOTION SWING
+      VECTOR P
+      A :- BOX WIDTH 0.2, HEIGHT 1.0, DEPTH 0.2, LIGHTNESS 30.0
+      B :- BOX WIDTH 0.15, HEIGHT 0.8, DEPTH 0.15, LIGHTNESS 60.0
+      C :- BOX WIDTH 0.3, HEIGHT 0.1, DEPTH 0.3
+      ARM :- JOINT 1, A, (0.0, 0.5, 0.0), B, (0.0, -0.4, 0.0), (-90.0, 90.0), (-180.0, 180.0), (-120.0, 120.0)
+      ARM :- JOINT 2, ARM, (0.0, -0.5, 0.0), C, (0.0, 0.05, 0.0), (-30.0, 30.0), (-30.0, 30.0), (-30.0, 30.0)
+      MIRROR :- ARM <SCALE MODEL -0.5>
+      FIGURE MIRROR MAIN JOINT 1
+      STARTMOTION SWING
+        JOINT 1 POSITION 10.0, 20.0, 30.0
+          FRAME 10 POSITION -50.0, 170.0, 100.0 INTERPOLATE ACCDCC
+        JOINT 2 POSITION 0.0, 0.0, 0.0
+          FRAME 10 POSITION 40.0, -40.0, 20.0
+      ENDMOTION
+      FLOOR :- BOX AT (0.0, -1.0, 0.0), WIDTH 4.0, HEIGHT 0.1, DEPTH 4.0
+      INITIALIZE SCENE 1
+        P = (0.0, 0.0, 0.0)
+        BACKGROUND FLOOR
+      STARTSCENE LENGTH 12
+        ANIMATE ARM FROM 0 TO 11 USING SWING
+        ARM :- ARM <SCALE (1.0, 2.0, 1.0)> <ROT Y 30.0> <TRANS (P)>
+        ANIMATE MIRROR FROM 3 TO 8 USING SWING
+        MIRROR :- MIRROR <ROT Z 20.0> <TRANS (1.0, 0.0, 0.0)>
+        P = P + (0.1, 0.05, 0.0)
+        VIEW POINT = (1.0, 2.0, 6.0) + P
+      ENDSCENE
+      INITIALIZE SCENE 2
+      STARTSCENE LENGTH 4 SAMEFRAME 2
+        ANIMATE ARM FROM 0 TO 3 USING SWING <SCALE FRAMES 0.5>
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+WALKING_HUMANOID = """\
+      LOAD HUMANOID, WALK FROM 'humanoid'
+      INITIALIZE SCENE 1
+        VIEW POINT = (0.0, 1.0, 5.0)
+      STARTSCENE LENGTH 30
+        ANIMATE HUMANOID FROM 0 TO 29 USING WALK REPEAT
+C       WALK's ROOT track carries the body forward; the scene places its start.
+        HUMANOID :- HUMANOID <TRANS (-1.0, 0.972, 0.0)>
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+
+def program_named(tmp_path, name):
+    """A compiled program: ``edges`` or ``walking_humanoid`` (above), or an example's name."""
+    from paths import ROOT_DIR
+
+    from liganimate.cli import load_program
+
+    if name == "edges":
+        path = tmp_path / "edges.lig"
+        path.write_text(EDGES)
+    elif name == "walking_humanoid":
+        path = tmp_path / "walk.lig"
+        path.write_text(WALKING_HUMANOID)
+    else:
+        path = os.path.join(ROOT_DIR, "examples", name + ".lig")
+    program, _ = load_program(str(path))
+    return program
+
+
+PROGRAMS = ["edges", "walking_humanoid", "appendix_a", "rerooting", "big_and_small_robot", "there_and_back"]
+
+
+# -- real clients: three.js in node, Blender's bpy ---------------------------------
+
+THREE_DIR = os.path.join(HERE, ".cache", "three")
+THREE_MODULE = os.path.join(THREE_DIR, "node_modules", "three")
+THREE_POSE_JS = os.path.join(HERE, "exchange_tools", "three_pose.mjs")
+BPY_DIR = os.path.join(HERE, ".cache", "bpy")
+BLENDER_POSE_PY = os.path.join(HERE, "exchange_tools", "blender_pose.py")
+# Blender's Python module: 4.5 is Blender's long-term-support line; its wheel
+# is built for CPython 3.11 only (about 370 MB, 950 MB installed; `import bpy`
+# takes under a second).  It pins numpy < 2, so it lives in a venv of its own
+# under tests/.cache rather than in the test extra, where it would hold the
+# whole suite to numpy 1.
+BPY_VERSION = "4.5.15"
+BPY_PYTHON = (3, 11)
+
+
+def _missing(message: str):
+    """Fail under CI, where every client must run; elsewhere skip, saying why."""
+    if os.environ.get("CI"):
+        pytest.fail(message)
+    pytest.skip(message)
+
+
+def three_or_skip() -> str:
+    """The three.js package folder, installed from npm into tests/.cache the first time.
+
+    Skips only outside CI, and says why; in CI a missing node or npm fails.
+    """
+    node, npm = shutil.which("node"), shutil.which("npm")
+    missing = [n for n, p in (("node", node), ("npm", npm)) if p is None]
+    if missing:
+        _missing(f"{' and '.join(missing)} not found, so three.js cannot load the exported files here")
+    if not os.path.isfile(os.path.join(THREE_MODULE, "build", "three.module.js")):
+        os.makedirs(THREE_DIR, exist_ok=True)
+        r = subprocess.run(
+            [npm, "install", "--no-audit", "--no-fund", "--prefix", THREE_DIR, "three"],
+            check=False,
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
+        if r.returncode != 0 or not os.path.isfile(os.path.join(THREE_MODULE, "build", "three.module.js")):
+            _missing(f"npm install three failed:\n{r.stdout}\n{r.stderr}")
+    return THREE_MODULE
+
+
+def three_pose(path: str, times) -> dict:
+    """What three.js's GLTFLoader and AnimationMixer make of a file at each time (see three_pose.mjs)."""
+    module = three_or_skip()
+    r = subprocess.run(
+        ["node", THREE_POSE_JS, module, path, *(repr(float(t)) for t in times)],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout)
+
+
+def _python_311():
+    import sys
+
+    if sys.version_info[:2] == BPY_PYTHON:
+        return sys.executable
+    return shutil.which("python{}.{}".format(*BPY_PYTHON))
+
+
+def bpy_python_or_skip() -> str:
+    """A Python that imports Blender's ``bpy``: a venv in tests/.cache, made the first time.
+
+    Skips only outside CI, and says why; in CI a missing Python 3.11 or a
+    failed install fails.
+    """
+    python = os.path.join(BPY_DIR, "bin", "python")
+    marker = os.path.join(BPY_DIR, f"bpy-{BPY_VERSION}.ok")
+    if os.path.isfile(marker):
+        return python
+    base = _python_311()
+    if base is None:
+        _missing("Blender's bpy {} needs CPython {}.{}, which is not here".format(BPY_VERSION, *BPY_PYTHON))
+    steps = [
+        [base, "-m", "venv", "--clear", BPY_DIR],
+        [python, "-m", "pip", "install", "--no-input", "--disable-pip-version-check", f"bpy=={BPY_VERSION}"],
+        [python, "-c", "import bpy"],
+    ]
+    for cmd in steps:
+        r = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=1200)
+        if r.returncode != 0:
+            _missing(f"installing Blender's bpy failed at {' '.join(cmd[:4])}:\n{r.stdout[-2000:]}\n{r.stderr[-2000:]}")
+    with open(marker, "w", encoding="utf-8") as fh:
+        fh.write(BPY_VERSION + "\n")
+    return python
+
+
+def blender_pose(path: str, fps: float, frames) -> dict:
+    """What Blender's glTF importer makes of a file at each frame (see blender_pose.py)."""
+    python = bpy_python_or_skip()
+    out = path + ".blender.json"
+    r = subprocess.run(
+        [python, BLENDER_POSE_PY, path, out, repr(float(fps)), *(str(int(f)) for f in frames)],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    with open(out, encoding="utf-8") as fh:
+        return json.load(fh)

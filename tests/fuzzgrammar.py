@@ -510,7 +510,10 @@ class Expander:
             return 1.0 if head == "STRING" else 0.01
         if name == "_prim_item":  # the pattern first
             return (1.0 if head == "statement" else 0.1) if self.prim_pattern else (0.2 if head == "statement" else 5.0)
-        if name in ("model_block", "motion_block", "reach_block", "primitive_def", "joint_args"):
+        if name == "joint_args":  # at least one extreme pair; SLIDE and AXIS now and then
+            w = 1.0 if len(symbols) > 9 else 0.01
+            return w * (0.3 if "SLIDE" in symbols else 1.0) * (0.3 if "joint_axis" in symbols else 1.0)
+        if name in ("model_block", "motion_block", "reach_block", "primitive_def"):
             return 1.0 if any(s.startswith("__") and s != "__start_star_0" for s in symbols) else 0.01
         if name in ("_prim_head", "_load_name"):
             return 10.0 if head == "NAME" else 1.0
@@ -592,7 +595,13 @@ class Expander:
         if name == "if_stmt" and sym == "cond":
             return COND
         if name == "joint_args":
-            return [PAIR] * (1 + rng.randrange(3)) if many else [INT, GRAPH, VEC, GRAPH, VEC][i // 2]
+            if many:
+                return [PAIR] * rng.randrange(3)
+            if sym == "joint_axis":
+                return None
+            return [INT, GRAPH, VEC, GRAPH, VEC][i // 2] if i < 9 else PAIR
+        if name == "joint_axis":
+            return VEC
         if name == "reach_block":
             return {"MODEL_KW": MODEL, "FRAME": INT, "FROM": MOTION}.get(prev)
         if name in ("goal_spec", "goal_point", "goal_plane", "goal_axis"):

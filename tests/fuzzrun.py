@@ -11,7 +11,7 @@ outcome    failure  meaning
 ========== ======== ==========================================================
 ok         no       compiled, checked and rendered
 diagnosed  no       LigDiagnostics, every one with file:line:col and one sentence
-error      no       an exception ``cli._guarded`` prints as a clean error line
+error      no       an exception ``cli.guarded`` prints as a clean error line
                     (LigError, OSError, RecursionError); counted apart because
                     it carries no position
 slow       no       still running after the time limit (a legitimately long program)

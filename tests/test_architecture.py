@@ -17,7 +17,16 @@ ROOT = pathlib.Path(ROOT_DIR)
 FOLDERS = {"lang": "liganimate.lang", "compiler": "liganimate.compiler", "runtime": "liganimate.runtime"}
 
 #: The command line and the tools above the runtime: nothing below imports them.
-ABOVE = ("liganimate.cli", "liganimate.__main__", "liganimate.api", "liganimate.exchange_cli", "liganimate.view_cli")
+ABOVE = (
+    "liganimate.cli",
+    "liganimate.__main__",
+    "liganimate.api",
+    "liganimate.exchange_cli",
+    "liganimate.view_cli",
+    "liganimate.fmt_cli",
+    "liganimate.lsp",
+    "liganimate.highlighting",
+)
 
 #: Package -> the modules (and packages, with everything in them) it may import, besides itself
 #: and ``liganimate`` (the version). The most specific package of a module applies.
@@ -57,10 +66,18 @@ CONTRACT = {
         "liganimate.runtime.figure",
         "liganimate.runtime.motion",
     ),
-    # The host and the other top-level modules, and the tools built on them
-    # (exchange/, view/, studio/): anything of the package but the command line.
-    "liganimate.runtime": ("liganimate.lang", "liganimate.compiler", "liganimate.runtime"),
+    # The runtime core: the host and the other top-level modules. Never the compiler: a
+    # compiled module runs without it (TOOLS below are the layer that compiles).
+    "liganimate.runtime": ("liganimate.lang", "liganimate.runtime"),
+    # The tools that compile and run programs, a layer above the runtime core.
+    "liganimate.runtime.exchange": ("liganimate.lang", "liganimate.compiler", "liganimate.runtime"),
+    "liganimate.runtime.view": ("liganimate.lang", "liganimate.compiler", "liganimate.runtime"),
+    "liganimate.runtime.studio": ("liganimate.lang", "liganimate.compiler", "liganimate.runtime"),
 }
+
+
+#: The tools' layer: nothing of the runtime core below it imports these.
+TOOLS = ("liganimate.runtime.exchange", "liganimate.runtime.view", "liganimate.runtime.studio")
 
 
 def _modules():
@@ -101,17 +118,35 @@ def _rule(name: str) -> str:
     return max((p for p in CONTRACT if name == p or name.startswith(p + ".")), key=len)
 
 
+def _is_under(name: str, packages) -> bool:
+    return any(name == p or name.startswith(p + ".") for p in packages)
+
+
 def _allowed(name: str, imported: str) -> bool:
     rule = _rule(name)
-    if imported == "liganimate" or imported == rule or imported.startswith(rule + "."):
+    if rule not in TOOLS and _is_under(imported, TOOLS):
+        return False  # the runtime core never reaches up to the tools built on it
+    if imported == "liganimate" or _is_under(imported, (rule,)):
         return True
-    return any(imported == a or imported.startswith(a + ".") for a in CONTRACT[rule])
+    return _is_under(imported, CONTRACT[rule])
 
 
 @pytest.mark.parametrize("name", sorted(MODULES))
 def test_module_imports_only_what_its_package_may(name):
     wrong = sorted(m for m in imports_of(name) if not _allowed(name, m) or m.startswith(ABOVE))
     assert not wrong, f"{name} imports {', '.join(wrong)}, which {_rule(name)} may not (docs/architecture.md)"
+
+
+def _reported(tmp_path, monkeypatch, name: str, text: str) -> list:
+    """What the contract test says of a module ``name`` with this text (a file that is not in the tree)."""
+    fake = tmp_path / (name.rsplit(".", 1)[-1] + ".py")
+    fake.write_text(text)
+    monkeypatch.setitem(MODULES, name, (False, fake))
+    try:
+        test_module_imports_only_what_its_package_may(name)
+    except AssertionError as exc:
+        return [str(exc)]
+    return []
 
 
 def test_the_contract_catches_a_wrong_import(tmp_path, monkeypatch):
@@ -123,6 +158,32 @@ def test_the_contract_catches_a_wrong_import(tmp_path, monkeypatch):
     assert found == {"liganimate.runtime.figure.tree", "liganimate.cli"}
     assert not _allowed("liganimate.runtime.motion.bad", "liganimate.runtime.figure.tree")
     assert not _allowed("liganimate.runtime.host", "liganimate.cli")
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "from liganimate.compiler import check\n",
+        "def later():\n    from liganimate.compiler.names import reserved\n",
+        "from liganimate.runtime.exchange import collect\n",
+        "from .view import iframe\n",
+    ],
+)
+def test_the_runtime_core_may_not_import_the_compiler_or_the_tools(tmp_path, monkeypatch, text):
+    # A module beside runtime/host.py, in the core's package: each of these imports is reported.
+    (report,) = _reported(tmp_path, monkeypatch, "liganimate.runtime.extra", text)
+    assert (
+        report.startswith("liganimate.runtime.extra imports liganimate.")
+        and "which liganimate.runtime may not" in report
+    )
+
+
+def test_the_tools_may_compile(tmp_path, monkeypatch):
+    text = "from liganimate.compiler import check\nfrom liganimate.runtime.host import Program\n"
+    for tool in TOOLS:
+        assert _reported(tmp_path, monkeypatch, f"{tool}.extra", text) == []
+    (report,) = _reported(tmp_path, monkeypatch, "liganimate.runtime.view.extra", "import liganimate.view_cli\n")
+    assert "imports liganimate.view_cli" in report
 
 
 def test_no_module_below_the_command_line_imports_it():

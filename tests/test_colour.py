@@ -42,10 +42,11 @@ def _errors(text: str) -> list[str]:
     return [format_diagnostic(d) for d in info.value.diagnostics]
 
 
-def _render(tmp_path: pathlib.Path, body: str, what: str, name: str) -> np.ndarray:
+def _render(tmp_path: pathlib.Path, body: str, what: str, name: str, look: str = "thesis") -> np.ndarray:
+    # The thesis look draws each face in exactly the shade LIGHTNESS and COLOUR give.
     program, _ = load_program(None, text=HEAD + body + SCENE.format(what=what), name=f"{name}.lig")
     out = tmp_path / name
-    program.render(str(out), size=(160, 120), quiet=True, workers=1)
+    program.render(str(out), size=(160, 120), quiet=True, workers=1, look=look)
     return np.asarray(Image.open(out / "scene1" / "00000.png"))
 
 
@@ -64,9 +65,10 @@ def test_a_program_without_colour_still_draws_grey(tmp_path):
     assert image.ndim == 2
 
 
-def test_white_is_grey(tmp_path):
-    grey = _render(tmp_path, "", "RED + GREY", "plain")
-    white = _render(tmp_path, "      RED :- RED <COLOUR (100, 100, 100)>\n", "RED + GREY", "white")
+@pytest.mark.parametrize("look", ["thesis", "modern"])
+def test_white_is_grey(tmp_path, look):
+    grey = _render(tmp_path, "", "RED + GREY", "plain", look)
+    white = _render(tmp_path, "      RED :- RED <COLOUR (100, 100, 100)>\n", "RED + GREY", "white", look)
     assert white.ndim == 3
     for c in range(3):
         assert np.array_equal(white[:, :, c], grey)

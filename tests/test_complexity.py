@@ -28,10 +28,6 @@ MAX_COMPLEXITY = 25
 
 #: (file, qualified function name) -> who splits it. Only ever remove entries.
 ALLOWED: dict[tuple[str, str], str] = {
-    ("runtime/exchange/_bvh_read.py", "parse_bvh"): "retarget",
-    ("runtime/exchange/_bvh_write.py", "bvh_text"): "retarget",
-    ("runtime/exchange/_lig_write.py", "lig_library"): "retarget",
-    ("runtime/figure/tree.py", "assemble"): "robots",
     ("runtime/studio/_library.py", "library_text"): "look",
     ("runtime/ik/goals.py", "GoalStack.__init__"): "arch-options",
     ("runtime/ik/goals.py", "GoalStack.evaluate"): "arch-options",

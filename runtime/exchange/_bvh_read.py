@@ -164,35 +164,82 @@ class _Tokens:
 def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
     """Parse BVH text (see :func:`read_bvh`)."""
     tk = _Tokens(text, filename)
-    first = tk.peek()
-    if first is None:
+    if tk.peek() is None:
         tk.fail(Pos(1, 1, 1, 1), "the file is empty, not a BVH file", "a BVH file starts with HIERARCHY")
     tok, pos = tk.next("HIERARCHY")
     if tok != "HIERARCHY":
-        tk.fail(pos, f"a BVH file starts with HIERARCHY, not '{tok}'")
+        tk.fail(pos, f"a BVH file starts with HIERARCHY, not '{tok}'", "this does not look like a BVH file")
     tok, pos = tk.next("ROOT")
     if tok != "ROOT":
         tk.fail(pos, f"expected ROOT, the hierarchy's first joint, found '{tok}'")
+    h = _Hierarchy(tk)
+    h.joint(-1, pos)
+    n_frames, frame_time = _motion_header(tk)
+    counts = np.array([len(c) for c in h.channels], dtype=np.int64)
+    first_col = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    data = _frames(tk, tk.line, n_frames, int(counts.sum()))
+    return BvhClip(
+        filename=filename,
+        source=text,
+        names=h.names,
+        parents=np.array(h.parents, dtype=np.int64),
+        offsets=np.array(h.offsets, dtype=np.float64).reshape(-1, 3),
+        channels=h.channels,
+        first=first_col,
+        end_sites=h.end_sites,
+        channel_pos=h.channel_pos,
+        frame_time=frame_time,
+        data=data,
+    )
 
-    names, parents, offsets, channels, channel_pos = [], [], [], [], []
-    end_sites: list[np.ndarray | None] = []
 
-    def joint(parent: int, keyword_pos: Pos) -> None:
+class _Hierarchy:
+    """The joints of a HIERARCHY section, read recursively from the tokens."""
+
+    def __init__(self, tk: _Tokens):
+        self.tk = tk
+        self.names: list = []
+        self.parents: list = []
+        self.offsets: list = []
+        self.channels: list = []
+        self.channel_pos: list = []
+        self.end_sites: list[np.ndarray | None] = []
+
+    def joint(self, parent: int, keyword_pos: Pos) -> None:
+        """One ROOT or JOINT, its keyword just read, to its closing brace."""
+        tk = self.tk
         rest = tk.rest_of_line()
         if not rest:
             tk.fail(keyword_pos, "this joint has no name", "write ROOT name or JOINT name")
-        names.append(" ".join(t for t, _ in rest))
-        me = len(names) - 1
-        parents.append(parent)
-        tk.expect("{", f"to open joint {names[me]}")
-        tok, pos = tk.next(f"OFFSET of joint {names[me]}")
+        self.names.append(" ".join(t for t, _ in rest))
+        me = len(self.names) - 1
+        name = self.names[me]
+        self.parents.append(parent)
+        tk.expect("{", f"to open joint {name}")
+        tok, pos = tk.next(f"OFFSET of joint {name}")
         if tok != "OFFSET":
-            tk.fail(pos, f"expected OFFSET in joint {names[me]}, found '{tok}'")
-        offsets.append([tk.number(f"the {a} offset of joint {names[me]}") for a in "XYZ"])
-        end_sites.append(None)
-        tok, pos = tk.next(f"CHANNELS of joint {names[me]}")
+            tk.fail(pos, f"expected OFFSET in joint {name}, found '{tok}'")
+        self.offsets.append([tk.number(f"the {a} offset of joint {name}") for a in "XYZ"])
+        self.end_sites.append(None)
+        self._channels(name)
+        while True:
+            tok, pos = tk.next(f"'}}' to close joint {name}")
+            if tok == "JOINT":
+                self.joint(me, pos)
+            elif tok == "End":
+                self._end_site(me)
+            elif tok == "}":
+                return
+            elif tok in ("MOTION", "ROOT"):
+                tk.fail(pos, f"joint {name} is never closed with '}}' before {tok}")
+            else:
+                tk.fail(pos, f"expected JOINT, End Site or '}}' in joint {name}, found '{tok}'")
+
+    def _channels(self, name: str) -> None:
+        tk = self.tk
+        tok, pos = tk.next(f"CHANNELS of joint {name}")
         if tok != "CHANNELS":
-            tk.fail(pos, f"expected CHANNELS in joint {names[me]}, found '{tok}'")
+            tk.fail(pos, f"expected CHANNELS in joint {name}, found '{tok}'")
         count_tok, count_pos = tk.next("the number of channels")
         try:
             count = int(count_tok)
@@ -205,39 +252,31 @@ def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
                 f"CHANNELS says {count_tok} but the line lists {len(listed)} channels",
                 "list the channel names on the CHANNELS line itself",
             )
-        seen = []
-        for name, npos in listed:
-            canonical = _CHANNEL_KEYS.get(name.lower())
+        seen: list = []
+        for channel, npos in listed:
+            canonical = _CHANNEL_KEYS.get(channel.lower())
             if canonical is None:
-                tk.fail(npos, f"'{name}' is not a BVH channel", "the channels are " + ", ".join(CHANNEL_NAMES))
+                tk.fail(npos, f"'{channel}' is not a BVH channel", "the channels are " + ", ".join(CHANNEL_NAMES))
             if canonical in seen:
-                tk.fail(npos, f"joint {names[me]} lists channel {canonical} twice")
+                tk.fail(npos, f"joint {name} lists channel {canonical} twice")
             seen.append(canonical)
-        channels.append(tuple(seen))
-        channel_pos.append(count_pos)
-        while True:
-            tok, pos = tk.next(f"'}}' to close joint {names[me]}")
-            if tok == "JOINT":
-                joint(me, pos)
-            elif tok == "End":
-                site, spos = tk.next("'Site'")
-                if site != "Site":
-                    tk.fail(spos, f"expected 'End Site', found 'End {site}'")
-                tk.expect("{", "to open the End Site")
-                opos = tk.expect("OFFSET", "in the End Site")
-                end_sites[me] = np.array([tk.number(f"the {a} offset of an End Site") for a in "XYZ"])
-                del opos
-                tk.expect("}", "to close the End Site")
-            elif tok == "}":
-                return
-            elif tok in ("MOTION", "ROOT"):
-                tk.fail(pos, f"joint {names[me]} is never closed with '}}' before {tok}")
-            else:
-                tk.fail(pos, f"expected JOINT, End Site or '}}' in joint {names[me]}, found '{tok}'")
+        self.channels.append(tuple(seen))
+        self.channel_pos.append(count_pos)
 
-    joint(-1, pos)
-    after = tk.peek()
-    if after is None:
+    def _end_site(self, me: int) -> None:
+        tk = self.tk
+        site, spos = tk.next("'Site'")
+        if site != "Site":
+            tk.fail(spos, f"expected 'End Site', found 'End {site}'")
+        tk.expect("{", "to open the End Site")
+        tk.expect("OFFSET", "in the End Site")
+        self.end_sites[me] = np.array([tk.number(f"the {a} offset of an End Site") for a in "XYZ"])
+        tk.expect("}", "to close the End Site")
+
+
+def _motion_header(tk: _Tokens) -> tuple:
+    """``MOTION``, ``Frames: N`` and ``Frame Time: t`` after the hierarchy: (N, t)."""
+    if tk.peek() is None:
         tk.fail(
             tk.end_pos(),
             "the file has no MOTION section",
@@ -271,23 +310,7 @@ def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
     if tk.pending:
         extra, epos = tk.pending[0]
         tk.fail(epos, f"unexpected '{extra}' after the frame time", "the frame values start on the next line")
-
-    counts = np.array([len(c) for c in channels], dtype=np.int64)
-    first_col = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    data = _frames(tk, tk.line, n_frames, int(counts.sum()))
-    return BvhClip(
-        filename=filename,
-        source=text,
-        names=names,
-        parents=np.array(parents, dtype=np.int64),
-        offsets=np.array(offsets, dtype=np.float64).reshape(-1, 3),
-        channels=channels,
-        first=first_col,
-        end_sites=end_sites,
-        channel_pos=channel_pos,
-        frame_time=frame_time,
-        data=data,
-    )
+    return n_frames, frame_time
 
 
 def _frames(tk: _Tokens, start: int, n_frames: int, n_channels: int) -> np.ndarray:

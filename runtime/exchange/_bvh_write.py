@@ -12,35 +12,49 @@ listed, so that is ``Rz Ry Rx``, the joint convention itself, with the very
 angles drawn.  A joint walked backwards (FIGURE ... MAIN) turns by the
 inverse, ``Rx(-ax) Ry(-ay) Rz(-az)``, written as ``Xrotation Yrotation
 Zrotation`` with negated angles: exact again, no conversion.
+
+A figure that came from a BVH file (its links carry a
+:class:`~liganimate.runtime.figure.tree.LinkSource`, from the library's name
+table) is written back as it came: each link under its source name with its
+source channels (rotations converted to that order exactly, constant
+position channels holding the offset), its End Site, and without the
+importer's empty ``ORIGIN``: the source's ROOT is the ROOT again.
 """
 
 from __future__ import annotations
 
 import os
 import re
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
 from liganimate.runtime.values import Graphical
 
 from ._numbers import format_rows
-from ._rotations import decompose_trs, euler_zyx_from_matrix
+from ._rotations import decompose_trs, euler_from_matrix
 
 __all__ = ["bvh_files", "bvh_text"]
 
 # Enough digits that angles survive a round trip to well within 1e-6 degrees.
 DECIMALS = 8
+_ROTATIONS = ("Xrotation", "Yrotation", "Zrotation")
+_POSITIONS = ("Xposition", "Yposition", "Zposition")
 
 
 def _joint_names(fig) -> list:
-    """A BVH name per link: its own name where unique, else with its joint id; unnamed links by joint."""
+    """A BVH name per link: its source name, else its own name where unique, else with its joint id."""
     counts: dict = {}
     for l in fig.links:
         if l.name is not None:
             counts[l.name.upper()] = counts.get(l.name.upper(), 0) + 1
     names = []
     for i, l in enumerate(fig.links):
+        if l.source is not None:
+            names.append(l.source.name)
+            continue
         up = fig.parent_joint_of(i)
         if l.name is None or l.name.startswith("<"):
             base = "SEGMENT"
@@ -62,6 +76,172 @@ def _end_site(fig, i: int, far: np.ndarray) -> np.ndarray:
     return 2.0 * (centre - far)
 
 
+@dataclass
+class _Node:
+    """One BVH joint: the link it is, its parent node, OFFSET, channels and how each gets its values."""
+
+    link: int
+    parent: int  # index into the node list; -1 for the ROOT
+    offset: np.ndarray
+    channels: tuple
+    joint: int | None = None  # index of the figure joint that turns it (None: the ROOT's placement)
+    reversed: bool = False
+    end: np.ndarray | None = None
+    children: list = field(default_factory=list)
+
+
+def _placement_factor(model, scene_id):
+    """The model's constant uniform placement scale, refusing anything a rigid skeleton cannot carry."""
+    t, R, s, ok = decompose_trs(model.placements)
+    factor = s[0, 0]
+    if not ok.all() or not np.allclose(s, factor, rtol=1e-12, atol=0) or factor <= 0:
+        where = f" in scene {scene_id}" if scene_id is not None else ""
+        raise LigError(
+            f"model {model.name}{where} is scaled, mirrored or sheared by its placement, which a BVH skeleton "
+            "cannot carry.",
+            "export to glTF, which can, or scale the model with <SCALE MODEL r> instead of <SCALE r>",
+        )
+    return float(factor)
+
+
+def _edges(fig, factor: float) -> tuple:
+    """Children of each link as walked from the main link, and (joint, near, far, reversed) of each non-main link."""
+    loc1, loc2 = fig.locations
+    children: dict = {i: [] for i in range(fig.n_links)}
+    edge_of: dict = {}
+    for level in fig.traversal:
+        for k, p, c, r in zip(level.joints, level.parents, level.children, level.reversed):
+            children[int(p)].append(int(c))
+            near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
+            edge_of[int(c)] = (int(k), near * factor, far * factor, bool(r))
+    return children, edge_of
+
+
+def _folds_origin(fig, children: dict, edge_of: dict) -> bool:
+    """Whether the main link is the importer's empty ORIGIN, which the source did not have."""
+    main = fig.main
+    if fig.links[main].source is not None or not any(l.source is not None for l in fig.links):
+        return False
+    kids = children[main]
+    if len(kids) != 1 or fig.links[kids[0]].source is None or edge_of[kids[0]][3]:
+        return False
+    shape = fig.links[main].shape
+    return not (isinstance(shape, Graphical) and len(shape) > 0)
+
+
+def _own_channels(source, is_root: bool, rev: bool) -> tuple:
+    """A node's channels: the source's, where they can be written exactly, else the joint convention's."""
+    if source is not None and source.channels:
+        rot = [c for c in source.channels if c in _ROTATIONS]
+        pos = [c for c in source.channels if c in _POSITIONS]
+        if (len(rot) == 3 or _zyx_subsequence(rot)) and (not is_root or len(pos) == 3):
+            return tuple(source.channels)
+    if is_root:
+        return _POSITIONS + ("Zrotation", "Yrotation", "Xrotation")
+    return ("Xrotation", "Yrotation", "Zrotation") if rev else ("Zrotation", "Yrotation", "Xrotation")
+
+
+def _zyx_subsequence(rot: list) -> bool:
+    it = iter("ZYX")
+    return bool(rot) and all(c[0] in it for c in rot)
+
+
+def _skeleton(fig, factor: float) -> list:
+    """The BVH joints of a figure, depth first from its ROOT."""
+    children, edge_of = _edges(fig, factor)
+    fold = _folds_origin(fig, children, edge_of)
+    root = children[fig.main][0] if fold else fig.main
+    nodes: list = []
+
+    def visit(i: int, parent: int, far_parent: np.ndarray) -> None:
+        link = fig.links[i]
+        if parent < 0:
+            k, rev = (edge_of[i][0], False) if fold else (None, False)
+            offset, far = np.zeros(3), (edge_of[i][2] if fold else np.zeros(3))
+        else:
+            k, near, far, rev = edge_of[i]
+            offset = near - far_parent
+        node = _Node(i, parent, offset, _own_channels(link.source, parent < 0, rev), k, rev)
+        me = len(nodes)
+        nodes.append(node)
+        if parent >= 0:
+            nodes[parent].children.append(me)
+        for c in children[i]:
+            visit(c, me, far)
+        if not children[i]:
+            if link.source is not None and link.source.end is not None:
+                node.end = np.asarray(link.source.end, dtype=np.float64) * factor
+            else:
+                node.end = _end_site(fig, i, far / factor) * factor
+
+    visit(root, -1, np.zeros(3))
+    return nodes
+
+
+def _hierarchy(nodes: list, names: list) -> list:
+    """The HIERARCHY section's lines."""
+    lines = ["HIERARCHY"]
+
+    def visit(n: int, depth: int) -> None:
+        node = nodes[n]
+        pad = "  " * depth
+        lines.append(f"{pad}{'ROOT' if node.parent < 0 else 'JOINT'} {names[node.link]}")
+        lines.append(f"{pad}{{")
+        lines.append(f"{pad}  OFFSET {_num(node.offset[0])} {_num(node.offset[1])} {_num(node.offset[2])}")
+        lines.append(f"{pad}  CHANNELS {len(node.channels)} {' '.join(node.channels)}")
+        for c in node.children:
+            visit(c, depth + 1)
+        if node.end is not None:
+            e = node.end
+            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET {_num(e[0])} {_num(e[1])} {_num(e[2])}"])
+            lines.append(f"{pad}  }}")
+        lines.append(f"{pad}}}")
+
+    visit(0, 0)
+    return lines
+
+
+def _node_frames(model, node: _Node, factor: float, fig) -> tuple:
+    """(position (T, 3), rotation (T, 3, 3)) of a node relative to its parent node, per tick."""
+    T = len(model.ticks)
+    if node.parent >= 0:
+        a = model.angles[:, node.joint]
+        if node.reversed:
+            return np.broadcast_to(node.offset, (T, 3)), np.swapaxes(matrix_from_euler_zyx(a), -1, -2)
+        return np.broadcast_to(node.offset, (T, 3)), matrix_from_euler_zyx(a)
+    t, R, _, _ = decompose_trs(model.placements)
+    if node.joint is None:
+        return t, R
+    # The folded ORIGIN: placement, then the joint at its location on ORIGIN.
+    loc1, loc2 = fig.locations
+    Rj = matrix_from_euler_zyx(model.angles[:, node.joint])
+    pos = (
+        t
+        + np.einsum("tij,j->ti", R, loc1[node.joint] * factor)
+        - np.einsum("tij,j->ti", R @ Rj, loc2[node.joint] * factor)
+    )
+    return pos, R @ Rj
+
+
+def _node_columns(model, node: _Node, factor: float, fig) -> np.ndarray:
+    """The node's channel values, (T, len(channels)), in its channels' order."""
+    pos, R = _node_frames(model, node, factor, fig)
+    rot = [c[0] for c in node.channels if c in _ROTATIONS]
+    if node.parent >= 0 and node.joint is not None and not node.reversed and rot and _zyx_subsequence(rot):
+        # The joint convention's own axes: the very angles drawn, no conversion.
+        a = model.angles[:, node.joint]
+        angles = {axis: a[:, "XYZ".index(axis)] for axis in rot}
+    elif node.parent >= 0 and node.reversed and "".join(rot) == "XYZ":
+        a = -model.angles[:, node.joint]
+        angles = {axis: a[:, "XYZ".index(axis)] for axis in rot}
+    else:
+        order = "".join(rot) if len(rot) == 3 else "ZYX"
+        e = np.unwrap(euler_from_matrix(order, R), period=360.0, axis=0)
+        angles = {axis: e[:, n] for n, axis in enumerate(order)}
+    cols = [pos[:, "XYZ".index(c[0])] if c in _POSITIONS else angles[c[0]] for c in node.channels]
+    return np.column_stack(cols) if cols else np.zeros((len(model.ticks), 0))
+
+
 def bvh_text(model, fps: float, scene_id=None) -> bytes:
     """The BVH file of one drawn model.
 
@@ -71,6 +251,8 @@ def bvh_text(model, fps: float, scene_id=None) -> bytes:
         Frames are the ticks at which the model is drawn.
     fps : float
         Frames per second (the file's ``Frame Time`` is ``1 / fps``).
+    scene_id : int, optional
+        For messages.
 
     Returns
     -------
@@ -84,79 +266,14 @@ def bvh_text(model, fps: float, scene_id=None) -> bytes:
         mirrors it: BVH skeletons are rigid.
     """
     fig = model.figure
-    t, R, s, ok = decompose_trs(model.placements)
-    factor = s[0, 0]
-    if not ok.all() or not np.allclose(s, factor, rtol=1e-12, atol=0) or factor <= 0:
-        where = f" in scene {scene_id}" if scene_id is not None else ""
-        raise LigError(
-            f"model {model.name}{where} is scaled, mirrored or sheared by its placement, which a BVH skeleton "
-            "cannot carry.",
-            "export to glTF, which can, or scale the model with <SCALE MODEL r> instead of <SCALE r>",
-        )
-    loc1, loc2 = fig.locations
-    names = _joint_names(fig)
-    children: dict = {i: [] for i in range(fig.n_links)}
-    edge_of: dict = {}
-    for level in fig.traversal:
-        for k, p, c, r in zip(level.joints, level.parents, level.children, level.reversed):
-            children[int(p)].append(int(c))
-            near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
-            edge_of[int(c)] = (int(k), near * factor, far * factor, bool(r))
-
-    lines = ["HIERARCHY"]
-    # Each channel, in the file's order, as (column, sign) of the (T, C) table
-    # [position (3), root angles (3), joint angles (3 per joint)] built below.
-    columns: list[tuple[int, float]] = []
-
-    def visit(i: int, depth: int) -> None:
-        pad = "  " * depth
-        if i == fig.main:
-            lines.append(f"ROOT {names[i]}")
-            lines.append("{")
-            lines.append("  OFFSET 0.0 0.0 0.0")
-            lines.append("  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation")
-            columns.extend([(0, 1.0), (1, 1.0), (2, 1.0), (3 + 2, 1.0), (3 + 1, 1.0), (3 + 0, 1.0)])
-            far_here = np.zeros(3)
-        else:
-            k, near, far, rev = edge_of[i]
-            parent_far = np.zeros(3) if edge_of.get(_parent[i]) is None else edge_of[_parent[i]][2]
-            off = near - parent_far
-            lines.append(f"{pad}JOINT {names[i]}")
-            lines.append(f"{pad}{{")
-            lines.append(f"{pad}  OFFSET {_num(off[0])} {_num(off[1])} {_num(off[2])}")
-            if rev:
-                lines.append(f"{pad}  CHANNELS 3 Xrotation Yrotation Zrotation")
-                columns.extend([(6 + 3 * k + axis, -1.0) for axis in (0, 1, 2)])
-            else:
-                lines.append(f"{pad}  CHANNELS 3 Zrotation Yrotation Xrotation")
-                columns.extend([(6 + 3 * k + axis, 1.0) for axis in (2, 1, 0)])
-            far_here = far
-        if children[i]:
-            for c in children[i]:
-                visit(c, depth + 1)
-        else:
-            tip = _end_site(fig, i, far_here / factor) * factor
-            lines.append(f"{pad}  End Site")
-            lines.append(f"{pad}  {{")
-            lines.append(f"{pad}    OFFSET {_num(tip[0])} {_num(tip[1])} {_num(tip[2])}")
-            lines.append(f"{pad}  }}")
-        lines.append(f"{pad}}}")
-
-    _parent = {c: p for p, cs in children.items() for c in cs}
-    visit(fig.main, 0)
+    factor = _placement_factor(model, scene_id)
+    nodes = _skeleton(fig, factor)
+    lines = _hierarchy(nodes, _joint_names(fig))
     T = len(model.ticks)
     lines += ["MOTION", f"Frames: {T}", f"Frame Time: {_num(1.0 / fps)}"]
-    # Every channel is one column of a (T, C) table gathered with indices.
-    root = euler_zyx_from_matrix(R)  # (T, 3)
-    angles = model.angles.reshape(T, -1)
-    table = np.concatenate([t, root, angles], axis=1)
-    J3 = angles.shape[1]
-    idx = np.array([c for c, _ in columns], dtype=np.int64)
-    sign = np.array([sg for _, sg in columns], dtype=np.float64)
-    assert table.shape[1] == 6 + J3
-    data = table[:, idx] * sign
+    data = np.concatenate([_node_columns(model, n, factor, fig) for n in nodes], axis=1)
     data += 0.0  # no -0.0
-    head = ("\n".join(lines) + "\n").encode("ascii")
+    head = ("\n".join(lines) + "\n").encode("utf-8")
     return head + format_rows(data, DECIMALS)
 
 

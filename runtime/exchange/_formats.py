@@ -144,6 +144,14 @@ def _size(value: Any) -> tuple[int, int]:
     return w, h
 
 
+def _rig(value: Any) -> str:
+    # The names are repeated from _gltf.RIGS, which this light module cannot import.
+    rig = str(value).lower() if isinstance(value, str) else value
+    if rig not in ("skin", "nodes"):
+        raise ValueError(f"{value!r} is not a glTF rig; the rigs are skin and nodes")
+    return rig
+
+
 #: The options of the export formats, by name.
 EXPORT_OPTIONS: dict[str, ExportOption] = {
     o.name: o
@@ -151,6 +159,13 @@ EXPORT_OPTIONS: dict[str, ExportOption] = {
         ExportOption("fps", 24.0, _fps, "ticks per second of the time axis (default 24)", "N"),
         ExportOption(
             "size", (640, 480), _size, "image size whose aspect ratio the glTF cameras take (default 640x480)", "WxH"
+        ),
+        ExportOption(
+            "rig",
+            "skin",
+            _rig,
+            "skin: per model a skeleton and one skinned mesh (default); nodes: a tree of rigid segment nodes",
+            "skin|nodes",
         ),
     )
 }
@@ -160,17 +175,17 @@ EXPORT_OPTIONS: dict[str, ExportOption] = {
 # the command line, which must not load numpy or pygltflib for --help.
 
 
-def _write_glb(scenes: Sequence[SceneTake], path: str, *, fps: float, size: tuple[int, int]) -> Export:
+def _write_glb(scenes: Sequence[SceneTake], path: str, *, fps: float, size: tuple[int, int], rig: str) -> Export:
     from ._gltf import gltf_bytes
 
-    data, warnings = gltf_bytes(scenes, True, fps=fps, size=size)
+    data, warnings = gltf_bytes(scenes, True, fps=fps, size=size, rig=rig)
     return Export(((path, data),), tuple(warnings))
 
 
-def _write_gltf(scenes: Sequence[SceneTake], path: str, *, fps: float, size: tuple[int, int]) -> Export:
+def _write_gltf(scenes: Sequence[SceneTake], path: str, *, fps: float, size: tuple[int, int], rig: str) -> Export:
     from ._gltf import gltf_bytes
 
-    data, warnings = gltf_bytes(scenes, False, fps=fps, size=size)
+    data, warnings = gltf_bytes(scenes, False, fps=fps, size=size, rig=rig)
     return Export(((path, data),), tuple(warnings))
 
 
@@ -183,10 +198,18 @@ def _write_bvh(scenes: Sequence[SceneTake], path: str, *, fps: float) -> Export:
 #: Every export format, in the order the documentation lists them.
 EXPORT_FORMATS: tuple[ExportFormat, ...] = (
     ExportFormat(
-        "glb", (".glb",), "glTF 2.0, binary: every drawn model, one animation per scene", ("fps", "size"), _write_glb
+        "glb",
+        (".glb",),
+        "glTF 2.0, binary: every drawn model, one animation per scene",
+        ("fps", "size", "rig"),
+        _write_glb,
     ),
     ExportFormat(
-        "gltf", (".gltf",), "glTF 2.0, JSON with the buffer embedded: the same as .glb", ("fps", "size"), _write_gltf
+        "gltf",
+        (".gltf",),
+        "glTF 2.0, JSON with the buffer embedded: the same as .glb",
+        ("fps", "size", "rig"),
+        _write_gltf,
     ),
     ExportFormat("bvh", (".bvh",), "BVH (Biovision hierarchy): one file per drawn model", ("fps",), _write_bvh),
 )

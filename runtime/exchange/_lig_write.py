@@ -26,17 +26,28 @@ from __future__ import annotations
 import math
 import os
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
 from liganimate.compiler.names import reserved
+from liganimate.lang import name_table
 from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
+from ._clip import clip_pose, clip_size
 from ._numbers import format_rows
-from ._rotations import euler_zyx_from_matrix, matrix_from_axes
 
-__all__ = ["clip_angles", "lig_library", "read_root_path", "reduce_keyframes"]
+__all__ = [
+    "ImportOptions",
+    "clip_angles",
+    "comment_text",
+    "import_library",
+    "lig_library",
+    "motion_library",
+    "read_root_path",
+    "reduce_keyframes",
+]
 
 DECIMALS = 7
 # Keywords and built-ins (compiler/names.py, read from the grammar), and the
@@ -59,78 +70,14 @@ def _identifier(name: str, taken: set) -> str:
     return candidate
 
 
-def _subsequence(order: str, of: str = "ZYX") -> bool:
-    it = iter(of)
-    return all(ch in it for ch in order)
-
-
-def clip_angles(clip):
+def clip_angles(clip, joint_translation: str = "error"):
     """The joint convention's angles, the root path and the rest offsets of a BVH clip.
 
-    Returns
-    -------
-    angles : ndarray, shape (F, J, 3)
-        ``(ax, ay, az)`` per frame and BVH joint, ``R = Rz Ry Rx`` equal to
-        the product of the joint's rotation channels in file order; each
-        axis unwrapped along the frames (no jumps of 360).
-    rotating : ndarray of bool, shape (J,)
-        Joints with rotation channels.
-    path : ndarray, shape (F, 3)
-        The ROOT's position: its position channels, or its OFFSET for the
-        components it has no channel for.
-    offsets : ndarray, shape (J, 3)
-        Each joint's offset from its parent; for joints with constant
-        position channels, those values.
-
-    Raises
-    ------
-    LigDiagnostics
-        When a joint other than the ROOT moves along position channels: a
-        LIG joint only turns.
+    ``(angles, rotating, path, offsets)`` of :func:`._clip.clip_pose`, which
+    documents them and what it raises.
     """
-    F = clip.data.shape[0]
-    J = len(clip.names)
-    angles = np.zeros((F, J, 3))
-    rotating = np.zeros(J, dtype=bool)
-    offsets = clip.offsets.copy()
-    path = np.broadcast_to(clip.offsets[0], (F, 3)).copy()
-    size = _size(clip.parents, clip.offsets)
-    for j in range(J):
-        cols = clip.first[j] + np.arange(len(clip.channels[j]))
-        rot = [(c[0], col) for c, col in zip(clip.channels[j], cols) if c.endswith("rotation")]
-        pos = [("XYZ".index(c[0]), col) for c, col in zip(clip.channels[j], cols) if c.endswith("position")]
-        if rot:
-            rotating[j] = True
-            order = "".join(a for a, _ in rot)
-            values = clip.data[:, [col for _, col in rot]]
-            if _subsequence(order):
-                for (axis, _), n in zip(rot, range(len(rot))):
-                    angles[:, j, "XYZ".index(axis)] = values[:, n]
-            else:
-                angles[:, j] = euler_zyx_from_matrix(matrix_from_axes(order, values))
-        for axis, col in pos:
-            v = clip.data[:, col]
-            if j == 0:
-                path[:, axis] = v
-            elif np.ptp(v) > 1e-9 * size:
-                raise clip.error(
-                    clip.channel_pos[j],
-                    f"joint {clip.names[j]} moves along its {'XYZ'[axis]}position channel, but a LIG joint only turns",
-                    "liganimate imports the ROOT's translation only; fix the other joints' lengths in the capture",
-                )
-            else:
-                offsets[j, axis] = v[0]
-    angles = np.unwrap(angles, period=360.0, axis=0)
-    return angles, rotating, path, offsets
-
-
-def _size(parents, offsets) -> float:
-    """The skeleton's extent at rest (largest coordinate range of its joints), 1 if it has none."""
-    rest = np.zeros_like(offsets)
-    for j in range(1, len(parents)):
-        rest[j] = rest[parents[j]] + offsets[j]
-    ext = float(np.ptp(rest, axis=0).max()) if len(rest) else 0.0
-    return ext if ext > 0 else 1.0
+    pose = clip_pose(clip, joint_translation)
+    return pose.angles, pose.rotating, pose.path, pose.offsets
 
 
 def _num(x: float) -> str:
@@ -151,9 +98,36 @@ def _bone(tip: np.ndarray, width: float) -> str:
     )
 
 
-def _comment_text(text: str) -> str:
+def comment_text(text: str) -> str:
     """Text safe inside a brace comment and on one line."""
     return re.sub(r"[{}\x00-\x1f\x7f]", "?", text)
+
+
+@dataclass(frozen=True)
+class ImportOptions:
+    """How ``liganimate import`` turns a capture into a library.
+
+    Attributes
+    ----------
+    model, motion : str
+        The variable names (valid LIG names, checked by the caller).
+    source_name : str, optional
+        The BVH file's name as the comments mention it.
+    tolerance : float
+        Degrees.  0 keeps a keyframe at every frame; a positive tolerance
+        drops the keyframes that the motion, as LIG plays it, can do without
+        while every angle at every frame stays within ``tolerance`` of the
+        captured one (see :func:`reduce_keyframes`).
+    joint_translation : {"error", "drop"}
+        What to do with joints other than the ROOT that slide
+        (:func:`._clip.clip_pose`).
+    """
+
+    model: str = "CAPTURE"
+    motion: str = "CAPTURED"
+    source_name: str | None = None
+    tolerance: float = 0.0
+    joint_translation: str = "error"
 
 
 def lig_library(
@@ -161,31 +135,48 @@ def lig_library(
 ) -> bytes:
     """The text of a LIG library holding a BVH clip's skeleton as a MODEL and its frames as a MOTION.
 
-    Parameters
-    ----------
-    clip : BvhClip
-    model, motion : str
-        The variable names (valid LIG names, checked by the caller).
-    source_name : str, optional
-        The BVH file's name as the comments mention it.
-    tolerance : float
-        Degrees.  0 (the default) keeps a keyframe at every frame; a
-        positive tolerance drops the keyframes that the motion, as LIG plays
-        it, can do without while every angle at every frame stays within
-        ``tolerance`` of the captured one (see :func:`reduce_keyframes`).
+    The parameters are :class:`ImportOptions`' (see :func:`import_library`,
+    which also returns the notes).
 
     Returns
     -------
     bytes
         UTF-8 text that ``LOAD model, motion FROM 'file.lig'`` takes.
     """
-    angles, rotating, path, offsets = clip_angles(clip)
-    F, J = angles.shape[:2]
-    src = _comment_text(source_name or os.path.basename(clip.filename))
-    taken = {model.upper(), motion.upper()}
+    return import_library(clip, ImportOptions(model, motion, source_name, tolerance))[0]
+
+
+def import_library(clip, options: ImportOptions) -> tuple:
+    """A BVH clip as a library: ``(UTF-8 text, notes)``.
+
+    The model's segments are named after the BVH joints (:func:`_identifier`)
+    and a name table (``lang/name_table.py``) keeps the BVH names and
+    channels, so that export writes them back.
+
+    Raises
+    ------
+    LigDiagnostics
+        From :func:`._clip.clip_pose` (a sliding joint, with ``error``).
+    """
+    pose = clip_pose(clip, options.joint_translation)
+    taken = {options.model.upper(), options.motion.upper()}
     links = [_identifier(n, taken) for n in clip.names]
-    size = _size(clip.parents, offsets)
+    src = comment_text(options.source_name or os.path.basename(clip.filename))
+    parts = [
+        "\n".join(_header(clip, options, links, src)),
+        _model_text(clip, options.model, options.motion, links, pose.offsets),
+        name_table.format_table(options.model, _name_rows(clip, links)),
+    ]
+    head = ("\n".join(parts) + "\n").encode("utf-8")
+    keep = reduce_keyframes(pose.angles, options.tolerance) if options.tolerance > 0 else None
+    return head + _motion_text(options.motion, pose.angles, pose.rotating, keep, pose.path), list(pose.notes)
+
+
+def _header(clip, options: ImportOptions, links: list, src: str) -> list:
+    """The comment lines that open the library: what it holds and the joint table."""
+    F, J = clip.data.shape[0], len(clip.names)
     fps = 1.0 / clip.frame_time
+    model, motion = options.model, options.motion
     out = [
         f"C {model}, {motion}: imported by liganimate from {src}",
         f"C {J} joints, {F} frames at {fps:g} frames per second (frame time {clip.frame_time:g} s).",
@@ -197,25 +188,33 @@ def lig_library(
         "C real time render with --fps matching the capture.",
         "C",
         "C The ROOT's path is the motion's ROOT track: ANIMATE carries the figure along it, in",
-        "C the model's own frame, after the placement (see docs/exchange.md).",
+        "C the model's own frame, after the placement (see docs/exchange.md). The {@names}",
+        "C table after the model keeps the BVH names and channels for export.",
         "C",
         "C   joint  segment            BVH joint (channels)",
     ]
     for j in range(J):
         out.append(
-            f"C   {j + 1:<5}  {links[j]:<18} {_comment_text(clip.names[j])} ({' '.join(clip.channels[j]) or 'none'})"
+            f"C   {j + 1:<5}  {links[j]:<18} {comment_text(clip.names[j])} ({' '.join(clip.channels[j]) or 'none'})"
         )
-    out.append("")
-    out.append(f"{{@ {model}: the skeleton of {src}, {J} joints, every axis free }}")
-    kept = "one keyframe per frame" if tolerance <= 0 else f"keyframes within {tolerance:g} degrees"
-    out.append(f"{{@ {motion}: {F} frames of {src} at {fps:g} frames per second, {kept} }}")
-    out.append("")
-    out.append("      GRAPHICAL ORIGIN")
+    kept = "one keyframe per frame" if options.tolerance <= 0 else f"keyframes within {options.tolerance:g} degrees"
+    out += [
+        "",
+        f"{{@ {model}: the skeleton of {src}, {J} joints, every axis free }}",
+        f"{{@ {motion}: {F} frames of {src} at {fps:g} frames per second, {kept} }}",
+        "",
+    ]
+    return out
+
+
+def _model_text(clip, model: str, motion: str, links: list, offsets: np.ndarray) -> str:
+    """GRAPHICAL, MODEL and MOTION declarations, the segments' bones, and STARTMODEL ... ENDMODEL."""
+    J = len(links)
+    size = clip_size(clip.parents, offsets)
+    out = ["      GRAPHICAL ORIGIN"]
     for k in range(0, J, 6):
         out.append("      GRAPHICAL " + ", ".join(links[k : k + 6]))
-    out.append(f"      MODEL {model}")
-    out.append(f"      MOTION {motion}")
-    out.append("")
+    out += [f"      MODEL {model}", f"      MOTION {motion}", ""]
     children: dict = {j: [] for j in range(J)}
     for j in range(1, J):
         children[int(clip.parents[j])].append(j)
@@ -228,8 +227,7 @@ def lig_library(
             continue
         bones = [_bone(np.asarray(t, dtype=np.float64), 0.06 * float(np.linalg.norm(t)) + 0.01 * size) for t in tips]
         out.append(f"      {links[j]} :- " + " +\n          ".join(bones))
-    out.append("")
-    out.append(f"      STARTMODEL {model}")
+    out += ["", f"      STARTMODEL {model}"]
     free = "(-180.0, 180.0), (-180.0, 180.0), (-180.0, 180.0)"
     for j in range(J):
         parent = "ORIGIN" if j == 0 else links[int(clip.parents[j])]
@@ -238,18 +236,24 @@ def lig_library(
             f"        JOINT {j + 1}, {parent}, ({_num(o[0])}, {_num(o[1])}, {_num(o[2])}), "
             f"{links[j]}, (0.0, 0.0, 0.0), {free}"
         )
-    out.append("      ENDMODEL")
-    out.append("")
-    head = ("\n".join(out) + "\n").encode("utf-8")
-    keep = reduce_keyframes(angles, tolerance) if tolerance > 0 else None
-    return head + _motion_text(motion, angles, rotating, keep, path)
+    out += ["      ENDMODEL", ""]
+    return "\n".join(out)
 
 
-def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None) -> bytes:
+def _name_rows(clip, links: list) -> list:
+    rows = []
+    for j, name in enumerate(clip.names):
+        end = clip.end_sites[j]
+        rows.append((links[j], name, clip.channels[j], None if end is None else tuple(float(x) for x in end)))
+    return rows
+
+
+def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None, ids=None) -> bytes:
     """STARTMOTION ... ENDMOTION: keyframes at every frame (or at ``keep[j]``) for every joint that moves.
 
     ``path`` (F, 3), if given, is the ROOT track: its start position, then a
-    keyframe at every frame if it moves.
+    keyframe at every frame if it moves.  ``ids`` are the joints' identifiers
+    (default 1, 2, ...).
     """
     F, J = angles.shape[:2]
     parts = [f"      STARTMOTION {name}\n".encode("ascii")]
@@ -260,7 +264,8 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
     for j in range(J):
         if not rotating[j] and not moving[j]:
             continue
-        start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {j + 1} POSITION", suffix="\n")
+        jid = j + 1 if ids is None else ids[j]
+        start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {jid} POSITION", suffix="\n")
         parts.append(start)
         if moving[j]:
             rows = np.arange(1, F) if keep is None else keep[j][keep[j] > 0]
@@ -271,6 +276,31 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
             parts.append(_keyframe_rows(frames, path[1:]))
     parts.append(b"      ENDMOTION\n")
     return b"".join(parts)
+
+
+def motion_library(
+    name: str, angles: np.ndarray, ids: list, path: np.ndarray, comments: list, tolerance: float = 0.0
+) -> bytes:
+    """A library holding one MOTION: ``comments`` (lines) first, then its declaration and keyframes.
+
+    Parameters
+    ----------
+    name : str
+    angles : ndarray, shape (F, J, 3)
+        Per frame, the angles of joints ``ids``.
+    ids : list of int
+    path : ndarray, shape (F, 3)
+        The ROOT track.
+    comments : list of str
+        Written as ``C`` lines (made safe for a brace comment).
+    tolerance : float
+        As :class:`ImportOptions`'.
+    """
+    head = [("C " + comment_text(c)).rstrip() for c in comments]
+    head += ["", f"      MOTION {name}", ""]
+    keep = reduce_keyframes(angles, tolerance) if tolerance > 0 else None
+    rotating = np.ones(angles.shape[1], dtype=bool)
+    return ("\n".join(head) + "\n").encode("utf-8") + _motion_text(name, angles, rotating, keep, path, ids)
 
 
 def read_root_path(path: str) -> np.ndarray:

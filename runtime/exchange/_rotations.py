@@ -13,6 +13,7 @@ from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
 __all__ = [
     "continuous_quaternions",
     "decompose_trs",
+    "euler_from_matrix",
     "euler_zyx_from_matrix",
     "matrix_from_axes",
     "matrix_from_euler_zyx",
@@ -84,6 +85,38 @@ def euler_zyx_from_matrix(R) -> np.ndarray:
         ax = np.where(lock, np.arctan2(sign * R[..., 0, 1], R[..., 1, 1]), ax)
         az = np.where(lock, 0.0, az)
     return np.rad2deg(np.stack([ax, ay, az], axis=-1))
+
+
+def euler_from_matrix(order: str, R) -> np.ndarray:
+    """Angles of three distinct axes that compose to ``R`` as BVH channels do: ``R = Ra(a) Rb(b) Rc(c)``.
+
+    Parameters
+    ----------
+    order : str
+        Three distinct axis letters, e.g. ``"ZXY"`` (the first is the
+        outermost factor, as in :func:`matrix_from_axes`).
+    R : array_like, shape (..., 3, 3)
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Degrees, in ``order``'s order: the middle angle in [-90, 90], the
+        others in (-180, 180].  At gimbal lock the last angle is 0.
+    """
+    R = np.asarray(R, dtype=np.float64)
+    i, j, k = ("XYZ".index(a) for a in order)
+    # +1 for a cyclic order (XYZ, YZX, ZXY), -1 for the others.
+    s = 1.0 if (j - i) % 3 == 1 else -1.0
+    c = np.hypot(R[..., i, i], R[..., i, j])
+    b = np.arctan2(s * R[..., i, k], c)
+    a = np.arctan2(-s * R[..., j, k], R[..., k, k])
+    g = np.arctan2(-s * R[..., i, j], R[..., i, i])
+    lock = c < 1e-12
+    if lock.any():
+        # Only a combination of the outer angles is defined: put it all on the first.
+        a = np.where(lock, np.arctan2(s * R[..., k, j], R[..., j, j]), a)
+        g = np.where(lock, 0.0, g)
+    return np.rad2deg(np.stack([a, b, g], axis=-1))
 
 
 def quaternion_from_matrix(R) -> np.ndarray:

@@ -136,8 +136,13 @@ def joint_transforms(figure: Figure, angles) -> np.ndarray:
     """
     a = _check_angles(figure, angles)
     loc1, loc2 = figure.locations
-    R = matrix_from_euler_zyx(a)
-    return transform_from(R, loc1 - np.einsum("...ij,...j->...i", R, loc2))
+    F = figure.frames
+    R = F @ matrix_from_euler_zyx(a) @ np.swapaxes(F, -1, -2)
+    slides = figure.slides
+    R = np.where(slides[:, None, None], np.eye(3), R)
+    shift = np.einsum("jik,...jk->...ji", F, a) * figure.slide_scales[:, None]
+    t = loc1 - np.einsum("...ij,...j->...i", R, loc2) + np.where(slides[:, None], shift, 0.0)
+    return transform_from(R, t)
 
 
 def pose_transforms(figure: Figure, angles) -> np.ndarray:
@@ -214,8 +219,8 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     # by their extremes) have one local transform, computed once.
     flat = angles.reshape(B, -1)
     moving = np.flatnonzero((flat != flat[0]).any(axis=0).reshape(J, 3).any(axis=1))
-    R0, T0 = _local_transforms(figure, np.arange(J), np.deg2rad(angles[:1].transpose(2, 1, 0)))
-    rad = np.deg2rad(angles[:, moving].transpose(2, 1, 0))  # (3, moving, B), contiguous
+    R0, T0 = _local_transforms(figure, np.arange(J), angles[:1].transpose(2, 1, 0))
+    values = np.ascontiguousarray(angles[:, moving].transpose(2, 1, 0))  # (3, moving, B), contiguous
     # Blocks of frames small enough for the intermediates to stay in cache.
     for lo in range(0, B, _BLOCK):
         hi = min(lo + _BLOCK, B)
@@ -224,7 +229,7 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
         R[...] = R0
         T[...] = T0
         if len(moving):
-            R[:, :, moving], T[:, moving] = _local_transforms(figure, moving, rad[:, :, lo:hi])
+            R[:, :, moving], T[:, moving] = _local_transforms(figure, moving, values[:, :, lo:hi])
         _compose(figure, R, T, None if root is None else root[lo:hi], buf[:, :, :, lo:hi])
     return buf.transpose(3, 2, 0, 1)
 
@@ -232,14 +237,15 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
 _BLOCK = 4096
 
 
-def _local_transforms(figure: Figure, joints: np.ndarray, rad: np.ndarray):
+def _local_transforms(figure: Figure, joints: np.ndarray, values: np.ndarray):
     """Rotations (3, 3, k, B) and translations (3, k, B) of some joints, as walked from the main link.
 
-    ``rad`` (3, k, B) holds the joints' angles in radians, axis first.
+    ``values`` (3, k, B) holds the joints' angles in degrees (a slide's
+    displacement), axis first.
     """
-    (cx, cy, cz), (sx, sy, sz) = _cos_sin(rad)
+    (cx, cy, cz), (sx, sy, sz) = _cos_sin(np.deg2rad(values))
     # Entry by entry as in matrix_from_euler_zyx.
-    R = np.empty((3, 3) + rad.shape[1:])
+    R = np.empty((3, 3) + values.shape[1:])
     R[0, 0] = cy * cz
     R[0, 1] = cz * sy * sx - sz * cx
     R[0, 2] = cz * sy * cx + sz * sx
@@ -249,6 +255,16 @@ def _local_transforms(figure: Figure, joints: np.ndarray, rad: np.ndarray):
     np.negative(sy, out=R[2, 0])
     R[2, 1] = cy * sx
     R[2, 2] = cy * cx
+    framed = figure.has_frames[joints]
+    if framed.any():
+        # AXIS: the angles turn about the joint's own axes, F R F^T.
+        F = figure.frames[joints[framed]].transpose(1, 2, 0)[:, :, :, None]  # (3, 3, f, 1)
+        Rf = R[:, :, framed]
+        FR = np.einsum("iafb,abfc->ibfc", F, Rf)
+        R[:, :, framed] = np.einsum("ibfc,jbfd->ijfc", FR, F)
+    slides = figure.slides[joints]
+    if slides.any():
+        R[:, :, slides] = np.eye(3)[:, :, None, None]
     rev = figure.reversed_joints[joints]
     loc1, loc2 = figure.locations
     loc1, loc2 = loc1[joints], loc2[joints]
@@ -258,6 +274,13 @@ def _local_transforms(figure: Figure, joints: np.ndarray, rad: np.ndarray):
     near = np.where(rev[:, None], loc2, loc1).T[:, :, None]  # (3, k, 1)
     far = np.where(rev[:, None], loc1, loc2).T[:, :, None]
     T = near - (R[:, 0] * far[0] + R[:, 1] * far[1] + R[:, 2] * far[2])
+    if slides.any():
+        # A slide moves S by k F d along its axes; walked backwards, P moves by -k F d.
+        k = joints[slides]
+        F = figure.frames[k]  # (s, 3, 3)
+        d = values[:, slides]  # (3, s, B)
+        gain = (figure.slide_scales[k] * np.where(rev[slides], -1.0, 1.0))[:, None]
+        T[:, slides] += np.einsum("sia,asb->isb", F, d) * gain
     return R, T
 
 
@@ -396,8 +419,7 @@ def pose_transforms_reference(figure: Figure, angles) -> np.ndarray:
         def visit(link, X):  # noqa: B023
             placed[link] = X  # noqa: B023
             for k, joint in enumerate(figure.joints):
-                ax, ay, az = frame[k]  # noqa: B023
-                A = _translation(joint.loc1) @ _rz(az) @ _ry(ay) @ _rx(ax) @ _translation(-joint.loc2)
+                A = _reference_joint(joint, frame[k])  # noqa: B023
                 if joint.primary == link and joint.secondary not in placed:  # noqa: B023
                     visit(joint.secondary, X @ A)
                 elif joint.secondary == link and joint.primary not in placed:  # noqa: B023
@@ -407,6 +429,19 @@ def pose_transforms_reference(figure: Figure, angles) -> np.ndarray:
         for link in range(figure.n_links):
             out[idx + (link,)] = placed[link]
     return out
+
+
+def _reference_joint(joint, values) -> np.ndarray:
+    """One joint's secondary-to-primary transform, composed from single-axis matrices."""
+    F = np.eye(4)
+    if joint.axes is not None:
+        F[:3, :3] = joint.axes
+    if joint.slide:
+        move = _translation(joint.slide_scale * (F[:3, :3] @ np.asarray(values, dtype=float)))
+    else:
+        ax, ay, az = values
+        move = F @ _rz(az) @ _ry(ay) @ _rx(ax) @ F.T
+    return _translation(joint.loc1) @ move @ _translation(-joint.loc2)
 
 
 def shape_transforms(figure: Figure, angles) -> np.ndarray:
@@ -438,7 +473,7 @@ def free_axes(figure: Figure) -> dict[int, tuple[bool, bool, bool]]:
         Per joint id, for X, Y and Z.
     """
     ext = figure.extremes
-    free = ext[..., 1] - ext[..., 0] >= 360.0
+    free = (ext[..., 1] - ext[..., 0] >= 360.0) & ~figure.slides[:, None]
     return {jid: (bool(row[0]), bool(row[1]), bool(row[2])) for jid, row in zip(figure.joint_ids, free)}
 
 
@@ -465,7 +500,7 @@ def clamp(figure: Figure, angles, out=None) -> np.ndarray:
     a = _check_angles(figure, angles)
     ext = figure.extremes
     lo, hi = ext[..., 0], ext[..., 1]
-    free = hi - lo >= 360.0
+    free = (hi - lo >= 360.0) & ~figure.slides[:, None]  # a slide never wraps round
     if not free.any():
         return np.clip(a, lo, hi, out=out)
     turns = np.mod(a - lo, 360.0)

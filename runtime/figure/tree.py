@@ -45,10 +45,13 @@ __all__ = [
     "AXES",
     "Figure",
     "Joint",
+    "JointKind",
     "JointSpec",
     "Link",
+    "LinkSource",
     "TraversalLevel",
     "assemble",
+    "frame_from_axis",
     "join",
     "normalize_extremes",
 ]
@@ -118,7 +121,50 @@ def _joint_id(value) -> int:
         raise FigureError(f"a joint identifier must be an integer, not {value!r}.") from exc
 
 
-def normalize_extremes(extremes) -> np.ndarray:
+def frame_from_axis(axis) -> np.ndarray:
+    """The joint axes an ``AXIS (x, y, z)`` clause gives: the shortest turn taking X onto the axis.
+
+    Parameters
+    ----------
+    axis : array_like, shape (3,)
+        Any non-zero finite vector; it is normalised.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        A rotation whose first column is the unit axis.  The other two
+        columns are where the shortest rotation from X onto the axis takes
+        Y and Z (for the axis -X, a half turn about Z), so the same axis
+        always gives the same joint.
+
+    Raises
+    ------
+    FigureError
+        If the axis is zero, not finite or not three numbers.
+    """
+    try:
+        a = np.array(axis, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise FigureError("a joint's AXIS must be a vector (x, y, z).") from exc
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise FigureError("a joint's AXIS must be a vector of three finite numbers.")
+    norm = float(np.linalg.norm(a))
+    if norm == 0.0 or not np.isfinite(norm):
+        raise FigureError(
+            "a joint's AXIS must not be the zero vector.", hint="give the direction the joint works along"
+        )
+    a = a / norm
+    c = float(a[0])
+    if c <= -1.0 + 1e-12:
+        return np.diag([-1.0, -1.0, 1.0])
+    v = np.array([0.0, -a[2], a[1]])  # e_x cross a
+    vx = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    R = np.eye(3) + vx + vx @ vx / (1.0 + c)
+    R[:, 0] = a  # exactly the given direction
+    return R
+
+
+def normalize_extremes(extremes, slide: bool = False) -> np.ndarray:
     """Turn the extremes written in a JOINT statement into a ``(3, 2)`` array.
 
     Parameters
@@ -142,26 +188,27 @@ def normalize_extremes(extremes) -> np.ndarray:
     """
     if isinstance(extremes, np.ndarray) and extremes.shape == (3, 2) and not extremes.flags.writeable:
         return extremes
+    unit = "lengths" if slide else "degrees"
     try:
         arr = np.array(extremes, dtype=float)
     except (TypeError, ValueError) as exc:
         raise FigureError(
-            "joint extremes must be one to three (min, max) pairs of degrees.",
+            f"joint extremes must be one to three (min, max) pairs of {unit}.",
             hint="write them as (min, max), (min, max), (min, max) for X, Y and Z",
         ) from exc
     if arr.shape == (2,):
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 2 or not 1 <= arr.shape[0] <= 3:
         raise FigureError(
-            f"joint extremes must be one to three (min, max) pairs of degrees, not an array of shape {arr.shape}.",
+            f"joint extremes must be one to three (min, max) pairs of {unit}, not an array of shape {arr.shape}.",
             hint="write them as (min, max), (min, max), (min, max) for X, Y and Z",
         )
     if not np.all(np.isfinite(arr)):
-        raise FigureError("joint extremes must be finite numbers of degrees.")
+        raise FigureError(f"joint extremes must be finite numbers of {unit}.")
     if not np.all(np.abs(arr) <= MAX_ANGLE):
         raise FigureError(
-            f"joint extremes must lie within ±{magnitude(MAX_ANGLE)} degrees.",
-            hint="a range of 360 degrees or more already lets the joint turn freely",
+            f"joint extremes must lie within ±{magnitude(MAX_ANGLE)} {unit}.",
+            hint=None if slide else "a range of 360 degrees or more already lets the joint turn freely",
         )
     out = np.zeros((3, 2))
     out[: arr.shape[0]] = arr
@@ -182,6 +229,32 @@ def normalize_extremes(extremes) -> np.ndarray:
 # --------------------------------------------------------------------------
 
 
+class LinkSource(NamedTuple):
+    """A link's name and channels in the file it came from (see :attr:`Link.source`).
+
+    Attributes
+    ----------
+    name : str
+        The name as the source spelled it (any characters).
+    channels : tuple of str
+        Its BVH channels in the source's order (empty when unknown).
+    end : tuple of 3 floats or None
+        Its BVH End Site offset, for a leaf that had one.
+    joint : str or None
+        The name of the source's joint that attaches it (URDF).
+    rpy : tuple of 3 floats or None
+        The source link frame's turn from this link's frame, as URDF roll,
+        pitch and yaw in radians (URDF: LIG link frames keep their
+        primary's orientation at neutral, a URDF link's need not).
+    """
+
+    name: str
+    channels: tuple = ()
+    end: tuple | None = None
+    joint: str | None = None
+    rpy: tuple | None = None
+
+
 @dataclass(frozen=True, eq=False)
 class Link:
     """A rigid segment of a figure.
@@ -196,11 +269,17 @@ class Link:
     scale : float, default 1.0
         Uniform factor the renderer applies to ``shape``'s coordinates before
         the link's pose (SCALE MODEL accumulates here; negative mirrors).
+    source : LinkSource or None
+        How the link was written in the file it was imported from (a BVH
+        joint's own name, such as ``mixamorig:Hips``, and its channels), so
+        that export gives the names back; None for a link made in LIG.  A
+        library's name table sets it (see docs/exchange.md, "Names").
     """
 
     name: str | None
     shape: object
     scale: float = 1.0
+    source: LinkSource | None = None
 
     def __post_init__(self) -> None:
         if self.name is not None and not isinstance(self.name, str):
@@ -231,8 +310,19 @@ class Joint:
     loc2 : array_like, shape (3,)
         The joint's location in the secondary link's coordinates.
     extremes : array_like, shape (k, 2), k in 1..3
-        ``(min, max)`` degrees per axis; see :func:`normalize_extremes`.
-        Stored as a read-only ``(3, 2)`` array.
+        ``(min, max)`` per axis, degrees (a slide: lengths); see
+        :func:`normalize_extremes`.  Stored as a read-only ``(3, 2)`` array.
+    slide : bool, default False
+        A prismatic joint: its three values are a displacement of S along
+        the joint's X, Y and Z axes instead of angles about them.
+    axes : array_like, shape (3, 3), optional
+        The joint's own axes as the columns of a rotation, in P's
+        coordinates (identity when None, the thesis' joint); written
+        ``AXIS (x, y, z)`` in a JOINT, which sets the X axis (see
+        :func:`frame_from_axis`).
+    slide_scale : float, default 1.0
+        What a slide's displacement is multiplied by (SCALE MODEL multiplies
+        it, so displacements scale with the model).
     """
 
     id: int
@@ -241,6 +331,9 @@ class Joint:
     loc1: np.ndarray
     loc2: np.ndarray
     extremes: np.ndarray
+    slide: bool = False
+    axes: np.ndarray | None = None
+    slide_scale: float = 1.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "id", _joint_id(self.id))
@@ -248,11 +341,21 @@ class Joint:
         object.__setattr__(self, "secondary", operator.index(self.secondary))
         object.__setattr__(self, "loc1", _frozen(self.loc1, (3,), f"the primary location of joint {self.id}"))
         object.__setattr__(self, "loc2", _frozen(self.loc2, (3,), f"the secondary location of joint {self.id}"))
+        object.__setattr__(self, "slide", bool(self.slide))
+        object.__setattr__(self, "slide_scale", float(self.slide_scale))
+        if self.axes is not None:
+            axes = _frozen(self.axes, (3, 3), f"the axes of joint {self.id}")
+            object.__setattr__(self, "axes", None if np.array_equal(axes, np.eye(3)) else axes)
         try:
-            object.__setattr__(self, "extremes", normalize_extremes(self.extremes))
+            object.__setattr__(self, "extremes", normalize_extremes(self.extremes, slide=self.slide))
         except FigureError as exc:
             # Say which joint: a model block may hold dozens of JOINT statements.
             raise FigureError(f"joint {self.id}: {exc.message}", exc.hint) from None
+
+    @property
+    def kind(self) -> str:
+        """``"slide"`` for a prismatic joint, ``"turn"`` for the thesis' rotational one."""
+        return "slide" if self.slide else "turn"
 
 
 class TraversalLevel(NamedTuple):
@@ -270,6 +373,33 @@ class TraversalLevel(NamedTuple):
     reversed: np.ndarray
 
 
+@dataclass(frozen=True)
+class JointKind:
+    """What a JOINT statement says beyond its extremes: SLIDE and AXIS.
+
+    Parameters
+    ----------
+    slide : bool, default False
+        ``SLIDE``: a prismatic joint.
+    axis : array_like, shape (3,), optional
+        ``AXIS (x, y, z)``: the joint's X axis (see :func:`frame_from_axis`).
+    """
+
+    slide: bool = False
+    axis: object = None
+
+    def fields(self, joint_id) -> dict:
+        """The :class:`Joint` keyword arguments for this kind (the error names the joint)."""
+        try:
+            axes = None if self.axis is None else frame_from_axis(self.axis)
+        except FigureError as exc:
+            raise FigureError(f"joint {joint_id}: {exc.message}", exc.hint) from None
+        return {"slide": self.slide, "axes": axes}
+
+
+TURN = JointKind()
+
+
 class JointSpec(NamedTuple):
     """One JOINT statement inside STARTMODEL ... ENDMODEL (see :func:`assemble`)."""
 
@@ -281,6 +411,8 @@ class JointSpec(NamedTuple):
     loc2: object
     extremes: object
     statement_index: int
+    slide: bool = False
+    axis: object = None  # AXIS (x, y, z), or None
 
 
 @dataclass(frozen=True, eq=False)
@@ -459,6 +591,34 @@ class Figure:
         return arr
 
     @cached_property
+    def slides(self) -> np.ndarray:
+        """Per joint, whether it is prismatic (a slide), shape ``(n_joints,)``, read-only."""
+        arr = np.array([j.slide for j in self.joints], dtype=bool)
+        arr.setflags(write=False)
+        return arr
+
+    @cached_property
+    def frames(self) -> np.ndarray:
+        """Every joint's axes (identity unless AXIS gave them), shape ``(n_joints, 3, 3)``, read-only."""
+        arr = np.array([np.eye(3) if j.axes is None else j.axes for j in self.joints]).reshape(len(self.joints), 3, 3)
+        arr.setflags(write=False)
+        return arr
+
+    @cached_property
+    def has_frames(self) -> np.ndarray:
+        """Per joint, whether AXIS turned its axes away from the primary's, shape ``(n_joints,)``."""
+        arr = np.array([j.axes is not None for j in self.joints], dtype=bool)
+        arr.setflags(write=False)
+        return arr
+
+    @cached_property
+    def slide_scales(self) -> np.ndarray:
+        """Per joint, the factor a slide's displacement is multiplied by, shape ``(n_joints,)``."""
+        arr = np.array([j.slide_scale for j in self.joints], dtype=float)
+        arr.setflags(write=False)
+        return arr
+
+    @cached_property
     def locations(self) -> tuple[np.ndarray, np.ndarray]:
         """``(loc1, loc2)`` of all joints, each shape ``(n_joints, 3)``, read-only."""
         loc1 = np.array([j.loc1 for j in self.joints]).reshape(len(self.joints), 3)
@@ -560,8 +720,28 @@ class Figure:
                 hint="a zero factor would shrink the model to a point",
             )
         links = tuple(dataclasses.replace(l, scale=l.scale * r) for l in self.links)
-        joints = tuple(dataclasses.replace(j, loc1=j.loc1 * r, loc2=j.loc2 * r) for j in self.joints)
+        # A slide's displacement scales with the model, so the scaled figure
+        # is r times the original at every pose, slides included.
+        joints = tuple(
+            dataclasses.replace(j, loc1=j.loc1 * r, loc2=j.loc2 * r, slide_scale=j.slide_scale * r) for j in self.joints
+        )
         return dataclasses.replace(self, links=links, joints=joints)
+
+    def with_sources(self, sources: dict) -> Figure:
+        """The same figure with each named link's :attr:`Link.source` set.
+
+        Parameters
+        ----------
+        sources : dict of str to LinkSource
+            By link name (case-insensitive); links not in it are unchanged.
+        """
+        table = {k.upper(): v for k, v in sources.items()}
+        if not table:
+            return self
+        links = tuple(
+            dataclasses.replace(l, source=table[_key(l.name)]) if _key(l.name) in table else l for l in self.links
+        )
+        return dataclasses.replace(self, links=links)
 
     def scale_extremes(self, r: float) -> Figure:
         """SCALE EXTREMES ``r``: multiply every joint extreme by ``r``.
@@ -729,7 +909,7 @@ class Figure:
         for k, j in enumerate(self.joints):
             rows.append(
                 (
-                    f"No. {j.id}",
+                    f"No. {j.id}" + _kind_note(j),
                     _vec(cols[0][k]),
                     _vec(j.extremes[0]),
                     _vec(j.extremes[1]),
@@ -739,6 +919,14 @@ class Figure:
                 )
             )
         return "\n".join(_table(rows))
+
+
+def _kind_note(j: Joint) -> str:
+    """What PRINT $m adds after a joint's number: nothing for the thesis' joint."""
+    note = " SLIDE" if j.slide else ""
+    if j.axes is not None:
+        note += " AXIS " + _vec(j.axes[:, 0])
+    return note
 
 
 def _table(rows: Sequence[tuple[str, ...]], indent: str = "") -> list[str]:
@@ -759,14 +947,14 @@ def _as_figure(operand, role: str) -> Figure:
     raise FigureError(f"the {role} of a JOINT must be a graphical object or a model, not {type(operand).__name__}.")
 
 
-def _graft(base: Figure, at: int, joint_id, loc1, sub: Figure, loc2, extremes) -> Figure:
+def _graft(base: Figure, at: int, joint_id, loc1, sub: Figure, loc2, extremes, kind: JointKind) -> Figure:
     """Attach ``sub`` by its ORIGINAL main link to link ``at`` of ``base``.
 
     Keeps ``base``'s root, current main and placement.  If ``at`` is the root
     (as in :func:`join`) and both operands are in pre-order, so is the result:
     the new joint is the root's last child and ``sub``'s links follow.
     """
-    new = Joint(joint_id, at, len(base.links) + sub.root, loc1, loc2, extremes)
+    new = Joint(joint_id, at, len(base.links) + sub.root, loc1, loc2, extremes, **kind.fields(joint_id))
     taken = set(base.joint_ids)
     for jid in (new.id, *sub.joint_ids):
         if jid in taken:
@@ -786,7 +974,7 @@ def _graft(base: Figure, at: int, joint_id, loc1, sub: Figure, loc2, extremes) -
     )
 
 
-def join(joint_id: int, primary, loc1, secondary, loc2, extremes) -> Figure:
+def join(joint_id: int, primary, loc1, secondary, loc2, extremes, kind: JointKind = TURN) -> Figure:
     """``m :- JOINT id, primary, loc1, secondary, loc2, extremes``.
 
     Parameters
@@ -799,7 +987,10 @@ def join(joint_id: int, primary, loc1, secondary, loc2, extremes) -> Figure:
     loc1, loc2 : array_like, shape (3,)
         The joint's location on the primary's and the secondary's main link.
     extremes : array_like, shape (k, 2), k in 1..3
-        ``(min, max)`` degrees; omitted trailing axes are locked at ``(0, 0)``.
+        ``(min, max)`` degrees (lengths for a slide); omitted trailing axes
+        are locked at ``(0, 0)``.
+    kind : JointKind, optional
+        SLIDE and AXIS, if the statement gives them.
 
     Returns
     -------
@@ -815,7 +1006,7 @@ def join(joint_id: int, primary, loc1, secondary, loc2, extremes) -> Figure:
     """
     p = _as_figure(primary, "primary segment")
     s = _as_figure(secondary, "secondary segment")
-    return _graft(p, p.root, joint_id, loc1, s, loc2, extremes)
+    return _graft(p, p.root, joint_id, loc1, s, loc2, extremes, kind)
 
 
 def _canonical(links: list[Link], joints: list[Joint], root: int) -> Figure:
@@ -885,8 +1076,17 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
     specs = [JointSpec(*s) for s in specs]
     if not specs:
         raise FigureError("STARTMODEL ... ENDMODEL needs at least one JOINT statement.")
+    pieces = _pieces(specs, shapes)
+    root_name = _main_name(specs, pieces)
+    root_link = Link(root_name, _lookup_shape(shapes, root_name))
+    attach, warnings = _attachments(specs, pieces, root_name)
+    _refuse_cycles(specs, attach)
+    _refuse_repeated_ids(specs, pieces)
+    return _flatten(specs, pieces, root_link, attach), warnings
 
-    # 1. Each statement's piece: a new link, or a copy of a submodel.
+
+def _pieces(specs: list[JointSpec], shapes: dict) -> list[Figure]:
+    """Step 1 of :func:`assemble`: each statement's piece, a new link or a copy of a submodel."""
     pieces: list[Figure] = []
     for s in specs:
         if isinstance(s.secondary, Figure):
@@ -900,8 +1100,11 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
             pieces.append(Figure.from_link(s.secondary))
         else:
             raise FigureError(f"the secondary of JOINT {s.joint_id} must be a graphical object or a model.")
+    return pieces
 
-    # 2. The main link: a primary name never used as a secondary.
+
+def _main_name(specs: list[JointSpec], pieces: list[Figure]) -> str:
+    """Step 2 of :func:`assemble`: the main link, the one primary name never used as a secondary."""
     secondary_names = {_key(l.name) for p in pieces for l in p.links if l.name is not None}
     roots: dict[str, str] = {}  # key -> name as first written, in textual order
     for s in specs:
@@ -919,11 +1122,17 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
             "so each would be a main link.",
             hint="join the pieces together, or check the spelling of the segment names",
         )
-    root_link = Link(root_names[0], _lookup_shape(shapes, root_names[0]))
+    return root_names[0]
 
-    # 3. Candidate links per name: (textual position of creator, link in piece);
-    #    the root's creator is position -1 ("created first").
-    candidates: dict[str, list[tuple[int, int]]] = {_key(root_names[0]): [(-1, 0)]}
+
+def _attachments(specs: list[JointSpec], pieces: list[Figure], root_name: str):
+    """Step 3 of :func:`assemble`: per statement, (creator position, link in that piece) of its primary.
+
+    Candidate links per name are (textual position of their creator, link in
+    its piece); the root's creator is position -1 ("created first").
+    Returns the attachments and the ambiguity warnings.
+    """
+    candidates: dict[str, list[tuple[int, int]]] = {_key(root_name): [(-1, 0)]}
     for pos, piece in enumerate(pieces):
         for local in piece.preorder:
             name = piece.links[local].name
@@ -957,9 +1166,12 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
                 ),
             )
         )
+    return attach, warnings
 
-    # 4. Cycles: follow each statement up through the statements that made
-    #    its primary; it must reach the main link without meeting itself.
+
+def _refuse_cycles(specs: list[JointSpec], attach: list[tuple[int, int]]) -> None:
+    """Step 4 of :func:`assemble`: each statement, followed up through the statements that made
+    its primary, must reach the main link without meeting itself."""
     for pos in range(len(specs)):
         chain = [pos]
         cur = attach[pos][0]
@@ -977,7 +1189,9 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
             chain.append(cur)
             cur = attach[cur][0]
 
-    # 5. Repeated ids, named with their statements.
+
+def _refuse_repeated_ids(specs: list[JointSpec], pieces: list[Figure]) -> None:
+    """Step 5 of :func:`assemble`: repeated joint identifiers, named with their statements."""
     owner: dict[int, int] = {}
     for pos, (s, piece) in enumerate(zip(specs, pieces)):
         for jid in (_joint_id(s.joint_id), *piece.joint_ids):
@@ -990,8 +1204,10 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
                 )
             owner[jid] = pos
 
-    # 6. Flatten: root, then each piece's links; pieces' own joints first, then
-    #    the statements' joints in textual order, so siblings keep that order.
+
+def _flatten(specs: Sequence, pieces: list[Figure], root_link: Link, attach) -> Figure:
+    """Step 6 of :func:`assemble`: root, then each piece's links; pieces' own joints first, then
+    the statements' joints in textual order, so siblings keep that order."""
     offsets = []
     links: list[Link] = [root_link]
     for piece in pieces:
@@ -1005,8 +1221,19 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
     for pos, s in enumerate(specs):
         creator, local = attach[pos]
         primary = 0 if creator < 0 else offsets[creator] + local
-        joints.append(Joint(s.joint_id, primary, offsets[pos] + pieces[pos].root, s.loc1, s.loc2, s.extremes))
-    return _canonical(links, joints, 0), warnings
+        kind = JointKind(s.slide, s.axis)
+        joints.append(
+            Joint(
+                s.joint_id,
+                primary,
+                offsets[pos] + pieces[pos].root,
+                s.loc1,
+                s.loc2,
+                s.extremes,
+                **kind.fields(s.joint_id),
+            )
+        )
+    return _canonical(links, joints, 0)
 
 
 def _lookup_shape(shapes: dict, name: str):

@@ -180,6 +180,26 @@ def figure_length(figure: Figure) -> float:
     return total if total > 0.0 else 1.0
 
 
+def _framed_term_sums(F: np.ndarray) -> np.ndarray:
+    """:data:`_TERM_SUMS` for a joint with axes ``F``: the columns of ``F R F^T`` and of ``F`` times each local axis."""
+    sums = np.empty_like(_TERM_SUMS)
+    rot = _TERM_SUMS[:, :9].reshape(16, 3, 3)
+    sums[:, :9] = np.einsum("ia,tab,jb->tij", F, rot, F).reshape(16, 9)
+    axes = _TERM_SUMS[:, 9:].reshape(16, 3, 3)  # (term, axis, component)
+    sums[:, 9:] = np.einsum("ic,tac->tai", F, axes).reshape(16, 9)
+    return sums
+
+
+def _conjugate(r: list, joints: np.ndarray, F: np.ndarray) -> None:
+    """Replace the rotation entries ``r[i][j]`` (each (J, B)) of ``joints`` by those of ``F R F^T``, in place."""
+    R = np.array([[r[i][j][joints] for j in range(3)] for i in range(3)])  # (3, 3, f, B)
+    out = np.einsum("fia,abfc,fjb->ijfc", F, R, F)
+    for i in range(3):
+        for j in range(3):
+            r[i][j] = r[i][j].copy() if not r[i][j].flags.writeable else r[i][j]
+            r[i][j][joints] = out[i, j]
+
+
 class IKModel:
     """The figure's free variables, their bounds and batched kinematics.
 
@@ -279,6 +299,10 @@ class IKModel:
         self.var_loc1 = loc1[self.var_joint] if V else np.zeros((0, 3))
         self._loc1, self._loc2, self._rev = loc1, loc2, rev
         self._any_reversed = bool(rev.any())
+        self._framed = np.flatnonzero(figure.has_frames)
+        self._framed_axes = figure.frames[self._framed]  # (f, 3, 3)
+        self._var_framed = np.flatnonzero(figure.has_frames[self.var_joint]) if V else np.zeros(0, dtype=np.intp)
+        self._var_frames = figure.frames[self.var_joint[self._var_framed]] if V else np.zeros((0, 3, 3))
         self._near = np.where(rev[:, None], loc2, loc1)
         self._far = np.where(rev[:, None], loc1, loc2)
         self._levels = [
@@ -301,17 +325,20 @@ class IKModel:
         # (16, 25) matrix per joint maps the products to them, with the
         # joint's locations, and its direction (R or R^T), folded in.
         SJ = np.zeros((J, 16, 25))
+        frames = figure.frames
         for k in range(J):
             near, far = self._near[k], self._far[k]
+            # AXIS turns the rotation into F R F^T, linear in R's entries.
+            sums = _framed_term_sums(frames[k]) if figure.has_frames[k] else _TERM_SUMS
             for i in range(3):
                 for j in range(3):
                     src = 3 * j + i if rev[k] else 3 * i + j
-                    SJ[k, :, 4 * i + j] = _TERM_SUMS[:, src]
+                    SJ[k, :, 4 * i + j] = sums[:, src]
                 # t_i = near_i - sum_j R_ij far_j; the constant rides on the product "1".
                 SJ[k, :, 4 * i + 3] = -(SJ[k, :, 4 * i : 4 * i + 3] @ far)
                 SJ[k, 15, 4 * i + 3] += near[i]
             SJ[k, 15, 15] = 1.0
-            SJ[k, :, 16:] = _TERM_SUMS[:, 9:]
+            SJ[k, :, 16:] = sums[:, 9:]
         self._term_maps = SJ
         self._term_index = (
             (np.arange(J)[:, None] * 7 + _TERMS[:, None, :]) if J else np.zeros((3, 0, 16), dtype=np.intp)
@@ -472,6 +499,8 @@ class IKModel:
             [cy * sz, szsy * sx + cz * cx, szsy * cx - cz * sx],
             [-sy, cy * sx, cy * cx],
         ]
+        if self._framed.size:
+            _conjugate(r, self._framed, self._framed_axes)
         if self._any_reversed:
             # Reversed joints (walked from the secondary) use R^T and
             # L2 - R^T L1 instead of R and L1 - R L2.
@@ -630,6 +659,9 @@ class IKModel:
             local[:, vy, 1] = c[:, jy, 2]
         vz, _ = self._axis_vars[2]
         local[:, vz, 2] = 1.0
+        if self._var_framed.size:
+            # AXIS: the joint's own axes are F's columns.
+            local[:, self._var_framed] = matvec3(self._var_frames, local[:, self._var_framed])
         Rp = R[:, self.var_primary]  # (B, V, 3, 3)
         omega = matvec3(Rp, local) * self.sign[:, None]
         pivot = p[:, self.var_primary] + matvec3(Rp, self.var_loc1)

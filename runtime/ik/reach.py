@@ -24,6 +24,7 @@ Example (``arm`` a model with a link named HAND)::
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -31,7 +32,7 @@ import numpy as np
 
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import pose as PO
-from liganimate.runtime.figure.tree import Figure
+from liganimate.runtime.figure.tree import Figure, Joint
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
 from liganimate.runtime.ik.model import IKModel
 from liganimate.runtime.ik.solvers import CONVERGED, DEFAULT_SOLVER, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
@@ -245,6 +246,43 @@ def start_pose(figure: Figure, start=None) -> np.ndarray:
     return K.clamp(figure, a)
 
 
+def _hold_slides(figure: Figure, start) -> tuple[Figure, np.ndarray, np.ndarray]:
+    """REACH holds every slide at its start displacement.
+
+    Returns
+    -------
+    held : Figure
+        The figure with each slide's start displacement built into its
+        primary location, the slide made a locked turn joint.
+    start : numpy.ndarray
+        The start pose for ``held`` (those joints at zero).
+    values : numpy.ndarray, shape (n_slides, 3)
+        The displacements held.
+
+    Raises
+    ------
+    GoalError
+        When a batch of start poses differs in a slide (one figure cannot
+        hold two displacements).
+    """
+    start_deg = np.array(start_pose(figure, start))
+    slides = figure.slides
+    d = start_deg[..., slides, :]
+    if d.ndim == 3 and not np.all(d == d[:1]):
+        raise GoalError(
+            "REACH holds slide joints at their start displacement, and this batch of start poses differs there.",
+        )
+    values = d.reshape(-1, d.shape[-2], 3)[0]
+    joints = list(figure.joints)
+    for value, k in zip(values, np.flatnonzero(slides)):
+        j = joints[k]
+        shift = j.slide_scale * (figure.frames[k] @ value)
+        joints[k] = Joint(j.id, j.primary, j.secondary, j.loc1 + shift, j.loc2, ((0.0, 0.0),))
+    held = Figure(figure.links, tuple(joints), root=figure.root, main=figure.main, placement=figure.placement)
+    start_deg[..., slides, :] = 0.0
+    return held, start_deg, values
+
+
 def _movable_mask(figure: Figure, goals: Sequence, movable) -> np.ndarray:
     """Which joint axes may move, shape (n_joints, 3), from the ``movable`` option."""
     J = figure.n_joints
@@ -357,6 +395,23 @@ def solve_pose(
         error: see ``PoseSolution.status`` and ``residuals``.
     """
     goals = list(goals)
+    if figure.slides.any():
+        held, start, values = _hold_slides(figure, start)
+        solution = solve_pose(
+            held,
+            goals,
+            start=start,
+            movable=movable,
+            translate=translate,
+            solver=solver,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+            restarts=restarts,
+            trace=trace,
+        )
+        angles = np.array(solution.angles)
+        angles[..., figure.slides, :] = values
+        return dataclasses.replace(solution, angles=angles)
     tol, max_iter = _options(figure, solver, tolerance, max_iterations)
     if isinstance(restarts, bool) or not isinstance(restarts, (int, np.integer)) or restarts < 0:
         raise GoalError(f"the number of restarts must be a non-negative whole number, not {restarts!r}.")

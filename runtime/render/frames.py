@@ -53,9 +53,10 @@ from liganimate.runtime.figure.pose import (
 from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
 from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
-from liganimate.runtime.render.outputs import KEYWORD_NAMES, OutputLock, check_outputs
-from liganimate.runtime.render.raster import MAX_AA, Framebuffer, rasterize
-from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, GifStream, Mp4Stream
+from liganimate.runtime.render.look import DEFAULT_LOOK, draw_modern, look_params
+from liganimate.runtime.render.options import RenderOptions, checked, executor_for
+from liganimate.runtime.render.outputs import OutputLock
+from liganimate.runtime.render.raster import Framebuffer, rasterize
 from liganimate.runtime.values import Graphical, joined_shades
 
 # Images whose poses are evaluated together.
@@ -79,23 +80,12 @@ class Renderer:
 
     Parameters
     ----------
-    out_dir : str or None
-        Frames go to ``out_dir/scene<ID>/<NNNNN>.png``; None writes no
-        frames (then ``gif`` or ``mp4`` must be given).
-    size : (int, int)
-        Image width and height in pixels.
-    gif, mp4, poses : str or None
-        Extra outputs: an animated GIF, an MP4, a JSON Lines pose record.
-    fps : float
-        Frame rate of the GIF and MP4.
-    quiet : bool
-        No progress bar.
-    workers : int or None
-        Processes rasterizing in parallel (default: the machine's cores, at
-        most 8); 1 draws everything in this process.
-    aa : int
-        Anti-aliasing factor, 1 (none, the default) to 8: each pixel is the
-        mean of ``aa x aa`` samples.
+    options : RenderOptions
+        What to write and how (:class:`.options.RenderOptions`: the frames
+        folder, the size, the movies, the pose record, their rate and
+        quality, the workers, the Dask scheduler); checked here again.
+    progress : bool, optional
+        Show a progress bar (default: unless ``options.quiet``, on a terminal).
     executor : object or None
         Where images are drawn instead of a pool of local processes: any
         object with ``submit(fn, *args) -> concurrent.futures.Future`` and
@@ -103,60 +93,36 @@ class Renderer:
         :class:`liganimate.runtime.render.distributed.DaskExecutor`.  The
         tasks return their images to this process, which writes every file.
         The renderer uses it for every image and shuts it down when closed.
-    crf, preset : int, str
-        x264's quality (0 to 51, lower is better and larger) and speed
-        (``ultrafast`` to ``veryslow``) for the MP4 (see :mod:`.video`).
+        Default: a Dask cluster when ``options.scheduler`` names one.
 
     Raises
     ------
     RenderError
-        Before anything is written: an output option that cannot be
-        honoured (see :func:`.outputs.check_outputs`), MP4 without ffmpeg,
-        or an output another run is writing (see :class:`.outputs.OutputLock`).
+        Before anything is written: an option that cannot be honoured (see
+        :func:`.options.checked`), MP4 without ffmpeg, or an output another
+        run is writing (see :class:`.outputs.OutputLock`).
     """
 
-    def __init__(
-        self,
-        out_dir,
-        size=(640, 480),
-        gif=None,
-        mp4=None,
-        poses=None,
-        fps=24.0,
-        quiet=False,
-        workers=None,
-        stdout=None,
-        progress=None,
-        aa=1,
-        executor=None,
-        crf=DEFAULT_CRF,
-        preset=DEFAULT_PRESET,
-    ):
+    def __init__(self, options: RenderOptions, progress=None, executor=None):
         try:
-            self._init(out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor, crf, preset)
+            self._init(checked(options, make_poses_folder=True), progress, executor)
         except BaseException:
             if executor is not None:
                 executor.shutdown(wait=False, cancel_futures=True)
             raise
 
-    def _init(self, out_dir, size, gif, mp4, poses, fps, quiet, workers, progress, aa, executor, crf, preset):
-        from liganimate.runtime.render.video import check_crf, check_preset, find_ffmpeg
-
-        self.aa = check_aa(aa, "aa=")
-        crf, preset = check_crf(crf, "crf="), check_preset(preset, "preset=")
-        if out_dir is None and not (gif or mp4):
-            raise RenderError("out_dir is None and there is no gif= or mp4=: nothing would be written")
-        check_outputs(out_dir, gif, mp4, poses, fps, KEYWORD_NAMES, make_poses_folder=True)
+    def _init(self, options, progress, executor):
+        if executor is None and options.scheduler is not None:
+            executor = executor_for(options.scheduler)
+        self.options = options
         self.executor = executor
-        self.out_dir = out_dir
-        self.size = (int(size[0]), int(size[1]))
-        self.gif, self.mp4, self.fps = gif, mp4, float(fps)
-        if mp4:
-            # No ffmpeg, no render: say so before any file is written.
-            find_ffmpeg()
-        self.poses_path = poses
-        self.quiet = quiet
-        self.workers = workers if workers is not None else min(os.cpu_count() or 1, 8)
+        self.out_dir = options.out
+        self.size = options.size
+        self.aa = options.aa
+        self.look = options.look
+        self.fps = options.fps
+        self.quiet = options.quiet
+        self.workers = options.workers if options.workers is not None else min(os.cpu_count() or 1, 8)
         self.pool = None
         self._worker_procs: list = []
         self.pending: list = []
@@ -169,7 +135,7 @@ class Renderer:
         self._angles: dict = {}
         self.scene_id = None
         self.scene_total = 0
-        self.progress = progress if progress is not None else (not quiet and sys.stderr.isatty())
+        self.progress = progress if progress is not None else (not options.quiet and sys.stderr.isatty())
         self._poses_fh = None
         self._closed = False
         self._failed = False
@@ -178,20 +144,19 @@ class Renderer:
         self._files = None  # threads writing the PNG files, started with the first
         self._writes: collections.deque = collections.deque()  # (future, path), in order
         # What the tasks send back: PNG bytes when frames are written, raw images for the movies.
-        self._want = (out_dir is not None, bool(gif or mp4))
+        self._want = (options.out is not None, bool(options.movies()))
+        poses = options.poses
         if poses:
             try:
                 os.makedirs(os.path.dirname(os.path.abspath(poses)), exist_ok=True)
             except OSError as exc:
                 raise RenderError(f"cannot create the folder of {poses}: {os_error_words(exc)}") from None
-        self.lock = OutputLock(out_dir, (gif, mp4, poses))
+        self.lock = OutputLock(options.out, options.files())
         try:
             if poses:
                 self._poses_fh = AtomicWriter(poses)
-            if gif:
-                self._streams.append(GifStream(gif, self.fps))
-            if mp4:
-                self._streams.append(Mp4Stream(mp4, self.fps, crf, preset))
+            for movie, path in options.movies():
+                self._streams.append(movie.open(path, options))
         except BaseException:
             self._abort_outputs()
             self.lock.release()
@@ -359,7 +324,7 @@ class Renderer:
         if not chunk:
             return
         names = [name for name, _ in chunk]
-        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want)
+        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want, self.look)
         if self.pool is None and self.executor is not None:
             self.pool = self.executor
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
@@ -471,7 +436,7 @@ class Renderer:
 
     def _sync_folders(self) -> None:
         """Make the renames of the movies and pose record durable (each file was synced before its rename)."""
-        folders = {os.path.dirname(os.path.abspath(p)) for p in (self.gif, self.mp4, self.poses_path) if p}
+        folders = {os.path.dirname(os.path.abspath(p)) for p in self.options.files()}
         for folder in sorted(folders):
             self._synced.add_folder(folder)
         if self.out_dir is not None:
@@ -506,7 +471,7 @@ class Renderer:
             try:
                 self._stop_writes()
                 self._abort_outputs()
-                self.lock.sweep(self.out_dir, (self.gif, self.mp4, self.poses_path))
+                self.lock.sweep(self.out_dir, self.options.files())
                 self._sync_folders()  # the frames of an interrupted run survive a power loss too
             finally:
                 self.lock.release()
@@ -581,7 +546,7 @@ def _worker_init(parent: int) -> None:
     mallopt(M_TRIM_THRESHOLD, 256 << 20)
 
 
-def draw_images(size, draws_list, aa=1, png=True, raw=False) -> list:
+def draw_images(size, draws_list, aa=1, png=True, raw=False, look=DEFAULT_LOOK) -> list:
     """Draw several images (a worker's task): ``draws_list`` holds each image's draws (see :func:`draw`).
 
     Returns
@@ -592,20 +557,21 @@ def draw_images(size, draws_list, aa=1, png=True, raw=False) -> list:
     """
     out = []
     for draws in draws_list:
-        image = draw(size, draws, aa)
+        image = draw(size, draws, aa, look)
         out.append((encode_png(image) if png else None, image if raw else None))
     return out
 
 
-def draw_image(path, size, draws, aa=1) -> None:
+def draw_image(path, size, draws, aa=1, look=DEFAULT_LOOK) -> None:
     """Rasterize one image and write it atomically."""
-    write_png(path, draw(size, draws, aa))
+    write_png(path, draw(size, draws, aa, look))
 
 
-def draw(size, draws, aa=1) -> np.ndarray:
+def draw(size, draws, aa=1, look=DEFAULT_LOOK) -> np.ndarray:
     """Rasterize one image from its draws: a list of (camera, parts).
 
-    ``aa`` is the anti-aliasing factor (1: none).  The result is an array
+    ``aa`` is the anti-aliasing factor (1: none), ``look`` the name of the
+    look (:mod:`.look`: ``"modern"`` or ``"thesis"``).  The result is an array
     of shape (H, W) (grey levels) or (H, W, 3) (colour), uint8.
 
     Consecutive draws seen by the same camera (the background and every tick
@@ -621,6 +587,9 @@ def draw(size, draws, aa=1) -> np.ndarray:
             merged[-1][1].extend(parts)
         else:
             merged.append((camera, list(parts)))
+    params = look_params(look)
+    if params is not None:
+        return draw_modern(size, [(_camera(c, size), p) for c, p in merged], aa, params)
     if len(merged) == 1:
         # The usual case: a fresh image, whose depth buffer need only cover what is drawn.
         camera, parts = merged[0]
@@ -633,23 +602,6 @@ def draw(size, draws, aa=1) -> np.ndarray:
             fb.draw(tris, grey, _camera(camera, size), cull)
         image = fb.image
     return image
-
-
-def check_aa(aa, name: str = "--aa") -> int:
-    """``aa`` as an int from 1 to the rasterizer's ``MAX_AA``, or a RenderError naming the option.
-
-    Unlike the rasterizer's own check, this takes the option's text ("2")
-    as the command line and ``Program.render`` options give it.
-    """
-    try:
-        n = int(aa)
-        ok = n == float(aa) and 1 <= n <= MAX_AA
-    except (TypeError, ValueError, OverflowError):
-        ok = False
-    if not ok or isinstance(aa, bool):
-        shown = f"{name}{aa!r}" if name.endswith("=") else f"{name} {aa}"
-        raise RenderError(f"{shown} is not an anti-aliasing factor; give a whole number from 1 (none) to {MAX_AA}")
-    return n
 
 
 def _joined(parts):

@@ -26,8 +26,13 @@ import os
 import re
 import struct
 import sys
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 from liganimate.runtime.errors import RenderError
+
+if TYPE_CHECKING:
+    from liganimate.runtime.render.options import RenderOptions
 
 LOCK_NAME = ".liganimate.lock"
 # The names AtomicWriter's temporary files take (mkstemp: 8 characters of [a-z0-9_]).
@@ -36,10 +41,6 @@ _FRAME_TMP = re.compile(r"\.\d{5,}\.png" + _TMP_TAIL)
 # GIF delays are 16-bit hundredths of a second: below 100/65535 fps a frame cannot be shown long enough.
 MIN_FPS = 0.01
 MAX_FPS = 1000.0
-
-# Option names as the command line spells them; the library's keyword names otherwise.
-CLI_NAMES = {"out": "-o", "gif": "--gif", "mp4": "--mp4", "poses": "--poses", "fps": "--fps"}
-KEYWORD_NAMES = {"out": "out_dir", "gif": "gif=", "mp4": "mp4=", "poses": "poses=", "fps": "fps="}
 
 # Lock paths this process holds: record locks do not exclude the process that holds them.
 _HELD: set = set()
@@ -59,20 +60,19 @@ def check_fps(fps, name: str = "--fps") -> float:
     return f
 
 
-def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None, make_poses_folder=False) -> None:
+def check_outputs(options: RenderOptions, names: Mapping[str, str], make_poses_folder: bool = False) -> None:
     """Refuse output options that could not be honoured, before anything is computed or written.
 
     Parameters
     ----------
-    out_dir : str or None
-        The frames folder; it may not exist yet (it is created with its
-        parents).  None: no frames are written.
-    gif, mp4, poses : str or None
-        Extra output files; each must name a file (not a folder) in a folder that exists.
-    fps : float
-        Frame rate of the GIF and MP4.
-    names : dict, optional
-        How to name each option in messages (default :data:`KEYWORD_NAMES`).
+    options : RenderOptions
+        ``out``, the frames folder, may not exist yet (it is created with
+        its parents); None: no frames are written.  Each output file (the
+        movies and the pose record) must name a file, not a folder, in a
+        folder that exists.  ``fps`` is the movies' frame rate.
+    names : mapping
+        How to name each option in messages (:data:`.options.CLI_NAMES`
+        or :data:`.options.KEYWORD_NAMES`).
     make_poses_folder : bool, optional
         The pose record's folder may be missing too, because the caller
         creates it (``Program.render(poses=...)`` always has); the command
@@ -83,12 +83,13 @@ def check_outputs(out_dir, gif=None, mp4=None, poses=None, fps=24.0, names=None,
     RenderError
         One line naming the option and the path, e.g. ``--gif out is a folder, not a file``.
     """
-    names = names or KEYWORD_NAMES
-    check_fps(fps, names["fps"])
+    check_fps(options.fps, names["fps"])
+    out_dir = options.out
     if out_dir is not None:
         _check_folder(os.fspath(out_dir), names["out"])
     seen: dict = {}
-    for key, path in (("gif", gif), ("mp4", mp4), ("poses", poses)):
+    wanted = [(m.name, p) for m, p in options.movies()] + [("poses", options.poses)]
+    for key, path in wanted:
         if path is None:
             continue
         path = os.fspath(path)
@@ -327,4 +328,4 @@ class OutputLock:
             _HELD.discard(key)
 
 
-__all__ = ["CLI_NAMES", "KEYWORD_NAMES", "OutputLock", "check_fps", "check_outputs", "holder_of", "refuse_if_locked"]
+__all__ = ["OutputLock", "check_fps", "check_outputs", "holder_of", "refuse_if_locked"]

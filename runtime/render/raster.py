@@ -67,6 +67,8 @@ EMPTY = 0
 _INDEX_BITS = 32
 _INDEX_MASK = (1 << _INDEX_BITS) - 1
 _DEPTH_MASK = ~_INDEX_MASK
+#: A depth key's triangle number (its low 32 bits) and its 1/z (the rest, as float64 bits).
+INDEX_MASK, DEPTH_MASK = _INDEX_MASK, _DEPTH_MASK
 _MAX_TRIANGLES = 1 << 31
 
 #: Largest anti-aliasing factor: aa x aa samples per pixel.

@@ -11,11 +11,13 @@ This sub-package owns ``liganimate view`` and the notebook display's page:
 * ``gl.js`` is also the studio's drawing code (``liganimate.runtime.studio``
   inlines it through :func:`asset`).
 
-It may import the runtime (pose, values), ``liganimate.runtime.exchange``
-(only through the collector's results), numpy and the standard library.
-Nothing in the runtime, the compiler or the language imports it; the
-command line reaches it through ``liganimate.view_cli`` and Python through
-``liganimate.api``.  See ``docs/viewer.md``.
+It is one of the tools, a layer above the runtime core (docs/architecture.md):
+it may import the runtime (pose, values), ``liganimate.runtime.exchange``
+(the collector's results), numpy and the standard library.  Of the rest of
+liganimate only the studio imports it (for ``gl.js``); the runtime core, the
+compiler and the language never do.  The command line reaches it through
+``liganimate.view_cli`` and Python through ``liganimate.api``.  See
+``docs/viewer.md``.
 """
 
 from ._html import asset, fill, iframe, inline_code, json_for_script, viewer_html

@@ -1,36 +1,80 @@
-"""The Python entry point: ``liganimate.load("scene.lig").view()``.
+"""The Python API: ``liganimate.load("scene.lig")``, then ``.render()``, ``.export()``, ``.view()``.
 
-:func:`load` compiles a program (a file or its text) the way ``liganimate
-run`` does; the :class:`LoadedProgram` it returns runs the scenes once
-without drawing them and shows them in the browser viewer.  In Jupyter,
-a loaded program, or the :class:`View` of one of its scenes, displays as
-the viewer itself (``_repr_html_``), in a sandboxed frame.
+:func:`load` compiles a program file and :func:`loads` a program's text, the
+way ``liganimate run`` does; the :class:`LoadedProgram` they return checks
+the program (:meth:`~LoadedProgram.check`), draws its scenes to files with
+the command line's options (:meth:`~LoadedProgram.render`, through one
+:class:`RenderOptions`), writes them in an exchange format
+(:meth:`~LoadedProgram.export`, through the same table as ``liganimate
+export``), and shows them in the browser viewer (:meth:`~LoadedProgram.view`).
+In Jupyter, a loaded program, or the :class:`View` of one of its scenes,
+displays as the viewer itself (``_repr_html_``), in a sandboxed frame.
+
+Everything wrong with a program or an option raises one exception type,
+:class:`LigProgramError`.  Loading leaves the calling process as it was:
+the garbage collector is paused while a program compiles and restored
+after (only the command line also freezes what survives).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
-import warnings
-from typing import TYPE_CHECKING, Any, NoReturn
+import warnings as _warnings
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
 
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, format_diagnostic
+from liganimate.runtime.errors import LigError
 
 if TYPE_CHECKING:
-    from liganimate.runtime.exchange import SceneTake
+    from liganimate.runtime.exchange import ModelTake, SceneTake
     from liganimate.runtime.host import Program
+    from liganimate.runtime.render.options import RenderOptions
 
-__all__ = ["LigProgramError", "LoadedProgram", "View", "load"]
+__all__ = ["LigProgramError", "LoadedProgram", "ModelTake", "RenderOptions", "SceneTake", "View", "load", "loads"]
 
 
-class LigProgramError(LigDiagnostics):
-    """A program that does not compile or run; ``str()`` is the diagnostics as the command line prints them."""
+class LigProgramError(LigDiagnostics, ValueError):
+    """What the API raises for a program that does not compile or run, or an option it cannot honour.
+
+    ``str()`` is what the command line prints: the diagnostics
+    (``file:line:col``, the line, a caret, a sentence, a hint), or the one
+    sentence and its hint when the problem has no place in the program (a
+    frame rate out of range, an output file in a missing folder).
+
+    Attributes
+    ----------
+    diagnostics : list of Diagnostic
+        The program's errors, each at its place; empty for an option's.
+    message : str
+        The first (or only) sentence.
+    hint : str or None
+        How to fix it, when there is one sentence and no diagnostics.
+    """
+
+    def __init__(self, diagnostics: list[Diagnostic], message: str | None = None, hint: str | None = None) -> None:
+        super().__init__(diagnostics)
+        self.message = message if message is not None else "; ".join(d.message for d in diagnostics)
+        self.hint = hint
 
     def __str__(self) -> str:
-        return "\n".join(format_diagnostic(d) for d in self.diagnostics)
+        if self.diagnostics:
+            return "\n".join(format_diagnostic(d) for d in self.diagnostics)
+        return self.message + (f"\n  hint: {self.hint}" if self.hint else "")
 
 
-def _reraise(exc: LigDiagnostics) -> NoReturn:
-    raise LigProgramError(exc.diagnostics) from None
+@contextlib.contextmanager
+def _program_errors() -> Iterator[None]:
+    """Turn the compiler's and the runtime's exceptions into :class:`LigProgramError`."""
+    try:
+        yield
+    except LigProgramError:
+        raise
+    except LigDiagnostics as exc:
+        raise LigProgramError(exc.diagnostics) from None
+    except LigError as exc:
+        raise LigProgramError([], exc.message, exc.hint) from None
 
 
 class View:
@@ -40,6 +84,8 @@ class View:
     ----------
     html : str
         The complete, self-contained HTML document (what ``liganimate view`` writes).
+    height : int
+        The height in pixels of the notebook's frame.
     """
 
     def __init__(self, html: str, height: int = 560) -> None:
@@ -56,7 +102,8 @@ class View:
     def _repr_html_(self) -> str:
         from liganimate.runtime.view import iframe
 
-        return iframe(self.html, self.height)
+        frame: str = iframe(self.html, self.height)
+        return frame
 
 
 class LoadedProgram:
@@ -65,9 +112,9 @@ class LoadedProgram:
     Attributes
     ----------
     name : str
-        The file name, or ``"<text>"``.
+        The file name, or the name given to :func:`loads` (``"<text>"``).
     program : liganimate.runtime.host.Program
-        The compiled program (``check``, ``execute``, ``render``).
+        The compiled program, as the command line runs it.
     warnings : list of Diagnostic
         The compiler's warnings.
     """
@@ -79,7 +126,14 @@ class LoadedProgram:
         self._scenes: list[SceneTake] | None = None
 
     def scenes(self) -> list[SceneTake]:
-        """Run the program once without drawing; its shot scenes (``SceneTake``), cached.
+        """Run the program once without drawing; its shot scenes, cached.
+
+        Returns
+        -------
+        list of SceneTake
+            One per shot scene: its identifier, camera and the models it
+            draws (:class:`ModelTake`: the joint angles and placements at
+            each tick, as ``--poses`` records them).
 
         Raises
         ------
@@ -89,35 +143,67 @@ class LoadedProgram:
         if self._scenes is None:
             from liganimate.runtime.exchange import collect
 
-            try:
-                scenes = collect(self.program)
-            except LigDiagnostics as exc:
-                _reraise(exc)
-            self._scenes = scenes
+            with _program_errors():
+                self._scenes = collect(self.program)
         return self._scenes
 
-    def view(self, scene: int | None = None, height: int = 560) -> View:
-        """The viewer for every scene, or for the scene whose identifier is ``scene``.
+    def _shot(self, doing: str) -> list[SceneTake]:
+        takes = self.scenes()
+        if not takes:
+            raise LigProgramError(
+                [],
+                f"the program shoots no scene, so there is nothing to {doing}",
+                "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES",
+            )
+        return takes
+
+    def check(self) -> list[Diagnostic]:
+        """Run every statement and every scene tick without drawing, as ``liganimate check`` does.
+
+        Returns
+        -------
+        list of Diagnostic
+            The warnings of the run (the compiler's are in :attr:`warnings`).
 
         Raises
         ------
         LigProgramError
             When the program fails while it runs.
-        ValueError
-            When the program shoots no scene, or none with that identifier.
         """
-        from liganimate.runtime.view import viewer_html
+        with _program_errors():
+            return list(self.program.check())
 
-        takes = self.scenes()
-        if scene is not None:
-            takes = [t for t in takes if t.id == scene]
-            if not takes:
-                shot = ", ".join(str(t.id) for t in self.scenes()) or "none"
-                raise ValueError(f"the program shoots no scene {scene!r} (it shoots: {shot})")
-        if not takes:
-            raise ValueError("the program shoots no scene, so there is nothing to view")
-        title = os.path.basename(self.name) + ("" if scene is None else f", scene {scene}")
-        return View(viewer_html(takes, title), height)
+    def render(
+        self, out: str | os.PathLike[str] | None = None, *, options: RenderOptions | None = None, **fields: Any
+    ) -> None:
+        """Check the program, then draw its scenes to files, as ``liganimate run`` does.
+
+        Parameters
+        ----------
+        out : str or os.PathLike, optional
+            The folder for the PNG frames (``out/scene<ID>/<NNNNN>.png``);
+            None writes only the movies asked for.
+        options : RenderOptions, optional
+            What to write and how, as one value; ``out`` and ``fields`` replace its values.
+        **fields
+            Fields of :class:`liganimate.RenderOptions`, as the command
+            line's options: ``size=(640, 480)``, ``gif=``, ``mp4=``,
+            ``poses=``, ``fps=``, ``aa=``, ``look=`` (``"modern"``, the
+            default, or ``"thesis"``), ``crf=``, ``preset=``,
+            ``workers=``, ``scheduler=``, ``quiet=``.
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs, or an option cannot be
+            honoured (nothing is written then), or nothing would be written.
+        TypeError
+            When a keyword is not a field of :class:`RenderOptions`.
+        """
+        if out is not None:
+            fields["out"] = os.fspath(out)
+        with _program_errors():
+            self.program.render(options=options, **fields)
 
     def export(self, path: str | os.PathLike[str], **options: Any) -> list[str]:
         """Write the scenes' models and motion in the format ``path``'s extension chooses.
@@ -144,23 +230,40 @@ class LoadedProgram:
         Raises
         ------
         LigProgramError
-            When the program fails while it runs.
-        ValueError
-            When the extension names no format, an option does not apply to
-            it or is out of range, or the program shoots no scene.
+            When the program fails while it runs or shoots no scene, the
+            extension names no format, or an option does not apply to it or
+            is out of range.
         """
         from liganimate.runtime.exchange import export_format, export_options, write_files
 
-        fmt = export_format(path)
-        checked = export_options(fmt, options)
-        takes = self.scenes()
-        if not takes:
-            raise ValueError("the program shoots no scene, so there is nothing to export")
-        written = fmt.write(takes, os.fspath(path), **checked)
+        with _program_errors():
+            fmt = export_format(path)
+            checked = export_options(fmt, options)
+            written = fmt.write(self._shot("export"), os.fspath(path), **checked)
         for note in written.warnings:
-            warnings.warn(note, UserWarning, stacklevel=2)
+            _warnings.warn(note, UserWarning, stacklevel=2)
         write_files(written.files)
         return [p for p, _ in written.files]
+
+    def view(self, scene: int | None = None, height: int = 560) -> View:
+        """The viewer for every scene, or for the scene whose identifier is ``scene``.
+
+        Raises
+        ------
+        LigProgramError
+            When the program fails while it runs, shoots no scene, or none
+            with that identifier.
+        """
+        from liganimate.runtime.view import viewer_html
+
+        takes = self._shot("view")
+        if scene is not None:
+            takes = [t for t in takes if t.id == scene]
+            if not takes:
+                shot = ", ".join(str(t.id) for t in self.scenes())
+                raise LigProgramError([], f"the program shoots no scene {scene!r} (it shoots: {shot})")
+        title = os.path.basename(self.name) + ("" if scene is None else f", scene {scene}")
+        return View(viewer_html(takes, title), height)
 
     def _repr_html_(self) -> str:
         return self.view()._repr_html_()
@@ -169,15 +272,13 @@ class LoadedProgram:
         return f"<liganimate program {self.name!r}>"
 
 
-def load(path_or_text: str | os.PathLike[str]) -> LoadedProgram:
-    """Compile a LIG ANIMATE program from a file or from its text.
+def load(path: str | os.PathLike[str]) -> LoadedProgram:
+    """Compile the LIG ANIMATE program in a file.
 
     Parameters
     ----------
-    path_or_text : str or os.PathLike
-        A path (a path object, a string naming an existing file, or a
-        one-line string ending in ``.lig``), or otherwise the program text
-        itself; a text's relative LOADs start from the current folder.
+    path : str or os.PathLike
+        The program's file; its relative LOADs start from its folder.
 
     Returns
     -------
@@ -189,21 +290,59 @@ def load(path_or_text: str | os.PathLike[str]) -> LoadedProgram:
         When the program does not compile (its ``str()`` is the diagnostics).
     OSError
         When the file cannot be read.
+    TypeError
+        When ``path`` is not a path (program text goes to :func:`loads`).
     """
     from liganimate.compiler import load_program
 
-    path: str | None
-    text: str | None
-    if isinstance(path_or_text, os.PathLike):
-        path, text = os.fspath(path_or_text), None
-    elif not isinstance(path_or_text, str):
-        raise TypeError(f"load() takes a path or the program's text, not {type(path_or_text).__name__}")
-    elif "\n" not in path_or_text and (path_or_text.lower().endswith(".lig") or os.path.isfile(path_or_text)):
-        path, text = path_or_text, None
-    else:
-        path, text = None, path_or_text
-    try:
-        program, warnings = load_program(path, text=text)
-    except LigDiagnostics as exc:
-        _reraise(exc)
-    return LoadedProgram(path if path is not None else "<text>", program, warnings)
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"load() takes a path, not {type(path).__name__}")
+    name = os.fspath(path)
+    if not isinstance(name, str) or "\n" in name:
+        raise TypeError("load() takes a file's path; give a program's text to liganimate.loads()")
+    with _program_errors():
+        program, warnings = load_program(name)
+    return LoadedProgram(name, program, warnings)
+
+
+def loads(text: str, name: str = "<text>") -> LoadedProgram:
+    """Compile a LIG ANIMATE program from its text.
+
+    Parameters
+    ----------
+    text : str
+        The program; its relative LOADs start from the current folder.
+    name : str, optional
+        What diagnostics call it (default ``"<text>"``).
+
+    Returns
+    -------
+    LoadedProgram
+
+    Raises
+    ------
+    LigProgramError
+        When the program does not compile (its ``str()`` is the diagnostics).
+    TypeError
+        When ``text`` is not a string.
+    """
+    from liganimate.compiler import load_program
+
+    if not isinstance(text, str):
+        raise TypeError(f"loads() takes the program's text as a str, not {type(text).__name__}")
+    with _program_errors():
+        program, warnings = load_program(None, text=text, name=name)
+    return LoadedProgram(name, program, warnings)
+
+
+def __getattr__(name: str) -> Any:
+    # The public value types, from the packages that own them, imported on first use.
+    if name == "RenderOptions":
+        from liganimate.runtime.render.options import RenderOptions
+
+        return RenderOptions
+    if name in ("SceneTake", "ModelTake"):
+        from liganimate.runtime import exchange
+
+        return getattr(exchange, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

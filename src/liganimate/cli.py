@@ -4,7 +4,7 @@ Every user error is printed as a diagnostic (``file:line:col``, the line, a
 caret, a sentence, a hint) and the command exits with status 1; no Python
 traceback reaches the user, and nothing is written when a program is wrong.
 Output options (``-o``, ``--gif``, ``--mp4``, ``--poses``, ``--fps``,
-``--aa``, ``--crf``, ``--preset``, ``--scheduler``) are checked before the
+``--aa``, ``--look``, ``--crf``, ``--preset``, ``--scheduler``) are checked before the
 program is compiled.  SIGINT and SIGTERM stop a command
 cleanly (exit status 130 and 143), leaving only whole files.
 """
@@ -43,7 +43,7 @@ def _size(text: str):
         raise argparse.ArgumentTypeError(f"{text!r} is not a size like 640x480") from None
 
 
-def _lig_name(text: str) -> str:
+def lig_name(text: str) -> str:
     """An option that names a MODEL or MOTION a tool writes: a name a program may define (compiler/names.py)."""
     from liganimate.compiler.names import definable
 
@@ -54,7 +54,7 @@ def _lig_name(text: str) -> str:
     return text.upper()
 
 
-def _shot_scenes(path: str, doing: str) -> list:
+def shot_scenes(path: str, doing: str) -> list:
     """The scenes the program at ``path`` shoots, its warnings printed; an error when it shoots none.
 
     ``doing`` finishes the sentence "there is nothing to ..." (export, view).
@@ -83,15 +83,17 @@ def load_program(path: str):
 
 
 def _add_render_options(p: argparse.ArgumentParser) -> None:
+    from liganimate.runtime.render.options import MOVIES
+
     p.add_argument(
         "-o",
         "--out",
         metavar="DIR",
-        help="folder for the PNG frames (default: <stem>_frames, or none when --gif or --mp4 is given)",
+        help="folder for the PNG frames (default: <stem>_frames, or none when a movie is asked for)",
     )
     p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="image size (default 640x480)")
-    p.add_argument("--gif", metavar="FILE", help="write an animated GIF")
-    p.add_argument("--mp4", metavar="FILE", help="write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)")
+    for movie in MOVIES:
+        p.add_argument("--" + movie.name, metavar="FILE", help=movie.help)
     p.add_argument(
         "--crf",
         default=None,
@@ -110,6 +112,12 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
         "--aa", default="1", metavar="N", help="anti-aliasing: draw N times finer and average, 1 to 8 (default 1, off)"
     )
     p.add_argument(
+        "--look",
+        default=None,
+        metavar="NAME",
+        help="modern (default: lit, outlined, shadowed, smooth edges) or thesis (flat shades on white, as in the thesis)",
+    )
+    p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
         default=None,
@@ -118,37 +126,27 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
-def _check_render_options(args, stem: str) -> str:
-    """Refuse output options that cannot be honoured, before compiling; return the frames folder (or None).
+def _render_options(args, stem: str):
+    """The command line's RenderOptions, checked before compiling (nothing is written here).
 
-    Nothing is written here: the folder and lock files are made when
-    rendering starts.  An output another run is writing is refused now too.
+    The folder and lock files are made when rendering starts; an output
+    another run is writing is refused now too.
     """
-    from liganimate.runtime.errors import RenderError
-    from liganimate.runtime.render.frames import check_aa
-    from liganimate.runtime.render.outputs import (
-        CLI_NAMES,
-        check_fps,
-        check_outputs,
-        refuse_if_locked,
-    )
-    from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, check_crf, check_preset, find_ffmpeg
+    import dataclasses
 
+    from liganimate.runtime.render.options import CLI_NAMES, MOVIES, RenderOptions, checked
+    from liganimate.runtime.render.outputs import refuse_if_locked
+
+    given = {f.name: getattr(args, f.name) for f in dataclasses.fields(RenderOptions) if hasattr(args, f.name)}
+    given = {k: v for k, v in given.items() if v is not None}
     # A movie alone writes no PNG frames; -o adds them.
-    out = args.out if args.out is not None or args.gif or args.mp4 else f"{stem}_frames"
-    args.fps = check_fps(args.fps, "--fps")
-    args.aa = check_aa(args.aa, "--aa")
-    args.crf = check_crf(args.crf if args.crf is not None else DEFAULT_CRF, "--crf")
-    args.preset = check_preset(args.preset if args.preset is not None else DEFAULT_PRESET, "--preset")
+    if args.out is None and not any(getattr(args, m.name) for m in MOVIES):
+        given["out"] = f"{stem}_frames"
     if args.scheduler is None:
-        args.scheduler = os.environ.get("LIGANIMATE_SCHEDULER") or None
-    if args.scheduler is not None and not args.scheduler.strip():
-        raise RenderError("--scheduler is empty; give the address of a Dask scheduler, like tcp://host:8786")
-    check_outputs(out, args.gif, args.mp4, args.poses, args.fps, CLI_NAMES)
-    if args.mp4:
-        find_ffmpeg()
-    refuse_if_locked(out, (args.gif, args.mp4, args.poses))
-    return out
+        given["scheduler"] = os.environ.get("LIGANIMATE_SCHEDULER") or None
+    options = checked(RenderOptions(**given), CLI_NAMES)
+    refuse_if_locked(options.out, options.files())
+    return options
 
 
 class _CheckProgress:
@@ -187,36 +185,21 @@ def _checked(program, quiet: bool, stdout=None) -> list:
             progress.done()
 
 
-def _render(program, warnings, args, out: str) -> int:
+def _render(program, warnings, options) -> int:
+    from liganimate.runtime.render.options import MOVIES
+
     _print_diagnostics(warnings)
-    warnings_run = _checked(program, args.quiet)
+    warnings_run = _checked(program, options.quiet)
     _print_diagnostics(warnings_run)
-    options = dict(size=args.size, gif=args.gif, mp4=args.mp4, poses=args.poses, fps=args.fps, quiet=args.quiet)
-    options.update(aa=args.aa, crf=args.crf, preset=args.preset)
-    if args.scheduler is not None:
-        options["executor"] = _dask_executor(args.scheduler)
-    program.render(out, checked=True, **options)
-    if not args.quiet:
-        written = [f"frames written to {out}"] if out is not None else []
-        written += [f"{what} written to {path}" for what, path in (("GIF", args.gif), ("MP4", args.mp4)) if path]
+    program.render(checked=True, options=options)
+    if not options.quiet:
+        written = [f"frames written to {options.out}"] if options.out is not None else []
+        written += [f"{m.label} written to {path}" for m in MOVIES if (path := getattr(options, m.name))]
         sys.stderr.write("; ".join(written) + "\n")
     return 0
 
 
-def _dask_executor(address: str):
-    """A DaskExecutor on ``address``; Dask is imported here only, never for a local run."""
-    from liganimate.runtime.errors import RenderError
-
-    try:
-        from liganimate.runtime.render.distributed import DaskExecutor
-    except ImportError as exc:
-        if exc.name is not None and exc.name.split(".")[0] not in ("dask", "distributed", "liganimate"):
-            raise  # a bug in a module that is installed: the internal-error report names it
-        raise RenderError("Dask is not installed: pip install 'liganimate[dask]'") from None
-    return DaskExecutor(address)
-
-
-def _guarded(fn):
+def guarded(fn):
     """Run a command, turning diagnostics into exit status 1 and bugs into a short report.
 
     KeyboardInterrupt (and :class:`~liganimate.runtime.interrupts.Interrupted`)
@@ -295,11 +278,11 @@ def _stoppable(fn, whole_process: bool) -> int:
 def cmd_run(args) -> int:
     def go():
         stem = os.path.splitext(os.path.basename(args.file))[0]
-        out = _check_render_options(args, stem)
+        options = _render_options(args, stem)
         program, warnings = load_program(args.file)
-        return _render(program, warnings, args, out)
+        return _render(program, warnings, options)
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_check(args) -> int:
@@ -309,7 +292,7 @@ def cmd_check(args) -> int:
         _print_diagnostics(_checked(program, False, stdout=sys.stdout))
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_compile(args) -> int:
@@ -324,7 +307,7 @@ def cmd_compile(args) -> int:
             fh.write(compiled.python.encode("utf-8"))
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_archive(args) -> int:
@@ -343,7 +326,7 @@ def cmd_archive(args) -> int:
         print(f"wrote {out}", file=sys.stderr)
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_lib(args) -> int:
@@ -369,7 +352,7 @@ def cmd_lib(args) -> int:
                 print(f"  {n:<{width}}  {kind:<9}  {lib.descriptions.get(n, '(no description)')}")
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_plot(args) -> int:
@@ -384,7 +367,14 @@ def cmd_plot(args) -> int:
         plot_motion(rt, name, out)
         return 0
 
-    return _guarded(go)
+    return guarded(go)
+
+
+def cmd_lsp(args) -> int:
+    """``liganimate lsp``: the language server, over stdin and stdout, until the editor says exit."""
+    from liganimate.lsp import main as serve
+
+    return serve()
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -418,15 +408,24 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE.png")
     p.set_defaults(func=cmd_plot)
     # Export/import and the browser tools register their own subcommands.
-    from liganimate import exchange_cli, view_cli
+    from liganimate import exchange_cli, fmt_cli, view_cli
 
     exchange_cli.add_commands(sub)
     view_cli.add_commands(sub)
+    fmt_cli.add_commands(sub)
+    p = sub.add_parser("lsp", help="serve the LIG language to an editor (the Language Server Protocol, over stdio)")
+    p.set_defaults(func=cmd_lsp)
     return parser
 
 
 def main(argv=None) -> int:
     """Entry point of the ``liganimate`` command."""
+    if argv is None:
+        # This process is the command's own: freeze each compile's survivors
+        # (lang/collector.py). Never done for a library user's process.
+        from liganimate.lang import collector
+
+        collector.freeze_survivors()
 
     def go():
         args = build_parser().parse_args(argv)
@@ -443,6 +442,6 @@ def run_program_cli(program, argv=None) -> int:
     def go():
         args = parser.parse_args(argv)
         stem = os.path.splitext(os.path.basename(program.name))[0]
-        return _guarded(lambda: _render(program, [], args, _check_render_options(args, stem)))
+        return guarded(lambda: _render(program, [], _render_options(args, stem)))
 
     return _stoppable(go, argv is None)

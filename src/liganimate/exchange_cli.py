@@ -36,9 +36,31 @@ def _degrees(text: str) -> float:
     return value
 
 
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of frames per second") from None
+    if not (0 < value < 1e6):
+        raise argparse.ArgumentTypeError(f"the frame rate must be a positive number, not {text}")
+    return value
+
+
+def _frame_range(text: str) -> tuple:
+    first, sep, last = text.partition(":")
+    try:
+        a = int(first) if first.strip() else 0
+        b = int(last) if last.strip() else None
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a range of frames such as 100:399") from None
+    if not sep or a < 0 or (b is not None and b < a):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a range of frames A:B with 0 <= A <= B")
+    return a, b
+
+
 def add_commands(subparsers) -> None:
     """Add ``export`` and ``import`` to the ``liganimate`` command's subparsers."""
-    from liganimate.cli import _lig_name
+    from liganimate.cli import lig_name
     from liganimate.runtime import exchange as X
 
     formats = X.EXPORT_FORMATS
@@ -73,14 +95,14 @@ def add_commands(subparsers) -> None:
     p.set_defaults(func=cmd_export)
     p = subparsers.add_parser(
         "import",
-        help="turn a BVH capture into a LIG library (a MODEL and a MOTION)",
-        description="Write a library file that LOAD takes, with the capture's skeleton as "
-        "a MODEL and its frames as a MOTION (see docs/exchange.md).",
+        help="turn a BVH capture (a MODEL and a MOTION) or a URDF robot (a MODEL) into a LIG library",
+        description="Write a library file that LOAD takes: from a BVH file, the capture's skeleton as "
+        "a MODEL and its frames as a MOTION; from a URDF file, the robot as a MODEL (see docs/exchange.md).",
     )
-    p.add_argument("file", metavar="FILE.bvh")
+    p.add_argument("file", metavar="FILE.bvh|FILE.urdf")
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
-    p.add_argument("--model", type=_lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
-    p.add_argument("--motion", type=_lig_name, help="the MOTION's name (default: <STEM>)")
+    p.add_argument("--model", type=lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
+    p.add_argument("--motion", type=lig_name, help="the MOTION's name (default: <STEM>)")
     p.add_argument(
         "--tolerance",
         type=_degrees,
@@ -88,13 +110,82 @@ def add_commands(subparsers) -> None:
         metavar="DEG",
         help="drop keyframes while every angle stays within DEG degrees (default 0: every frame)",
     )
+    p.add_argument(
+        "--joint-translation",
+        choices=("error", "drop"),
+        default="error",
+        help="joints other than the ROOT that slide: refuse the file (error, the default) or keep each "
+        "at its first frame's offset (drop); position channels that hold still are always dropped, with a note",
+    )
+    p.add_argument("--frames", type=_frame_range, metavar="A:B", help="import frames A to B only (inclusive)")
+    p.add_argument("--fps", type=_rate, metavar="N", help="resample the capture to N frames per second")
+    p.add_argument(
+        "--onto",
+        metavar="LIBRARY",
+        help="retarget the capture onto a figure of this library (a standard library's name, or FILE.lig); "
+        "the output then holds only the MOTION",
+    )
+    p.add_argument("--onto-model", type=lig_name, metavar="NAME", help="the model of --onto's library")
+    p.add_argument("--map", metavar="FILE", help="joint map for --onto: 'capture joint = figure link' lines")
+    p.add_argument("--scale", type=_rate, metavar="R", help="with --onto: scale the capture's lengths by R")
+    p.add_argument(
+        "--mesh-triangles",
+        type=_count,
+        default=None,
+        metavar="N",
+        help="URDF: thin each mesh to at most N triangles (default 1500)",
+    )
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
     p.set_defaults(func=cmd_import)
 
 
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 4 <= value <= 100000:
+        raise argparse.ArgumentTypeError("give 4 to 100000 triangles")
+    return value
+
+
+def _import_urdf(args) -> int:
+    """``liganimate import FILE.urdf -o OUT.lig [--model NAME]``: the robot as a MODEL."""
+    from liganimate.runtime import exchange as X
+    from liganimate.runtime.errors import LigError
+
+    for flag, value in (
+        ("--motion", args.motion),
+        ("--frames", args.frames),
+        ("--fps", args.fps),
+        ("--tolerance", args.tolerance or None),
+        ("--joint-translation", None if args.joint_translation == "error" else args.joint_translation),
+        ("--onto", args.onto),
+        ("--map", args.map),
+    ):
+        if value is not None:
+            raise LigError(f"{flag} applies to BVH captures; a URDF file holds a robot, not a motion.")
+    stem = os.path.splitext(os.path.basename(args.file))[0]
+    out = args.output or f"{stem}.lig"
+    robot = X.read_urdf(args.file)
+    model = args.model or X.robot_model_name(robot)
+    options = X.UrdfImportOptions(
+        model=model,
+        source_name=os.path.basename(args.file),
+        mesh_triangles=args.mesh_triangles or X.MESH_TRIANGLES,
+    )
+    text, notes = X.import_urdf(robot, options)
+    X.write_files([(out, text)])
+    for note in notes:
+        sys.stderr.write(f"liganimate: note: {note}\n")
+    if not args.quiet:
+        sys.stderr.write(f"wrote {out}: MODEL {model} ({len(robot.links)} links, {len(robot.joints)} joints)\n")
+    return 0
+
+
 def cmd_export(args) -> int:
     """``liganimate export FILE -o OUT``."""
-    from liganimate.cli import _guarded, _shot_scenes
+    from liganimate.cli import guarded, shot_scenes
 
     def go():
         from liganimate.runtime import exchange as X
@@ -102,7 +193,7 @@ def cmd_export(args) -> int:
         # The format and its options are checked before the program runs.
         fmt = X.export_format(args.output)
         options = X.export_options(fmt, {o: getattr(args, "export_" + o) for o in X.EXPORT_OPTIONS})
-        scenes = _shot_scenes(args.file, "export")
+        scenes = shot_scenes(args.file, "export")
         export = fmt.write(scenes, args.output, **options)
         for note in export.warnings:
             sys.stderr.write(f"liganimate: warning: {note}\n")
@@ -113,16 +204,22 @@ def cmd_export(args) -> int:
                 sys.stderr.write(f"wrote {path}\n")
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_import(args) -> int:
     """``liganimate import FILE.bvh -o OUT.lig``."""
-    from liganimate.cli import _guarded
+    from liganimate.cli import guarded
 
     def go():
         from liganimate.runtime import exchange as X
 
+        if args.file.lower().endswith(".urdf"):
+            return _import_urdf(args)
+        if args.mesh_triangles is not None:
+            from liganimate.runtime.errors import LigError
+
+            raise LigError("--mesh-triangles applies to URDF robots, not BVH captures.")
         stem = os.path.splitext(os.path.basename(args.file))[0]
         base = re.sub(r"[^A-Za-z0-9_]", "_", stem).upper().strip("_") or "CAPTURE"
         if not base[0].isalpha():
@@ -138,10 +235,27 @@ def cmd_import(args) -> int:
             )
         out = args.output or f"{stem}.lig"
         clip = X.read_bvh(args.file)
-        text = X.lig_library(
-            clip, model=model, motion=motion, source_name=os.path.basename(args.file), tolerance=args.tolerance
+        if args.frames is not None:
+            clip = X.cut_frames(clip, *args.frames)
+        if args.fps is not None:
+            clip = X.resample(clip, args.fps)
+        if args.onto is not None:
+            return _retarget(args, X, clip, out, base)
+        if args.onto_model or args.map or args.scale:
+            from liganimate.runtime.errors import LigError
+
+            raise LigError("--onto-model, --map and --scale go with --onto.", "add --onto LIBRARY")
+        options = X.ImportOptions(
+            model=model,
+            motion=motion,
+            source_name=os.path.basename(args.file),
+            tolerance=args.tolerance,
+            joint_translation=args.joint_translation,
         )
+        text, notes = X.import_library(clip, options)
         X.write_files([(out, text)])
+        for note in notes:
+            sys.stderr.write(f"liganimate: note: {note}\n")
         if not args.quiet:
             sys.stderr.write(
                 f"wrote {out}: MODEL {model} and MOTION {motion} "
@@ -149,4 +263,24 @@ def cmd_import(args) -> int:
             )
         return 0
 
-    return _guarded(go)
+    return guarded(go)
+
+
+def _retarget(args, X, clip, out: str, base: str) -> int:
+    """``import --onto``: write the retargeted MOTION and print the report."""
+    options = X.OntoOptions(
+        library=args.onto,
+        model=args.onto_model,
+        map_file=args.map,
+        motion=args.motion or base,
+        source_name=os.path.basename(args.file),
+        retarget=X.RetargetOptions(scale=args.scale, joint_translation=args.joint_translation),
+        tolerance=args.tolerance,
+    )
+    text, report, _ = X.retarget_library(clip, options)
+    X.write_files([(out, text)])
+    if not args.quiet:
+        for line in report:
+            sys.stderr.write(line + "\n")
+        sys.stderr.write(f"wrote {out}: MOTION {options.motion} ({clip.data.shape[0]} frames)\n")
+    return 0

@@ -39,7 +39,7 @@ def _frames(text: str) -> int:
 
 def add_commands(subparsers) -> None:
     """Add ``view`` and ``studio`` to the ``liganimate`` command's subparsers."""
-    from liganimate.cli import _lig_name
+    from liganimate.cli import lig_name
 
     p = subparsers.add_parser(
         "view",
@@ -58,9 +58,9 @@ def add_commands(subparsers) -> None:
         "posing figures with interactive genetic algorithms (see docs/viewer.md).",
     )
     p.add_argument("file", nargs="?", help="a program whose model to pose (default: the standard library)")
-    p.add_argument("--model", type=_lig_name, help="the MODEL to pose (default HUMANOID, or the file's only model)")
+    p.add_argument("--model", type=lig_name, help="the MODEL to pose (default HUMANOID, or the file's only model)")
     p.add_argument("--save", metavar="LIB.lig", help="the library Save writes (default: <model>_poses.lig)")
-    p.add_argument("--motion", type=_lig_name, default="POSES", help="the saved MOTION's name (default POSES)")
+    p.add_argument("--motion", type=lig_name, default="POSES", help="the saved MOTION's name (default POSES)")
     p.add_argument(
         "--frames",
         type=_frames,
@@ -77,14 +77,14 @@ def add_commands(subparsers) -> None:
 
 def cmd_view(args) -> int:
     """``liganimate view FILE [-o OUT.html]``."""
-    from liganimate.cli import _guarded, _shot_scenes
+    from liganimate.cli import guarded, shot_scenes
 
     def go():
         from liganimate.runtime import exchange as X
         from liganimate.runtime.view import viewer_html
 
         out = args.output or os.path.splitext(os.path.basename(args.file))[0] + ".html"
-        scenes = _shot_scenes(args.file, "view")
+        scenes = shot_scenes(args.file, "view")
         page = viewer_html(scenes, os.path.basename(args.file)).encode("utf-8")
         X.write_files([(out, page)])
         if not args.quiet:
@@ -92,12 +92,12 @@ def cmd_view(args) -> int:
             sys.stderr.write(f"wrote {out} ({size}, {len(scenes)} scene(s))\n")
         return 0
 
-    return _guarded(go)
+    return guarded(go)
 
 
 def cmd_studio(args) -> int:
     """``liganimate studio [FILE] [--model NAME] ...``: serve until Ctrl-C."""
-    from liganimate.cli import _guarded
+    from liganimate.cli import guarded
 
     def go():
         import secrets
@@ -138,4 +138,4 @@ def cmd_studio(args) -> int:
             print("\nliganimate studio: stopped", flush=True)
         return 0
 
-    return _guarded(go)
+    return guarded(go)

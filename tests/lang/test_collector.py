@@ -32,10 +32,12 @@ def test_a_disabled_collector_stays_disabled():
         gc.enable()
 
 
-def test_survivors_are_frozen_and_a_cycle_among_them_is_collected_once_unfrozen():
+def test_survivors_are_frozen_and_a_cycle_among_them_is_collected_once_unfrozen(monkeypatch):
     class Node:
         pass
 
+    monkeypatch.setattr(collector, "_freezing", False)
+    collector.freeze_survivors()  # as the command line does
     with collector.paused():
         a, b = Node(), Node()
         a.other, b.other = b, a
@@ -49,3 +51,14 @@ def test_survivors_are_frozen_and_a_cycle_among_them_is_collected_once_unfrozen(
     gc.unfreeze()
     gc.collect()
     assert ref() is None
+
+
+def test_a_library_user_s_process_is_never_frozen(monkeypatch):
+    # liganimate.load in a notebook: the user's objects must stay collectable.
+    import liganimate
+
+    monkeypatch.setattr(collector, "_freezing", False)
+    gc.unfreeze()
+    was_on = gc.isenabled()
+    liganimate.loads("      X = 1\n")
+    assert gc.get_freeze_count() == 0 and gc.isenabled() == was_on

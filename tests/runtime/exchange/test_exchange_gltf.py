@@ -9,105 +9,38 @@ import sys
 import numpy as np
 import pytest
 from exchange_support import (
+    EDGES,
+    PROGRAMS,
+    WALKING_HUMANOID,
     load_gltf,
     pose_records,
+    program_named,
     sample_channels,
     segment_nodes,
     validate,
     world_transforms,
 )
-from paths import ROOT_DIR
 
-from liganimate.cli import load_program
 from liganimate.runtime import exchange as X
 
-ROOT = ROOT_DIR
 FPS = 24.0
 
-# Two scenes: a figure scaled unevenly, turned and moved every tick, with a
-# clamped joint and a free axis; a mirrored copy re-rooted at its forearm
-# that is drawn only from tick 3 to 8; a camera that follows; a second scene
-# with SAMEFRAME 2 (STEP sampling).
-EDGES = """\
-      GRAPHICAL A, B, C, FLOOR
-      MODEL ARM, MIRROR
-      MOTION SWING
-      VECTOR P
-      A :- BOX WIDTH 0.2, HEIGHT 1.0, DEPTH 0.2, LIGHTNESS 30.0
-      B :- BOX WIDTH 0.15, HEIGHT 0.8, DEPTH 0.15, LIGHTNESS 60.0
-      C :- BOX WIDTH 0.3, HEIGHT 0.1, DEPTH 0.3
-      ARM :- JOINT 1, A, (0.0, 0.5, 0.0), B, (0.0, -0.4, 0.0), (-90.0, 90.0), (-180.0, 180.0), (-120.0, 120.0)
-      ARM :- JOINT 2, ARM, (0.0, -0.5, 0.0), C, (0.0, 0.05, 0.0), (-30.0, 30.0), (-30.0, 30.0), (-30.0, 30.0)
-      MIRROR :- ARM <SCALE MODEL -0.5>
-      FIGURE MIRROR MAIN JOINT 1
-      STARTMOTION SWING
-        JOINT 1 POSITION 10.0, 20.0, 30.0
-          FRAME 10 POSITION -50.0, 170.0, 100.0 INTERPOLATE ACCDCC
-        JOINT 2 POSITION 0.0, 0.0, 0.0
-          FRAME 10 POSITION 40.0, -40.0, 20.0
-      ENDMOTION
-      FLOOR :- BOX AT (0.0, -1.0, 0.0), WIDTH 4.0, HEIGHT 0.1, DEPTH 4.0
-      INITIALIZE SCENE 1
-        P = (0.0, 0.0, 0.0)
-        BACKGROUND FLOOR
-      STARTSCENE LENGTH 12
-        ANIMATE ARM FROM 0 TO 11 USING SWING
-        ARM :- ARM <SCALE (1.0, 2.0, 1.0)> <ROT Y 30.0> <TRANS (P)>
-        ANIMATE MIRROR FROM 3 TO 8 USING SWING
-        MIRROR :- MIRROR <ROT Z 20.0> <TRANS (1.0, 0.0, 0.0)>
-        P = P + (0.1, 0.05, 0.0)
-        VIEW POINT = (1.0, 2.0, 6.0) + P
-      ENDSCENE
-      INITIALIZE SCENE 2
-      STARTSCENE LENGTH 4 SAMEFRAME 2
-        ANIMATE ARM FROM 0 TO 3 USING SWING <SCALE FRAMES 0.5>
-      ENDSCENE
-      SHOOTSCENES
-"""
 
-WALKING_HUMANOID = """\
-      LOAD HUMANOID, WALK FROM 'humanoid'
-      INITIALIZE SCENE 1
-        VIEW POINT = (0.0, 1.0, 5.0)
-      STARTSCENE LENGTH 30
-        ANIMATE HUMANOID FROM 0 TO 29 USING WALK REPEAT
-C       WALK's ROOT track carries the body forward; the scene places its start.
-        HUMANOID :- HUMANOID <TRANS (-1.0, 0.972, 0.0)>
-      ENDSCENE
-      SHOOTSCENES
-"""
-
-
-def _program(tmp_path, name):
-    if name == "edges":
-        path = tmp_path / "edges.lig"
-        path.write_text(EDGES)
-    elif name == "walking_humanoid":
-        path = tmp_path / "walk.lig"
-        path.write_text(WALKING_HUMANOID)
-    else:
-        path = os.path.join(ROOT, "examples", name + ".lig")
-    program, _ = load_program(str(path))
-    return program
-
-
-PROGRAMS = ["edges", "walking_humanoid", "appendix_a", "rerooting", "big_and_small_robot", "there_and_back"]
-
-
-def _export(program, path):
+def _export(program, path, rig="nodes"):
     scenes = X.collect(program)
-    data, warnings = X.gltf_bytes(scenes, path.endswith(".glb"), fps=FPS)
+    data, warnings = X.gltf_bytes(scenes, path.endswith(".glb"), fps=FPS, rig=rig)
     with open(path, "wb") as fh:
         fh.write(data)
     return scenes, warnings
 
 
+@pytest.mark.parametrize("rig", X.RIGS)
 @pytest.mark.parametrize("name", PROGRAMS)
-def test_validator_reports_no_errors(tmp_path, name):
-    program = _program(tmp_path, name)
+def test_validator_reports_no_errors(tmp_path, name, rig):
+    program = program_named(tmp_path, name)
     paths = [str(tmp_path / f"{name}.glb"), str(tmp_path / f"{name}.gltf")]
     for p in paths:
-        _export(program, p)
+        _export(program, p, rig)
     reports = validate(paths)
     for p in paths:
         issues = reports[p]
@@ -118,7 +51,7 @@ def test_validator_reports_no_errors(tmp_path, name):
 
 def test_validator_catches_a_broken_file(tmp_path):
     """The check can fail: the same export with a POSITION accessor's bounds spoiled is reported."""
-    program = _program(tmp_path, "appendix_a")
+    program = program_named(tmp_path, "appendix_a")
     doc, blob, _ = X.gltf_document(X.collect(program))
     acc = doc.meshes[0].primitives[0].attributes.POSITION
     doc.accessors[acc].max = [v - 1.0 for v in doc.accessors[acc].max]
@@ -132,7 +65,7 @@ def test_validator_catches_a_broken_file(tmp_path):
 @pytest.mark.parametrize("name", PROGRAMS)
 @pytest.mark.parametrize("ext", [".glb", ".gltf"])
 def test_node_world_transforms_equal_the_pose_record(tmp_path, name, ext):
-    program = _program(tmp_path, name)
+    program = program_named(tmp_path, name)
     path = str(tmp_path / f"out{ext}")
     _export(program, path)
     doc, blob = load_gltf(path)
@@ -171,10 +104,10 @@ def test_sampling_is_linear_but_steps_at_sameframe_holds(tmp_path):
     assert {s.interpolation for s in by_name["scene 2"].samplers} == {"STEP"}
 
 
-def _export_and_load(tmp_path, name, ext=".glb"):
-    program = _program(tmp_path, name)
+def _export_and_load(tmp_path, name, ext=".glb", rig="nodes"):
+    program = program_named(tmp_path, name)
     path = str(tmp_path / f"x{ext}")
-    _export(program, path)
+    _export(program, path, rig)
     return load_gltf(path)
 
 
@@ -252,5 +185,47 @@ def test_cli_export_writes_a_valid_glb(tmp_path):
     times = [sampler.input for a in doc.animations for sampler in a.samplers]
     from exchange_support import accessor
 
-    assert accessor(doc, blob, times[0])[-1, 0] == pytest.approx(29 / 30)
+    # Ticks 0..29 at 1/30 s, and the last one held a tick more: the 30-tick scene lasts one second.
+    keys = accessor(doc, blob, times[0])[:, 0]
+    assert keys[-2] == pytest.approx(29 / 30) and keys[-1] == pytest.approx(1.0)
     assert validate([str(out)])[str(out)]["numErrors"] == 0
+
+
+def test_the_skin_rig_has_one_primitive_per_sidedness_and_vertex_colours(tmp_path):
+    """The humanoid's 71 shades are vertex colours of one primitive, not 71 materials."""
+    from exchange_support import accessor
+
+    doc, blob = _export_and_load(tmp_path, "walking_humanoid", rig="skin")
+    assert [m.name for m in doc.materials] == ["vertex colours"]
+    (mesh,) = doc.meshes
+    (prim,) = mesh.primitives
+    colours = accessor(doc, blob, prim.attributes.COLOR_0)
+    # sRGB grey levels back from the linear colours: the renderer's shades of the humanoid's triangles.
+    levels = np.where(colours <= 0.0031308, colours * 12.92, 1.055 * colours ** (1 / 2.4) - 0.055) * 255
+    assert np.abs(levels - levels.round()).max() < 1e-3
+    assert len(np.unique(levels.round(), axis=0)) == 71
+    (skin,) = doc.skins
+    names = [doc.nodes[j].name for j in skin.joints]
+    assert names[:4] == ["TOP", "R_HIP", "L_HIP", "SPINE"] and len(names) == 20
+
+
+def test_cli_export_chooses_the_rig(tmp_path):
+    src = tmp_path / "walk.lig"
+    src.write_text(WALKING_HUMANOID)
+    counts = {}
+    for rig in ("skin", "nodes", None):
+        out = tmp_path / f"{rig}.glb"
+        cmd = [sys.executable, "-m", "liganimate", "export", str(src), "-o", str(out), "--quiet"]
+        r = subprocess.run(cmd + (["--rig", rig] if rig else []), check=False, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        doc, _ = load_gltf(str(out))
+        counts[rig] = (len(doc.skins), len(doc.meshes))
+    assert counts == {"skin": (1, 1), "nodes": (0, 20), None: (1, 1)}
+    r = subprocess.run(
+        [sys.executable, "-m", "liganimate", "export", str(src), "-o", str(tmp_path / "x.glb"), "--rig", "bones"],
+        check=False,
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 2 and "'bones' is not a glTF rig; the rigs are skin and nodes" in r.stderr
+    assert not (tmp_path / "x.glb").exists()

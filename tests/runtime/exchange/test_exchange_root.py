@@ -67,7 +67,7 @@ def test_gltf_export_writes_the_path(tmp_path):
     want = _expected_path(program)
     path = str(tmp_path / "travel.gltf")
     scenes = X.collect(program)
-    data, _ = X.gltf_bytes(scenes, False, fps=FPS)
+    data, _ = X.gltf_bytes(scenes, False, fps=FPS, rig="nodes")
     with open(path, "wb") as fh:
         fh.write(data)
     doc, blob = load_gltf(path)

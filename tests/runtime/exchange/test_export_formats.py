@@ -51,9 +51,20 @@ def test_every_suffix_chooses_one_format():
 
 def test_options_are_converted_once_for_text_and_values():
     glb = X.export_format("a.glb")
-    assert X.export_options(glb, {}) == {"fps": 24.0, "size": (640, 480)}
-    assert X.export_options(glb, {"fps": "30", "size": "320x200"}) == {"fps": 30.0, "size": (320, 200)}
-    assert X.export_options(glb, {"fps": 30, "size": (320, 200)}) == {"fps": 30.0, "size": (320, 200)}
+    assert X.export_options(glb, {}) == {"fps": 24.0, "size": (640, 480), "rig": "skin"}
+    assert X.export_options(glb, {"fps": "30", "size": "320x200", "rig": "nodes"}) == {
+        "fps": 30.0,
+        "size": (320, 200),
+        "rig": "nodes",
+    }
+    assert X.export_options(glb, {"fps": 30, "size": (320, 200)}) == {"fps": 30.0, "size": (320, 200), "rig": "skin"}
+    with pytest.raises(ValueError, match="--rig: 'bones' is not a glTF rig; the rigs are skin and nodes"):
+        X.export_options(glb, {"rig": "bones"})
+    with pytest.raises(ValueError, match="--rig does not apply to bvh files"):
+        X.export_options(X.export_format("a.bvh"), {"rig": "skin"})
+    # The table names the rigs the glTF writer has (it cannot import the writer to ask).
+    for rig in X.RIGS:
+        assert X.export_options(glb, {"rig": rig})["rig"] == rig
     with pytest.raises(ValueError, match="--fps: the frame rate must be a positive number, not -1"):
         X.export_options(glb, {"fps": -1})
     with pytest.raises(ValueError, match=r"--size: \(3\.5, 2\) is not a size like 640x480"):

@@ -17,6 +17,7 @@ import pytest
 from liganimate.cli import load_program
 from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render import frames
+from liganimate.runtime.render.options import RenderOptions
 from tests.runtime.render.test_render import program
 
 
@@ -56,7 +57,7 @@ def test_an_executor_draws_every_image_and_the_bytes_are_those_of_a_local_run(tm
 def test_an_executor_is_shut_down_when_the_render_is_refused(tmp_path):
     ex = CountingExecutor()
     with pytest.raises(RenderError):
-        frames.Renderer(str(tmp_path / "out"), fps=0, executor=ex)
+        frames.Renderer(RenderOptions(out=str(tmp_path / "out"), fps=0), executor=ex)
     assert ex.shutdowns
 
 
@@ -78,7 +79,7 @@ def test_bad_aa_is_refused_before_compiling(tmp_path, value):
 
 def test_the_library_refuses_a_bad_aa_by_its_keyword_name(tmp_path):
     with pytest.raises(RenderError, match=r"^aa=0 is not an anti-aliasing factor"):
-        frames.Renderer(str(tmp_path / "out"), aa=0)
+        frames.Renderer(RenderOptions(out=str(tmp_path / "out"), aa=0))
 
 
 def test_aa_reaches_the_rasterizer(monkeypatch):
@@ -94,8 +95,8 @@ def test_aa_reaches_the_rasterizer(monkeypatch):
     import numpy as np
 
     part = (np.zeros((1, 3, 3)), np.zeros(1, np.uint8), np.zeros(1, bool))
-    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 3)
-    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 1)
+    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 3, "thesis")
+    frames.draw((2, 2), [(((0.0, 0.0, 5.0), 2.0), [part])], 1, "thesis")
     assert seen == [{"aa": 3}, {"aa": 1}]
 
 
@@ -103,7 +104,21 @@ def test_run_with_aa_smooths_the_edges(tmp_path):
     src = program(tmp_path, 2)
     for aa in ("1", "3"):
         r = subprocess.run(
-            [sys.executable, "-m", "liganimate", "run", str(src), "-o", f"aa{aa}", "--size", "64x48", "--aa", aa],
+            [
+                sys.executable,
+                "-m",
+                "liganimate",
+                "run",
+                str(src),
+                "-o",
+                f"aa{aa}",
+                "--size",
+                "64x48",
+                "--aa",
+                aa,
+                "--look",
+                "thesis",
+            ],
             capture_output=True,
             text=True,
             cwd=tmp_path,

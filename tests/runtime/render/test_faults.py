@@ -20,6 +20,7 @@ from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render import frames as render
 from liganimate.runtime.render import outputs
 from liganimate.runtime.render.imagefiles import read_png
+from liganimate.runtime.render.options import CLI_NAMES, KEYWORD_NAMES, RenderOptions
 
 # --------------------------------------------------------------------------
 # Output options are refused before the program is compiled
@@ -77,9 +78,9 @@ def test_an_unwritable_folder_is_refused(tmp_path, monkeypatch):
     os.mkdir(locked)
     monkeypatch.setattr(outputs.os, "access", lambda p, mode: False if str(p) == locked else real(p, mode))
     with pytest.raises(RenderError, match=f"^--gif {locked}/a.gif cannot be written: permission denied for the folder"):
-        outputs.check_outputs(tmp_path / "out", gif=f"{locked}/a.gif", names=outputs.CLI_NAMES)
+        outputs.check_outputs(RenderOptions(out=str(tmp_path / "out"), gif=f"{locked}/a.gif"), CLI_NAMES)
     with pytest.raises(RenderError, match=f"^-o {locked}/f cannot be written: permission denied for {locked}$"):
-        outputs.check_outputs(f"{locked}/f", names=outputs.CLI_NAMES)
+        outputs.check_outputs(RenderOptions(out=f"{locked}/f"), CLI_NAMES)
 
 
 def test_an_unwritable_folder_is_refused_by_the_command(tmp_path):
@@ -104,16 +105,18 @@ def test_an_unwritable_folder_is_refused_by_the_command(tmp_path):
 
 
 def test_a_file_in_the_frames_folder_to_be_created_is_accepted(tmp_path):
-    outputs.check_outputs(tmp_path / "new", poses=str(tmp_path / "new" / "p.jsonl"), names=outputs.CLI_NAMES)
+    outputs.check_outputs(RenderOptions(out=str(tmp_path / "new"), poses=str(tmp_path / "new" / "p.jsonl")), CLI_NAMES)
     with pytest.raises(RenderError, match="the folder .*new/deeper does not exist"):
-        outputs.check_outputs(tmp_path / "new", poses=str(tmp_path / "new" / "deeper" / "p.jsonl"))
+        outputs.check_outputs(
+            RenderOptions(out=str(tmp_path / "new"), poses=str(tmp_path / "new" / "deeper" / "p.jsonl")), KEYWORD_NAMES
+        )
 
 
 def test_the_library_refuses_the_same_options_by_their_keyword_names(tmp_path):
     with pytest.raises(RenderError, match="^gif= .* is a folder, not a file$"):
-        render.Renderer(str(tmp_path / "out"), gif=str(tmp_path))
+        render.Renderer(RenderOptions(out=str(tmp_path / "out"), gif=str(tmp_path)))
     with pytest.raises(RenderError, match="^fps= 0 is not a usable frame rate"):
-        render.Renderer(str(tmp_path / "out"), fps=0)
+        render.Renderer(RenderOptions(out=str(tmp_path / "out"), fps=0))
     assert os.listdir(tmp_path) == []
 
 

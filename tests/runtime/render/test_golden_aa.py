@@ -31,7 +31,7 @@ CASES = ["appendix_a", "walk_and_wave", "ring_the_bell", "big_and_small_robot"]
 
 def _render(name: str, out: pathlib.Path, aa: int, workers: int = 1) -> list:
     program, _ = load_program(str(EXAMPLES / f"{name}.lig"))
-    program.render(str(out), size=SIZE, quiet=True, workers=workers, aa=aa)
+    program.render(str(out), size=SIZE, quiet=True, workers=workers, aa=aa, look="thesis")
     return sorted(p.relative_to(out) for p in out.rglob("*.png"))
 
 

@@ -64,7 +64,8 @@ def pages(tmp_path_factory):
         page = tmp / f"{name}.html"
         for cmd in (
             [sys.executable, "-m", "liganimate", "view", str(src), "-o", str(page), "--quiet"],
-            [sys.executable, "-m", "liganimate", "run", str(src), "-o", str(tmp / name), "--quiet"],
+            # The viewer's flat shading is the thesis look's.
+            [sys.executable, "-m", "liganimate", "run", str(src), "-o", str(tmp / name), "--quiet", "--look", "thesis"],
         ):
             r = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=600)
             assert r.returncode == 0, r.stderr

@@ -198,8 +198,10 @@ def test_load_path_text_and_notebook_display(tmp_path):
     assert isinstance(p, LoadedProgram) and p.name == APPENDIX
     assert liganimate.load(Path(APPENDIX)).name == APPENDIX
     text = Path(APPENDIX).read_text(encoding="utf-8")
-    q = liganimate.load(text)
+    q = liganimate.loads(text)
     assert q.name == "<text>"
+    with pytest.raises(TypeError, match="give a program's text to liganimate.loads"):
+        liganimate.load(text)
     shown = q._repr_html_()
     assert shown.startswith('<iframe srcdoc="') and 'sandbox="allow-scripts"' in shown
     inner = html.unescape(re.search(r'srcdoc="(.*?)"', shown, re.DOTALL).group(1))
@@ -214,7 +216,7 @@ def test_load_path_text_and_notebook_display(tmp_path):
 
 def test_load_errors_read_like_the_command_line(tmp_path):
     with pytest.raises(LigProgramError) as info:
-        liganimate.load("      X = (1,\n")
+        liganimate.loads("      X = (1,\n")
     assert re.match(r"<text>:1:\d+: error: ", str(info.value)) and "^" in str(info.value)
     bad = tmp_path / "rt.lig"
     bad.write_text(
@@ -229,3 +231,5 @@ def test_load_errors_read_like_the_command_line(tmp_path):
         liganimate.load(tmp_path / "missing.lig")
     with pytest.raises(TypeError):
         liganimate.load(42)
+    with pytest.raises(TypeError):
+        liganimate.loads(b"      X = 1\n")

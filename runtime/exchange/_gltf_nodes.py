@@ -1,0 +1,80 @@
+"""The ``nodes`` glTF rig: a model as a rigid tree of segment and joint nodes.
+
+Under the model node (its host placement) hangs the node of its current main
+link; then, walking the tree from the main link as the renderer does, for
+each joint a *joint node* at the joint's location whose rotation is the
+joint's (its inverse when FIGURE ... MAIN makes the walk go from secondary to
+primary), and under it the node of the link it reaches.  Every segment
+node's world transform is exactly the ``--poses`` matrix of that segment,
+``placement @ pose @ diag(s, s, s, 1)``; each carries its own mesh.
+"""
+
+from __future__ import annotations
+
+from liganimate.runtime.values import Graphical
+
+from ._gltf import joint_quaternions, moving_joints
+from ._names import link_names
+
+__all__ = ["node_rig"]
+
+
+def node_rig(b, take, model, anim, interp) -> list[int]:
+    """Add one drawn model as a node tree to builder ``b``; its scene-root node, in a list."""
+    fig = model.figure
+    root = b.model_node(take, model, anim, interp)
+    label = b.doc.nodes[root].name
+    qj = joint_quaternions(model)  # (T, J, 4)
+    moving = moving_joints(qj)
+    names = link_names(fig)
+    scales = fig.link_scales
+    loc1, loc2 = fig.locations
+    seg = {fig.main: _segment(b, take, model, f"{label} {names[fig.main]}", fig.main, root)}
+    for level in fig.traversal:
+        for k, p, c, r in zip(level.joints, level.parents, level.children, level.reversed):
+            near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
+            sp = scales[p]
+            jid = fig.joints[k].id
+            jn = b.node(
+                name=f"{label} joint {jid}",
+                translation=[float(v) for v in near / sp],
+                rotation=[float(v) for v in qj[0, k]],
+                extras={"liganimate": {"scene": take.id, "model": model.name, "joint": jid, "reversed": bool(r)}},
+            )
+            if sp != 1.0:
+                b.doc.nodes[jn].scale = [1.0 / sp] * 3
+            b.doc.nodes[seg[p]].children.append(jn)
+            if moving[k]:
+                b.channel(anim, jn, "rotation", model.ticks, qj[:, k], interp)
+            seg[c] = _segment(b, take, model, f"{label} {names[c]}", c, jn, offset=-far)
+    return [root]
+
+
+def _segment(b, take, model, name, i, parent, offset=None) -> int:
+    fig = model.figure
+    link = fig.links[i]
+    up = fig.parent_joint_of(i)
+    g = link.shape
+    mesh = None
+    if isinstance(g, Graphical) and len(g):
+        mesh = b.mesh_by_colour(("link", id(g)), link.label, g.triangles, g.shades(), g.closed)
+    n = b.node(
+        name=name,
+        mesh=mesh,
+        extras={
+            "liganimate": {
+                "scene": take.id,
+                "model": model.name,
+                "link": link.name,
+                "segment": int(i),
+                "joint": None if up is None else up.id,
+            }
+        },
+    )
+    node = b.doc.nodes[n]
+    if offset is not None and offset.any():
+        node.translation = [float(v) for v in offset]
+    if link.scale != 1.0:
+        node.scale = [link.scale] * 3
+    b.doc.nodes[parent].children.append(n)
+    return n

@@ -1,0 +1,274 @@
+"""What a render writes and how: one frozen :class:`RenderOptions` from the caller to the renderer.
+
+The command line (``liganimate run``), ``Program.render`` and
+``LoadedProgram.render`` all build one ``RenderOptions``; :func:`checked`
+refuses what cannot be honoured before anything is computed, and the
+renderer, the output checks (:mod:`.outputs`) and the output lock all read
+that one value.
+
+The movie files a render may write beside (or instead of) the PNG frames
+are a table, :data:`MOVIES`: each names its ``RenderOptions`` field, its
+``--help`` line, what must be present before anything is written (ffmpeg),
+and how to open its stream (:mod:`.video`).  Adding a movie format (WebM)
+is a field here, an entry in :data:`MOVIES`, and its stream class; the
+command line, the checks, the lock and the renderer take it from the table
+(docs/architecture.md, "A new output format").
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import numbers
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from liganimate.runtime.errors import RenderError
+from liganimate.runtime.render.look import DEFAULT_LOOK, check_look
+from liganimate.runtime.render.outputs import check_fps, check_outputs
+from liganimate.runtime.render.raster import MAX_AA
+from liganimate.runtime.render.video import (
+    DEFAULT_CRF,
+    DEFAULT_PRESET,
+    GifStream,
+    Mp4Stream,
+    check_crf,
+    check_preset,
+    find_ffmpeg,
+)
+
+__all__ = [
+    "CLI_NAMES",
+    "KEYWORD_NAMES",
+    "MOVIES",
+    "Movie",
+    "RenderOptions",
+    "check_aa",
+    "checked",
+    "executor_for",
+]
+
+# The largest image side: bounds the memory of one framebuffer up front.
+MAX_SIDE = 16384
+
+
+@dataclass(frozen=True)
+class RenderOptions:
+    """Everything a render writes and how: the one value the renderer, the checks and the lock read.
+
+    Attributes
+    ----------
+    out : str or None
+        Frames go to ``out/scene<ID>/<NNNNN>.png``; None writes no frames
+        (then a movie must be asked for).
+    size : (int, int)
+        Image width and height in pixels, 1 to 16384 each.
+    gif, mp4 : str or None
+        Movie files (:data:`MOVIES`): an animated GIF, an MP4 (needs ffmpeg).
+    poses : str or None
+        The pose record, JSON Lines (docs/poses.md).
+    fps : float
+        Frame rate of the movies, 0.01 to 1000.
+    aa : int
+        Anti-aliasing factor, 1 (none) to 8: each pixel is the mean of ``aa x aa`` samples.
+    look : str
+        ``"modern"`` (the default: lit faces, outlines, a contact shadow,
+        smoothed edges) or ``"thesis"`` (flat shades on white, the thesis'
+        own look, byte for byte); see :mod:`.look`.
+    crf, preset : int, str
+        x264's quality (0 to 51, lower is better and larger) and speed
+        (``ultrafast`` to ``veryslow``) for the MP4.
+    workers : int or None
+        Processes rasterizing in parallel (default: the machine's cores, at
+        most 8); 1 draws everything in this process.
+    scheduler : str or None
+        The address of a Dask scheduler to draw the frames on (``tcp://host:8786``).
+    quiet : bool
+        No progress bar.
+    """
+
+    out: str | None = None
+    size: tuple[int, int] = (640, 480)
+    gif: str | None = None
+    mp4: str | None = None
+    poses: str | None = None
+    fps: float = 24.0
+    aa: int = 1
+    look: str = DEFAULT_LOOK
+    crf: int = DEFAULT_CRF
+    preset: str = DEFAULT_PRESET
+    workers: int | None = None
+    scheduler: str | None = None
+    quiet: bool = False
+
+    def movies(self) -> list[tuple[Movie, str]]:
+        """The movies asked for, with their paths, in the order of :data:`MOVIES`."""
+        return [(m, path) for m in MOVIES if (path := getattr(self, m.name)) is not None]
+
+    def files(self) -> tuple[str, ...]:
+        """Every output file asked for (movies, then the pose record): what the checks and the lock guard."""
+        return tuple(path for _, path in self.movies()) + ((self.poses,) if self.poses is not None else ())
+
+
+@dataclass(frozen=True)
+class Movie:
+    """A movie file a render can write, fed the drawn images in order.
+
+    Attributes
+    ----------
+    name : str
+        Its :class:`RenderOptions` field and keyword; the command line's flag is ``--<name>``.
+    label : str
+        What the command line calls it when done (``MP4 written to film.mp4``).
+    help : str
+        The ``--help`` line.
+    open : callable
+        ``open(path, options) -> stream``: the stream the frames go to (:mod:`.video`).
+    require : callable, optional
+        Called by :func:`checked`, before anything is written: raises a
+        :class:`RenderError` when the movie cannot be made here (no ffmpeg).
+    """
+
+    name: str
+    label: str
+    help: str
+    open: Callable[[str, RenderOptions], Any] = field(repr=False)
+    require: Callable[[], object] | None = field(default=None, repr=False)
+
+
+#: The movie formats, in the order their options are listed.
+MOVIES: tuple[Movie, ...] = (
+    Movie("gif", "GIF", "write an animated GIF", lambda path, o: GifStream(path, o.fps)),
+    Movie(
+        "mp4",
+        "MP4",
+        "write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)",
+        lambda path, o: Mp4Stream(path, o.fps, o.crf, o.preset),
+        find_ffmpeg,
+    ),
+)
+
+_FIELDS = tuple(f.name for f in dataclasses.fields(RenderOptions))
+#: How the command line spells each option in messages.
+CLI_NAMES: Mapping[str, str] = {name: "-o" if name == "out" else "--" + name for name in _FIELDS}
+#: How the Python API spells them.
+KEYWORD_NAMES: Mapping[str, str] = {name: name + "=" for name in _FIELDS}
+
+
+def check_aa(aa: object, name: str = "--aa") -> int:
+    """``aa`` as an int from 1 to the rasterizer's ``MAX_AA``, or a RenderError naming the option.
+
+    Unlike the rasterizer's own check, this takes the option's text ("2")
+    as the command line and ``Program.render`` options give it.
+    """
+    try:
+        n = int(aa)  # type: ignore[call-overload]
+        ok = n == float(aa) and 1 <= n <= MAX_AA  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok or isinstance(aa, bool):
+        raise RenderError(
+            f"{_shown(name, aa)} is not an anti-aliasing factor; give a whole number from 1 (none) to {MAX_AA}"
+        )
+    return n
+
+
+def _shown(name: str, value: object) -> str:
+    """An option and its value as the caller wrote them: ``size=(0, 1)`` or ``--size 0x1``."""
+    return f"{name}{value!r}" if name.endswith("=") else f"{name} {value}"
+
+
+def _side(v: Any) -> bool:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return False
+    x = float(v)
+    return 0 < x <= MAX_SIDE and x.is_integer()
+
+
+def _size(size: object, name: str) -> tuple[int, int]:
+    try:
+        values = list(size)  # type: ignore[call-overload]
+    except TypeError:
+        values = []
+    ok = len(values) == 2 and all(_side(v) for v in values)
+    if not ok:
+        raise RenderError(
+            f"{_shown(name, size)} is not an image size; give (width, height), 1 to {MAX_SIDE} pixels each"
+        )
+    return int(values[0]), int(values[1])
+
+
+def _workers(workers: object, name: str) -> int | None:
+    if workers is None:
+        return None
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise RenderError(f"{_shown(name, workers)} is not a number of processes; give a whole number from 1")
+    return workers
+
+
+def checked(options: RenderOptions, names: Mapping[str, str] = KEYWORD_NAMES, make_poses_folder: bool = False):
+    """``options`` with every value checked and in its type; nothing is written.
+
+    Parameters
+    ----------
+    options : RenderOptions
+        As the caller gave them (numbers may still be text, as the command line reads them).
+    names : mapping, optional
+        How to name each option in messages: :data:`KEYWORD_NAMES` (default) or :data:`CLI_NAMES`.
+    make_poses_folder : bool, optional
+        The pose record's folder may be missing, because the renderer creates it.
+
+    Returns
+    -------
+    RenderOptions
+
+    Raises
+    ------
+    RenderError
+        One line naming the option: a bad number, an output that cannot be
+        written (:func:`.outputs.check_outputs`), MP4 without ffmpeg.
+    """
+    paths = {
+        k: os.fspath(v) for k in ("out", "poses", *(m.name for m in MOVIES)) if (v := getattr(options, k)) is not None
+    }
+    result = dataclasses.replace(
+        options,
+        **paths,
+        size=_size(options.size, names["size"]),
+        fps=check_fps(options.fps, names["fps"]),
+        aa=check_aa(options.aa, names["aa"]),
+        look=check_look(options.look, names["look"]),
+        crf=check_crf(options.crf, names["crf"]),
+        preset=check_preset(options.preset, names["preset"]),
+        workers=_workers(options.workers, names["workers"]),
+    )
+    if result.scheduler is not None and not result.scheduler.strip():
+        raise RenderError(
+            f"{names['scheduler'].rstrip('=')} is empty; give the address of a Dask scheduler, like tcp://host:8786"
+        )
+    if result.out is None and not result.movies():
+        movies = " or ".join(names[m.name] for m in MOVIES)
+        raise RenderError(f"there is no frames folder ({names['out']}) and no {movies}: nothing would be written")
+    check_outputs(result, names, make_poses_folder=make_poses_folder)
+    for movie, _ in result.movies():
+        if movie.require is not None:
+            movie.require()
+    return result
+
+
+def executor_for(scheduler: str):
+    """A DaskExecutor on ``scheduler``; Dask is imported here only, never for a local run.
+
+    Raises
+    ------
+    RenderError
+        When Dask is not installed, or the scheduler cannot be reached.
+    """
+    try:
+        from liganimate.runtime.render.distributed import DaskExecutor
+    except ImportError as exc:
+        if exc.name is not None and exc.name.split(".")[0] not in ("dask", "distributed", "liganimate"):
+            raise  # a bug in a module that is installed: the internal-error report names it
+        raise RenderError("Dask is not installed: pip install 'liganimate[dask]'") from None
+    return DaskExecutor(scheduler)

@@ -1,0 +1,182 @@
+"""URDF import: real robot descriptions from a PyPI package (pybullet_data), checked against an
+independent reader (yourdfpy), and malformed files refused at their line."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pybullet_data  # the test extra installs pybullet, whose wheel ships these robot descriptions
+import pytest
+import yourdfpy
+
+from liganimate.compiler import load_program
+from liganimate.lang.diagnostics import LigDiagnostics
+from liganimate.runtime import exchange as X
+from liganimate.runtime.exchange._urdf_read import rpy_matrix
+from liganimate.runtime.figure import kinematics as K
+
+DATA = pybullet_data.getDataPath()
+ROBOTS = [
+    "kuka_iiwa/model.urdf",  # revolute joints, axes in turned frames, OBJ meshes
+    "franka_panda/panda.urdf",  # fixed joints, a prismatic finger, a mimic joint, package:// meshes
+    "r2d2.urdf",  # boxes, cylinders, spheres, continuous wheels, a prismatic gripper
+    "xarm/xarm6_robot.urdf",
+    "a1/a1.urdf",  # a quadruped: a tree, not a chain
+]
+
+
+def imported(path: str, tmp_path, triangles: int = 24):
+    """Import ``path`` and load the library: (figure, Urdf)."""
+    robot = X.read_urdf(path)
+    text, _ = X.import_urdf(robot, X.UrdfImportOptions(model="BOT", mesh_triangles=triangles))
+    lib = tmp_path / "bot.lig"
+    lib.write_bytes(text)
+    program, _ = load_program(text=f"LOAD BOT FROM '{lib}'\n", name="use.lig")
+    return program.execute("check").variables["BOT"], robot
+
+
+def lig_values(fig, robot, cfg: dict) -> np.ndarray:
+    """The LIG joint values for URDF joint positions ``cfg`` (mimic joints follow their leader)."""
+    by_name = {j.name: j for j in robot.joints}
+    values = np.zeros((fig.n_joints, 3))
+    for k, joint in enumerate(fig.joints):
+        name = fig.links[joint.secondary].source.joint
+        j = by_name[name]
+        if j.mimic is not None:
+            q = j.mimic[1] * cfg[j.mimic[0]] + j.mimic[2]
+        else:
+            q = cfg.get(name, 0.0)
+        values[k, 0] = q if j.type == "prismatic" else math.degrees(q)
+    return values
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_forward_kinematics_agree_with_yourdfpy_at_random_joint_values(name, tmp_path):
+    path = os.path.join(DATA, name)
+    fig, robot = imported(path, tmp_path)
+    ref = yourdfpy.URDF.load(path, load_meshes=False, build_collision_scene_graph=False, load_collision_meshes=False)
+    assert fig.n_links == len(ref.robot.links) and fig.n_joints == len(ref.robot.joints)
+    rng = np.random.default_rng(20)
+    limits = {
+        j.name: (j.lower, j.upper) if j.type in ("revolute", "prismatic") else (-math.pi, math.pi) for j in robot.joints
+    }
+    for _ in range(5):
+        cfg = {n: float(rng.uniform(*limits[n])) for n in ref.actuated_joint_names}
+        ref.update_cfg(np.array([cfg[n] for n in ref.actuated_joint_names]))
+        X_lig = K.pose_transforms(fig, lig_values(fig, robot, cfg)[None])[0]
+        for i, link in enumerate(fig.links):
+            T = ref.get_transform(link.source.name, ref.base_link)
+            R0 = rpy_matrix(link.source.rpy) if link.source.rpy is not None else np.eye(3)
+            np.testing.assert_allclose(X_lig[i, :3, 3], T[:3, 3], rtol=0, atol=1e-9)
+            np.testing.assert_allclose(X_lig[i, :3, :3] @ R0, T[:3, :3], rtol=0, atol=1e-9)
+
+
+def test_names_extremes_and_kinds_come_from_the_urdf(tmp_path):
+    fig, robot = imported(os.path.join(DATA, "franka_panda/panda.urdf"), tmp_path)
+    names = [fig.links[j.secondary].source.joint for j in fig.joints]
+    assert names[:7] == [f"panda_joint{k}" for k in range(1, 8)]
+    finger = fig.joints[names.index("panda_finger_joint1")]
+    assert finger.slide and tuple(finger.extremes[0]) == (0.0, 0.04)
+    j1 = fig.joints[0]
+    assert not j1.slide and j1.extremes[0] == pytest.approx((-math.degrees(2.9671), math.degrees(2.9671)))
+    hand = fig.joints[names.index("panda_hand_joint")]
+    assert not hand.extremes.any()  # fixed: locked
+    assert fig.links[fig.root].source.name == "panda_link0"
+
+
+def test_the_command_line_imports_a_robot_and_notes_its_mimic_joint(tmp_path):
+    out = tmp_path / "panda.lig"
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "liganimate",
+            "import",
+            os.path.join(DATA, "franka_panda/panda.urdf"),
+            "-o",
+            str(out),
+            "--mesh-triangles",
+            "30",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "MODEL PANDA" in done.stderr and "panda_finger_joint2 mimics panda_finger_joint1" in done.stderr
+    text = out.read_text()
+    assert 'JOINT "panda_joint1"' in text and "SLIDE (0.0, 0.04)" in text
+
+
+# ------------------------------------------------------------------ bad input
+
+
+GOOD = """<?xml version="1.0"?>
+<robot name="two">
+  <link name="base"><visual><geometry><box size="1 1 1"/></geometry></visual></link>
+  <link name="arm"/>
+  <joint name="j1" type="revolute">
+    <parent link="base"/><child link="arm"/>
+    <origin xyz="0 0 1" rpy="0 0 0"/><axis xyz="0 1 1"/>
+    <limit lower="-1" upper="1"/>
+  </joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "words"),
+    [
+        (GOOD.replace('<link name="arm"/>', '<link name="arm">'), 10, "not well-formed"),
+        (GOOD.replace('<child link="arm"/>', '<child link="hand"/>'), 6, "hand, which the robot does not define"),
+        (
+            GOOD.replace(
+                "</robot>", '<joint name="j2" type="fixed"><parent link="arm"/><child link="base"/></joint>\n</robot>'
+            ),
+            10,
+            "cycle",
+        ),
+        (
+            GOOD.replace("</robot>", '<link name="wheel"/>\n</robot>'),
+            10,
+            "2 root links",
+        ),
+        (GOOD.replace('type="revolute"', 'type="planar"'), 5, '"planar"'),
+        (GOOD.replace('upper="1"', 'upper="x"'), 8, "finite number"),
+        (
+            '<?xml version="1.0"?>\n<!DOCTYPE robot [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;&a;">]>\n<robot name="x">&b;</robot>\n',
+            2,
+            "document type",
+        ),
+    ],
+)
+def test_malformed_urdf_is_refused_at_its_line_and_nothing_is_written(text, line, words, tmp_path):
+    path = tmp_path / "bad.urdf"
+    path.write_text(text)
+    with pytest.raises(LigDiagnostics) as info:
+        X.read_urdf(str(path))
+    d = info.value.diagnostics[0]
+    assert words in d.message and d.pos.line == line, (d.message, d.pos.line)
+    out = tmp_path / "bad.lig"
+    done = subprocess.run(
+        [sys.executable, "-m", "liganimate", "import", str(path), "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode != 0 and f"bad.urdf:{line}:" in done.stderr and "Traceback" not in done.stderr
+    assert not out.exists()
+
+
+def test_a_joint_axis_is_any_unit_direction(tmp_path):
+    path = tmp_path / "two.urdf"
+    path.write_text(GOOD)
+    fig, _ = imported(str(path), tmp_path)
+    np.testing.assert_allclose(fig.joints[0].axes[:, 0], [0, 2**-0.5, 2**-0.5], atol=1e-15)
+    # Turning by 90 degrees about (0, 1, 1) takes the arm's X axis to (0, 1, -1) / sqrt 2.
+    X_ = K.pose_transforms(fig, np.array([[[90.0, 0, 0]]]))[0, 1]
+    np.testing.assert_allclose(X_[:3, :3] @ [1, 0, 0], [0, 2**-0.5, -(2**-0.5)], atol=1e-12)
