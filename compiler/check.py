@@ -95,6 +95,7 @@ class _Passes:
         self.st = S.State(sigs)
         self.typer = ExpressionTyper(self.st)
         self.stmts = StatementChecker(self.st, self.typer, top_loads)
+        self.calls: dict | None = None  # PRIMITIVE -> the primitives it calls (scopes.call_graph)
 
     def walk(self, body: list, scope: Scope, primitive, out) -> None:
         self.st.enter(scope, primitive, out)
@@ -110,7 +111,9 @@ class _Passes:
         for default in sig.defaults.values():
             if isinstance(default, A.Node):
                 self.typer.expr(default)
-        S.recursion(self.program, p, self.report)
+        if self.calls is None:  # once per check: walking every body for every PRIMITIVE was quadratic
+            self.calls = S.call_graph(self.program)
+        S.recursion(self.calls, p, self.report)
         for slot in sig.slots:
             sig.param_types[slot.keyword] = scope.types.get(slot.param, T.REAL)
         self.primitives[p.name.name] = (prim, sig, scope)

@@ -151,11 +151,16 @@ def unknown(st: State, node) -> None:
     st.out.error(node, f"{name} is not defined", hint or "assign it or declare it (REAL, VECTOR, MODEL, ...) first")
 
 
-def recursion(program: A.Program, p: A.PrimitiveDef, out) -> None:
-    """A PRIMITIVE may not call itself, directly or through others (it would never end)."""
-    calls = {}
-    for q in program.primitives:
-        calls[q.name.name] = {n for n in _prim_calls(q)}
+def call_graph(program: A.Program) -> dict:
+    """Each PRIMITIVE's name -> the names of the primitives its body calls."""
+    return {q.name.name: _prim_calls(q) for q in program.primitives}
+
+
+def recursion(calls: dict, p: A.PrimitiveDef, out) -> None:
+    """A PRIMITIVE may not call itself, directly or through others (it would never end).
+
+    ``calls`` is the program's :func:`call_graph`.
+    """
     seen, stack = set(), [(c, c) for c in calls.get(p.name.name, ())]
     while stack:
         name, first = stack.pop()

@@ -28,7 +28,6 @@ MAX_COMPLEXITY = 25
 
 #: (file, qualified function name) -> who splits it. Only ever remove entries.
 ALLOWED: dict[tuple[str, str], str] = {
-    ("runtime/studio/_library.py", "library_text"): "look",
     ("runtime/ik/goals.py", "GoalStack.__init__"): "arch-options",
     ("runtime/ik/goals.py", "GoalStack.evaluate"): "arch-options",
     ("runtime/ik/model.py", "IKModel.__init__"): "arch-options",

@@ -364,8 +364,8 @@ def _library_text(robot, options, joints, segment, shapes, frames, meshes) -> st
             line += f" AXIS ({_num(axis[0])}, {_num(axis[1])}, {_num(axis[2])})"
         out.append(line)
     out += ["      ENDMODEL", ""]
-    rows = [(segment[robot.root], robot.root, (), None, None, _rpy(frames[robot.root]))]
-    rows += [(segment[j.child], j.child, (), None, j.name, _rpy(frames[j.child])) for j in joints]
+    rows: list = [(segment[robot.root], robot.root, (), None, None, _rpy(frames[robot.root]))]
+    rows += [(segment[j.child], j.child, (), None, j.name, _rpy(frames[j.child]), j.mimic) for j in joints]
     out.append(name_table.format_table(model, rows))
     return "\n".join(out)
 

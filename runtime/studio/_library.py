@@ -20,12 +20,13 @@ extremes and angles are written with Python's shortest round-trip
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
 from liganimate.compiler.names import reserved
 
-__all__ = ["library_text", "lig_name"]
+__all__ = ["Library", "library", "library_text", "lig_name"]
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 # Keywords and built-ins (compiler/names.py, read from the grammar), and the
@@ -109,6 +110,36 @@ def widened_extremes(fig, kept: np.ndarray) -> np.ndarray:
     return ext
 
 
+@dataclass(frozen=True)
+class Library:
+    """A saved library in its parts: what depends on the figure alone, and what the kept poses change.
+
+    Attributes
+    ----------
+    head : str
+        The header comment.
+    shapes : str
+        One PRIMITIVE per distinct segment shape, drawing its triangles:
+        most of the text, the same for every Save of one figure.
+    skeleton : str
+        The same PRIMITIVEs, each drawing only its first triangle: what
+        checking the rest needs of them (their names and that they draw).
+    body : str
+        The declarations, the segments' assignments, STARTMODEL (with the
+        widened extremes) and the motion.
+    """
+
+    head: str
+    shapes: str
+    skeleton: str
+    body: str
+
+    @property
+    def text(self) -> str:
+        """The library's text."""
+        return self.head + self.shapes + self.body
+
+
 def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: str = "") -> str:
     """The text of a library with ``fig`` as MODEL ``model`` and the kept poses as MOTION ``motion``.
 
@@ -129,11 +160,27 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
     str
         Library text that ``LOAD model, motion FROM 'file.lig'`` takes.
     """
+    return library(fig, model, motion, kept, spacing, note).text
+
+
+def library(fig, model: str, motion: str, kept, spacing: int = 24, note: str = "") -> Library:
+    """The library of :func:`library_text`, in its parts (see :class:`Library`)."""
     kept = np.asarray(kept, dtype=np.float64).reshape(-1, fig.n_joints, 3)
     model, motion = model.upper(), motion.upper()
     taken = {model, motion}
     segs = _segment_names(fig, taken)
     ext = widened_extremes(fig, kept)
+    head = _header(fig, model, motion, kept, spacing, note, ext)
+    shapes, skeleton, assign = _shapes(fig, segs, taken)
+    body = []
+    for k in range(0, len(segs), 6):
+        body.append("      GRAPHICAL " + ", ".join(segs[k : k + 6]))
+    body += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + [""]
+    body += _startmodel(fig, model, segs, ext) + [""] + _motion(fig, motion, kept, spacing)
+    return Library("\n".join(head) + "\n", "\n".join(shapes) + "\n", "\n".join(skeleton) + "\n", "\n".join(body) + "\n")
+
+
+def _header(fig, model: str, motion: str, kept, spacing: int, note: str, ext) -> list:
     grown = [
         fig.joints[k].id
         for k in range(fig.n_joints)
@@ -157,14 +204,18 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
             + ", ".join(str(j) for j in grown)
             + " are widened to hold poses the Generator took beyond them."
         )
-    out += [
+    return out + [
         "",
         f"{{@ {model}: the posed model, {fig.n_links} segments and {fig.n_joints} joints }}",
         f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}",
         "",
     ]
+
+
+def _shapes(fig, segs: list, taken: set) -> tuple:
+    """(PRIMITIVE lines, the same with one triangle each, the segments' assignments)."""
     shapes: dict = {}  # (id(shape), scale) -> primitive name
-    assign = []
+    full, skeleton, assign = [], [], []
     for i, link in enumerate(fig.links):
         tris = getattr(link.shape, "triangles", None)
         if tris is None or len(tris) == 0:
@@ -177,11 +228,16 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
                 prim += "_"
             taken.add(prim)
             shapes[key] = prim
-            out += _primitive(prim, tris * link.scale, link.shape.lightness)
+            lines = _primitive(prim, tris * link.scale, link.shape.lightness)
+            full += lines
+            draws = [n for n, line in enumerate(lines) if line.startswith("      DRAW POLY")]
+            skeleton += lines[: draws[0] + 1] + lines[-2:] if draws else lines
         assign.append(f"      {segs[i]} :- ({prim})")
-    for k in range(0, len(segs), 6):
-        out.append("      GRAPHICAL " + ", ".join(segs[k : k + 6]))
-    out += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + ["", f"      STARTMODEL {model}"]
+    return full, skeleton, assign
+
+
+def _startmodel(fig, model: str, segs: list, ext) -> list:
+    out = [f"      STARTMODEL {model}"]
     for k, j in enumerate(fig.joints):
         pairs = ", ".join(f"({_num(a)}, {_num(b)})" for a, b in ext[k])
         out.append(f"        JOINT {j.id}, {segs[j.primary]}, {_vec(j.loc1)}, {segs[j.secondary]}, {_vec(j.loc2)},")
@@ -190,7 +246,11 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
     if fig.main is not None and fig.main != fig.root:
         parent = fig.parent_joint_of(fig.main)
         out.append(f"      FIGURE {model} MAIN JOINT {parent.id}")
-    out += ["", f"      STARTMOTION {motion}"]
+    return out
+
+
+def _motion(fig, motion: str, kept, spacing: int) -> list:
+    out = [f"      STARTMOTION {motion}"]
     for k, j in enumerate(fig.joints):
         a = kept[0, k]
         out.append(f"        JOINT {j.id} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
@@ -198,4 +258,4 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
             a = kept[n, k]
             out.append(f"          FRAME {n * spacing} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
     out.append("      ENDMOTION")
-    return "\n".join(out) + "\n"
+    return out

@@ -9,13 +9,14 @@ state (:meth:`Session.state`).  All the posing logic is the
 from __future__ import annotations
 
 import base64
+import hashlib
 import os
 import threading
 
 import numpy as np
 
 from ._generator import MODES, POPULATION, SEED_MAX, Generator
-from ._library import library_text
+from ._library import library
 
 __all__ = ["ACTIONS", "RequestError", "Session"]
 
@@ -59,6 +60,34 @@ class Session:
         self.spacing = spacing
         self.saved = False
         self.lock = threading.Lock()
+        # Digests of PRIMITIVE texts (Library.shapes) a whole library with them has compiled with.
+        self._shapes_ok: set = set()
+        self._warming: threading.Thread | None = None
+
+    def warm(self) -> None:
+        """Check, in a background thread, the library Save will write, so that Save need not.
+
+        Almost all of a saved library is the figure's PRIMITIVEs, the same
+        at every Save; compiling all of it took seconds for the humanoid.
+        Once a whole library with these PRIMITIVEs has compiled, a Save
+        compiles the library with each PRIMITIVE cut to one triangle
+        instead (the rest, which the kept poses change, in full).
+        """
+        if self._warming is not None:
+            return
+        g = self.generator
+        pose = g.current.copy()
+
+        def check():
+            lib = library(g.figure, self.model, self.motion, [pose], self.spacing)
+            try:
+                check_library(lib.text, self.save_path)
+            except Exception:  # noqa: BLE001 - Save then checks the whole library itself, and reports
+                return
+            self._shapes_ok.add(_digest(lib.shapes))
+
+        self._warming = threading.Thread(target=check, name="liganimate-studio-warm", daemon=True)
+        self._warming.start()
 
     # ---------------------------------------------------------------- state
     def state(self, message: str = "") -> dict:
@@ -164,16 +193,37 @@ class Session:
     def _do_save(self, g, body):
         if not g.kept:
             raise RequestError("keep a pose first: the saved motion is made of the kept poses")
-        text = library_text(
+        lib = library(
             g.figure, self.model, self.motion, g.kept, self.spacing, note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept."
         )
-        write_library(self.save_path, text)
+        if self._warming is not None:
+            self._warming.join()  # at most once: the first Save waits for the check it would make itself
+        digest = _digest(lib.shapes)
+        known = digest in self._shapes_ok
+        write_library(self.save_path, lib.text, checked_as=lib.head + lib.skeleton + lib.body if known else None)
+        self._shapes_ok.add(digest)
         self.saved = True
         return f"saved {len(g.kept)} pose(s) to {self.save_path}"
 
 
-def write_library(path: str, text: str) -> None:
+def _digest(text: str) -> bytes:
+    return hashlib.sha256(text.encode("utf-8")).digest()
+
+
+def check_library(text: str, path: str) -> None:
+    """Compile ``text`` as the library at ``path``; LigDiagnostics if it does not compile."""
+    from liganimate.compiler import compile_source
+    from liganimate.lang.source import prepare
+
+    compile_source(prepare(text, path), path=path)
+
+
+def write_library(path: str, text: str, checked_as: str | None = None) -> None:
     """Check that ``text`` compiles as a library at ``path``, then write it atomically.
+
+    ``checked_as``, if given, is compiled instead: ``text`` with its
+    PRIMITIVEs' drawing cut short (:class:`._library.Library`), whose
+    full PRIMITIVEs have compiled before.
 
     Raises
     ------
@@ -182,9 +232,7 @@ def write_library(path: str, text: str) -> None:
     OSError
         If it cannot be written (the old file stays).
     """
-    from liganimate.compiler import compile_source
-    from liganimate.lang.source import prepare
     from liganimate.runtime.exchange import write_files
 
-    compile_source(prepare(text, path), path=path)
+    check_library(text if checked_as is None else checked_as, path)
     write_files([(path, text.encode("utf-8"))])

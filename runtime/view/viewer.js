@@ -315,6 +315,17 @@
     frame: function () { return state.image; },
     play: function (on) { setPlaying(on !== false); },
     hoverAt: function (x, y) { state.hover = pickAt(x, y); draw(); return el('info').textContent; },
+    /* What view --watch keeps across a reload: the scene, the frame and the camera. */
+    view: function () { return { scene: scenes[state.scene].id, image: state.image, cam: state.userCam }; },
+    restore: function (v) {
+      var i = scenes.map(function (s) { return s.id; }).indexOf(v.scene);
+      if (i < 0) return;
+      setScene(i);
+      setFrame(v.image);
+      state.userCam = v.cam || null;
+      draw();
+    },
+    camera: function () { return state.userCam; },
     ready: performance.now()
   };
 })();

@@ -203,6 +203,8 @@ async def hover_text(client: LanguageClient, uri: str, position: T.Position) -> 
 
 async def test_hover(client: LanguageClient, folder: pathlib.Path):
     uri = from_fs_path(str(folder / "scene.lig"))
+    method = await hover_text(client, uri, pos_of(PROGRAM, "ACCDCC", into=2))
+    assert "STARTMOTION ... ENDMOTION" in method
     animate = await hover_text(client, uri, pos_of(PROGRAM, "ANIMATE HUMANOID", into=2))
     assert "4.10 ANIMATE" in animate and "animate_stmt = ANIMATE name FROM expr TO expr USING expr" in animate
     arm = await hover_text(client, uri, pos_of(PROGRAM, "ARM FROM", into=1))
@@ -267,8 +269,12 @@ async def test_completion(client: LanguageClient, folder: pathlib.Path):
 
     view = await at_end_of("      VIEW ")
     assert {"POINT", "WIDTH"} <= view and "ANIMATE" not in view
-    modifiers = await at_end_of("      X = BEND <")
-    assert {"SCALE", "TRANS", "ROT", "LIGHTNESS", "COLOUR"} <= modifiers and "VIEW" not in modifiers
+    # The modifiers the grammar takes after <, narrowed to those of the value's type.
+    graphical = await at_end_of("      X = UPPER <")
+    assert graphical == {"SCALE", "TRANS", "ROT", "LIGHTNESS", "COLOUR", "COLOR"}
+    assert await at_end_of("      X = BEND <") == {"SCALE"}
+    assert await at_end_of("      X = BEND <SCALE ") == {"FRAMES", "FRAME", "EXTREMES", "EXTREME"}
+    assert {"TRANS", "ROT", "SCALE"} == await at_end_of("      X = ARM <")
     methods = await at_end_of("      BEND[1, 3] = FRAME 30 POSITION 0, 0, 0 INTERPOLATION ")
     assert {"LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"} <= methods
     statement = await at_end_of("      ")

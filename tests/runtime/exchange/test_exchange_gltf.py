@@ -229,3 +229,29 @@ def test_cli_export_chooses_the_rig(tmp_path):
     )
     assert r.returncode == 2 and "'bones' is not a glTF rig; the rigs are skin and nodes" in r.stderr
     assert not (tmp_path / "x.glb").exists()
+
+
+@pytest.mark.parametrize("rig", X.RIGS)
+def test_the_same_program_exports_the_same_bytes(tmp_path, rig):
+    program = program_named(tmp_path, "edges")
+    first, _ = X.gltf_bytes(X.collect(program), True, fps=FPS, rig=rig)
+    again, _ = X.gltf_bytes(X.collect(program_named(tmp_path, "edges")), True, fps=FPS, rig=rig)
+    assert first == again
+
+
+def test_key_times_never_follow_the_tick_and_a_collision_is_refused():
+    from liganimate.runtime.errors import LigError
+    from liganimate.runtime.exchange import _gltf
+
+    ticks = np.arange(100_000)
+    for fps in (24.0, 25.0, 30.0, 60.0, 120.0, 29.97):
+        t = X.key_times(ticks, fps)
+        assert t.dtype == np.float32 and (t.astype(np.float64) <= ticks / fps).all()
+        assert (np.diff(t) > 0).all()
+        # Still the nearest float32 below: one step up is past the tick.
+        assert (np.nextafter(t, np.float32(np.inf)).astype(np.float64) > ticks / fps).all()
+    # At a million ticks a second, 16.777216 s and one tick later share a float32.
+    b = _gltf.Builder(1e6, (640, 480), "skin")
+    b.length = 2**25
+    with pytest.raises(LigError, match="too long for glTF's 32-bit key times"):
+        b._times(np.array([2**24, 2**24 + 1]))

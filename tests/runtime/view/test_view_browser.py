@@ -127,6 +127,7 @@ def test_the_canvas_shows_what_liganimate_run_draws(pages, browser, name, scene_
 
 def test_moving_the_scrubber_changes_the_picture(pages, browser):
     from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
 
     _open(browser, pages["five"][0])
     before = browser.canvas()
@@ -142,9 +143,13 @@ def test_moving_the_scrubber_changes_the_picture(pages, browser):
     # Playing moves on by itself.
     browser.driver.execute_script("ligViewer.setFrame(0)")
     browser.driver.find_element("id", "play").click()
-    time.sleep(0.6)
+    # Waits for the event (a frame shown after 0), however slow the machine; the bound only stops a hang.
+    WebDriverWait(browser.driver, 60, poll_frequency=0.05).until(
+        lambda d: d.execute_script("return ligViewer.frame()") > 0
+    )
     browser.driver.find_element("id", "play").click()
-    assert browser.driver.execute_script("return ligViewer.frame()") > 0
+    stopped = browser.driver.execute_script("return ligViewer.frame()")
+    assert stopped > 0
 
 
 def test_orbit_and_back_to_the_scene_camera(pages, browser):
@@ -194,12 +199,17 @@ def test_hovering_a_segment_names_its_joint_angles_and_extremes(pages, browser):
 
 
 def test_the_page_makes_no_request_beyond_its_own_file(pages, tmp_path):
+    from selenium.webdriver.support.ui import WebDriverWait
+
     require_chromium()
     page = pages["five"][0]
     with Browser(log_network=True) as b:
         _open(b, page)
         b.driver.execute_script("ligViewer.setFrame(30); ligViewer.play(true);")
-        time.sleep(0.3)
+        # Several frames drawn while playing (whatever the machine's speed), then the network log.
+        WebDriverWait(b.driver, 60, poll_frequency=0.05).until(
+            lambda d: d.execute_script("return ligViewer.frame()") >= 33
+        )
         requests = b.requests()
     mine = {url.split("#")[0] for url, doc in requests if doc.split("#")[0] == page.as_uri()}
     assert mine == {page.as_uri()}, "the page's only request is for its own file"
