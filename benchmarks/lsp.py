@@ -61,19 +61,14 @@ def process_cpu(pid: int) -> float:
 def edit(text: str, round_no: int) -> tuple:
     """One digit near the middle of ``text`` changed, differently each round: ``(new text, the change)``.
 
-    The change is what an editor sends for a keystroke: a range and its
-    new text (the program stays valid).
+    The server asks for whole texts (see src/liganimate/lsp/server.py), so
+    an editor sends the whole new text for a keystroke (the program stays valid).
     """
     m = re.compile(r"(?<![A-Za-z0-9_])\d").search(text, len(text) // 2) or re.search(r"(?<![A-Za-z0-9_])\d", text)
     assert m is not None
-    line = text.count("\n", 0, m.start())
-    column = m.start() - (text.rfind("\n", 0, m.start()) + 1)
     digit = str(round_no % 10)
-    change = T.TextDocumentContentChangePartial(
-        range=T.Range(start=T.Position(line=line, character=column), end=T.Position(line=line, character=column + 1)),
-        text=digit,
-    )
-    return text[: m.start()] + digit + text[m.end() :], change
+    new = text[: m.start()] + digit + text[m.end() :]
+    return new, T.TextDocumentContentChangeWholeDocument(text=new)
 
 
 def name_position(text: str) -> T.Position:

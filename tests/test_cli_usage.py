@@ -14,11 +14,14 @@ import os
 import shutil
 import stat
 import subprocess
+from pathlib import Path
 
 import pytest
 from commands import liganimate as run
 
 from liganimate.cli import build_parser
+
+ROOT = Path(__file__).resolve().parent.parent
 
 SCENE = "INITIALIZE SCENE 1\nSTARTSCENE LENGTH 1\nENDSCENE\nSHOOTSCENES\n"
 
@@ -148,3 +151,30 @@ def test_fmt_rewrites_in_place_keeping_the_mode_and_goes_on_past_a_broken_file(t
     assert (tmp_path / "bad.lig").read_text() == "X = = 1\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.lig", "bad.lig"]  # no temporary file left
     assert run("fmt", "--check", "a.lig", cwd=tmp_path).returncode == 0
+
+
+# ------------------------------------------------------------ liganimate plot
+
+
+def test_plot_names_each_curve_by_the_link_its_joint_moves_and_the_title_clears_the_legend():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from liganimate.cli import load_program
+    from liganimate.runtime.render.plot import joint_links, plot_motion_figure
+
+    program, _ = load_program(str(ROOT / "examples" / "appendix_a.lig"))
+    rt = program.execute("check")
+    squat = rt.variables["SQUAT"]
+    links, model = joint_links(rt.variables, squat.joints)
+    assert model == "HUMAN"
+    assert links == {1: "FARM", 2: "FARM", 3: "FLEG", 4: "FOOT", 5: "FLEG", 6: "FOOT", 9: "BLEG", 10: "BLEG"}
+    fig = plot_motion_figure(squat, "SQUAT", links, model)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    axes = fig.axes
+    assert [a.get_ylabel().split("\n")[0] for a in axes] == [links[j] for j in squat.joints]
+    title = axes[0].title.get_window_extent(renderer)
+    legend = axes[0].get_legend().get_window_extent(renderer)
+    assert not title.overlaps(legend), (title, legend)
+    assert title.y0 >= axes[0].get_window_extent(renderer).y1 - 1, "the title sits above the first panel"

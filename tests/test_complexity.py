@@ -28,13 +28,6 @@ MAX_COMPLEXITY = 25
 
 #: (file, qualified function name) -> who splits it. Only ever remove entries.
 ALLOWED: dict[tuple[str, str], str] = {
-    ("runtime/ik/goals.py", "GoalStack.__init__"): "arch-options",
-    ("runtime/ik/goals.py", "GoalStack.evaluate"): "arch-options",
-    ("runtime/ik/model.py", "IKModel.__init__"): "arch-options",
-    ("runtime/ik/reach.py", "solve_pose"): "arch-options",
-    ("runtime/ik/solvers.py", "_dls_one"): "arch-options",
-    ("runtime/ik/solvers.py", "_ccd"): "arch-options",
-    ("runtime/render/raster.py", "_spans"): "arch-options",
 }
 
 

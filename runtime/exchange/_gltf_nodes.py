@@ -14,7 +14,7 @@ from __future__ import annotations
 from liganimate.runtime.values import Graphical
 
 from ._gltf import joint_motion, moving_joints
-from ._names import link_names
+from ._names import joint_names, link_names
 
 __all__ = ["node_rig"]
 
@@ -27,6 +27,7 @@ def node_rig(b, take, model, anim, interp) -> list[int]:
     qj, shift = joint_motion(model)  # (T, J, 4), (T, J, 3)
     turning, sliding = moving_joints(qj), moving_joints(shift)
     names = link_names(fig)
+    sourced = joint_names(fig)
     scales = fig.link_scales
     loc1, loc2 = fig.locations
     seg = {fig.main: _segment(b, take, model, f"{label} {names[fig.main]}", fig.main, root)}
@@ -37,7 +38,7 @@ def node_rig(b, take, model, anim, interp) -> list[int]:
             jid = fig.joints[k].id
             place = (near + shift[:, k]) / sp  # (T, 3): a slide moves the joint node
             jn = b.node(
-                name=f"{label} joint {jid}",
+                name=f"{label} {sourced[k]}" if sourced[k] else f"{label} joint {jid}",
                 translation=[float(v) for v in place[0]],
                 rotation=[float(v) for v in qj[0, k]],
                 extras={"liganimate": {"scene": take.id, "model": model.name, "joint": jid, "reversed": bool(r)}},

@@ -439,18 +439,7 @@ def solve_pose(
     restarts, translate = o.restarts, o.translate
     if isinstance(restarts, bool) or not isinstance(restarts, (int, np.integer)) or restarts < 0:
         raise GoalError(f"the number of restarts must be a non-negative whole number, not {restarts!r}.")
-    start_deg = start_pose(figure, start)
-    B_goals = batch_size(goals)
-    B_start = start_deg.shape[0] if start_deg.ndim == 3 else None
-    if B_goals is not None and B_start is not None and B_goals != B_start:
-        raise GoalError(f"the goals are a batch of {B_goals} but the start poses a batch of {B_start}.")
-    batched = B_goals is not None or B_start is not None
-    B = B_goals or B_start or 1
-    base = np.deg2rad(start_deg).reshape(B_start or 1, figure.n_joints, 3)  # (1 or B, J, 3)
-    start_deg = (
-        start_deg[None] if start_deg.ndim == 2 and B == 1 else np.broadcast_to(start_deg, (B, figure.n_joints, 3))
-    )
-
+    start_deg, base, B, batched = _start_batch(figure, goals, start)
     model = IKModel.cached(figure, _movable_mask(figure, goals, o.movable), translate)
     stack = GoalStack(model, goals, B)
     x0 = np.zeros((B, model.n_params))
@@ -467,6 +456,34 @@ def solve_pose(
         trace=trace,
     )
 
+    return _pose_solution(figure, model, stack, result, start_deg, tol, translate, batched)
+
+
+def _start_batch(figure: Figure, goals: list, start) -> tuple:
+    """The start poses for a solve: ``(degrees (B, J, 3), radians (1 or B, J, 3), B, batched)``.
+
+    Raises
+    ------
+    GoalError
+        When the goals and the start poses are batches of different sizes.
+    """
+    start_deg = start_pose(figure, start)
+    B_goals = batch_size(goals)
+    B_start = start_deg.shape[0] if start_deg.ndim == 3 else None
+    if B_goals is not None and B_start is not None and B_goals != B_start:
+        raise GoalError(f"the goals are a batch of {B_goals} but the start poses a batch of {B_start}.")
+    batched = B_goals is not None or B_start is not None
+    B = B_goals or B_start or 1
+    base = np.deg2rad(start_deg).reshape(B_start or 1, figure.n_joints, 3)  # (1 or B, J, 3)
+    start_deg = (
+        start_deg[None] if start_deg.ndim == 2 and B == 1 else np.broadcast_to(start_deg, (B, figure.n_joints, 3))
+    )
+    return start_deg, base, B, batched
+
+
+def _pose_solution(figure, model, stack, result, start_deg, tol: float, translate: bool, batched: bool):
+    """The solver's result as a :class:`PoseSolution`: angles clamped, batched or not as the input was."""
+    B = start_deg.shape[0]
     q = result.x[:, : model.n_vars]
     angles = start_deg.copy()
     flat = angles.reshape(B, -1)

@@ -140,7 +140,9 @@ class Library:
         return self.head + self.shapes + self.body
 
 
-def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: str = "") -> str:
+def library_text(
+    fig, model: str, motion: str, kept, spacing: int = 24, note: str = "", frames=None, method: str = "LINEAR"
+) -> str:
     """The text of a library with ``fig`` as MODEL ``model`` and the kept poses as MOTION ``motion``.
 
     Parameters
@@ -154,33 +156,42 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
         Frames between kept poses.
     note : str
         One line for the header comment (no braces or line breaks).
+    frames : sequence of int, optional
+        Each kept pose's frame: 0, then increasing (default ``k * spacing``).
+    method : str
+        The interpolation method that leads to each keyframe (a name of
+        :mod:`liganimate.runtime.motion.interpolation`); LINEAR is written
+        as no INTERPOLATE clause.
 
     Returns
     -------
     str
         Library text that ``LOAD model, motion FROM 'file.lig'`` takes.
     """
-    return library(fig, model, motion, kept, spacing, note).text
+    return library(fig, model, motion, kept, spacing, note, frames, method).text
 
 
-def library(fig, model: str, motion: str, kept, spacing: int = 24, note: str = "") -> Library:
+def library(
+    fig, model: str, motion: str, kept, spacing: int = 24, note: str = "", frames=None, method: str = "LINEAR"
+) -> Library:
     """The library of :func:`library_text`, in its parts (see :class:`Library`)."""
     kept = np.asarray(kept, dtype=np.float64).reshape(-1, fig.n_joints, 3)
+    frames = [k * spacing for k in range(len(kept))] if frames is None else [int(f) for f in frames]
     model, motion = model.upper(), motion.upper()
     taken = {model, motion}
     segs = _segment_names(fig, taken)
     ext = widened_extremes(fig, kept)
-    head = _header(fig, model, motion, kept, spacing, note, ext)
+    head = _header(fig, model, motion, kept, spacing, note, ext, frames)
     shapes, skeleton, assign = _shapes(fig, segs, taken)
     body = []
     for k in range(0, len(segs), 6):
         body.append("      GRAPHICAL " + ", ".join(segs[k : k + 6]))
     body += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + [""]
-    body += _startmodel(fig, model, segs, ext) + [""] + _motion(fig, motion, kept, spacing)
+    body += _startmodel(fig, model, segs, ext) + [""] + _motion(fig, motion, kept, frames, method)
     return Library("\n".join(head) + "\n", "\n".join(shapes) + "\n", "\n".join(skeleton) + "\n", "\n".join(body) + "\n")
 
 
-def _header(fig, model: str, motion: str, kept, spacing: int, note: str, ext) -> list:
+def _header(fig, model: str, motion: str, kept, spacing: int, note: str, ext, frames) -> list:
     grown = [
         fig.joints[k].id
         for k in range(fig.n_joints)
@@ -195,7 +206,12 @@ def _header(fig, model: str, motion: str, kept, spacing: int, note: str, ext) ->
     out += [
         "C",
         f"C {motion} holds {len(kept)} kept pose(s): the first is its starting position and pose k",
-        f"C is its keyframe at FRAME k * {spacing}. Play it with ANIMATE ... USING {motion}.",
+        (
+            f"C is its keyframe at FRAME k * {spacing}."
+            if frames == [k * spacing for k in range(len(kept))]
+            else "C is its keyframe at FRAME " + ", ".join(str(f) for f in frames[1:]) + " in turn."
+        )
+        + f" Play it with ANIMATE ... USING {motion}.",
         f"C {model} is the model as drawn: each segment's triangles, its joints and extremes.",
     ]
     if grown:
@@ -207,7 +223,9 @@ def _header(fig, model: str, motion: str, kept, spacing: int, note: str, ext) ->
     return out + [
         "",
         f"{{@ {model}: the posed model, {fig.n_links} segments and {fig.n_joints} joints }}",
-        f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}",
+        f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}"
+        if frames == [k * spacing for k in range(len(kept))]
+        else f"{{@ {motion}: {len(kept)} kept pose(s), over {frames[-1]} frames }}",
         "",
     ]
 
@@ -249,13 +267,14 @@ def _startmodel(fig, model: str, segs: list, ext) -> list:
     return out
 
 
-def _motion(fig, motion: str, kept, spacing: int) -> list:
+def _motion(fig, motion: str, kept, frames, method: str) -> list:
     out = [f"      STARTMOTION {motion}"]
+    how = "" if method == "LINEAR" else f" INTERPOLATE {method}"
     for k, j in enumerate(fig.joints):
         a = kept[0, k]
         out.append(f"        JOINT {j.id} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
         for n in range(1, len(kept)):
             a = kept[n, k]
-            out.append(f"          FRAME {n * spacing} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
+            out.append(f"          FRAME {frames[n]} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}{how}")
     out.append("      ENDMOTION")
     return out

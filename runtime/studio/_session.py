@@ -15,12 +15,34 @@ import threading
 
 import numpy as np
 
+from liganimate.runtime.motion.interpolation import names as interpolation_names
+
 from ._generator import MODES, POPULATION, SEED_MAX, Generator
 from ._library import library
 
 __all__ = ["ACTIONS", "RequestError", "Session"]
 
-ACTIONS = ("state", "next", "take", "freeze", "undo", "keep", "stand", "seed", "settings", "save")
+ACTIONS = (
+    "state",
+    "next",
+    "take",
+    "set",
+    "freeze",
+    "undo",
+    "keep",
+    "stand",
+    "seed",
+    "settings",
+    "recall",
+    "delete",
+    "move",
+    "frame",
+    "interpolation",
+    "play",
+    "save",
+)
+#: Frames a played motion may have at most (its matrices go to the page).
+MAX_PLAY_FRAMES = 2400
 
 
 class RequestError(ValueError):
@@ -58,6 +80,7 @@ class Session:
         self.model, self.motion = model, motion
         self.save_path = os.path.abspath(save_path)
         self.spacing = spacing
+        self.method = "LINEAR"  # how the saved motion reaches each kept pose
         self.saved = False
         self.lock = threading.Lock()
         # Digests of PRIMITIVE texts (Library.shapes) a whole library with them has compiled with.
@@ -109,6 +132,10 @@ class Session:
             "matrices": _b64(X),
             "angles": np.round(poses, 4).tolist(),
             "levels": g.levels.tolist(),
+            "keptFrames": list(g.kept_frames),
+            "keptMatrices": _b64(g.transforms(np.asarray(g.kept))[:, :, :3, :]) if g.kept else "",
+            "interpolation": self.method,
+            "interpolations": list(interpolation_names()),
         }
 
     # -------------------------------------------------------------- actions
@@ -129,7 +156,41 @@ class Session:
         g = self.generator
         with self.lock:
             message = getattr(self, "_do_" + action)(g, body)
-            return self.state(message or "")
+            state = self.state(message or "")
+            if action == "play":
+                state["play"] = self.played()
+            return state
+
+    def played(self) -> dict:
+        """The kept poses as the saved motion plays them: segment matrices for every frame from 0 to the last.
+
+        Raises
+        ------
+        RequestError
+            When no pose is kept, or the motion is longer than :data:`MAX_PLAY_FRAMES`.
+        """
+        from liganimate.runtime.motion import algebra as M
+        from liganimate.runtime.motion.keyframe import Keyframe
+
+        g = self.generator
+        if not g.kept:
+            raise RequestError("keep a pose first: the motion is made of the kept poses")
+        frames = g.kept_frames
+        if frames[-1] + 1 > MAX_PLAY_FRAMES:
+            raise RequestError(
+                f"the motion is {frames[-1] + 1} frames long; the studio plays at most {MAX_PLAY_FRAMES}"
+            )
+        spec = {}
+        for k, j in enumerate(g.figure.joints):
+            start = tuple(float(a) for a in g.kept[0][k])
+            keys = [
+                Keyframe(frames[n], tuple(float(a) for a in g.kept[n][k]), self.method) for n in range(1, len(frames))
+            ]
+            spec[j.id] = (start, keys)
+        motion = M.Motion.from_tracks(spec)
+        times = np.arange(frames[-1] + 1, dtype=np.float64)
+        angles = motion.evaluate(times, g.figure.joint_ids)
+        return {"frames": len(times), "matrices": _b64(g.transforms(angles)[:, :, :3, :])}
 
     def _settings(self, g, body) -> None:
         intensity, mode = body.get("intensity"), body.get("mode")
@@ -177,8 +238,63 @@ class Session:
     def _do_undo(self, g, body):
         return "undone" if g.undo() else "nothing to undo"
 
+    def _do_set(self, g, body):
+        joint, name = self._link_joint(g, body)
+        angles = body.get("angles")
+        if (
+            not isinstance(angles, list)
+            or len(angles) != 3
+            or any(isinstance(a, bool) or not isinstance(a, (int, float)) or not np.isfinite(a) for a in angles)
+        ):
+            raise RequestError("'angles' must be three numbers (degrees about X, Y and Z)")
+        g.set_angles(joint, angles)
+        a = g.current[joint]
+        return f"{name} (joint {g.figure.joints[joint].id}) set to X {a[0]:.2f} Y {a[1]:.2f} Z {a[2]:.2f}"
+
+    def _kept_index(self, g, body, key: str = "index") -> int:
+        if not g.kept:
+            raise RequestError("no pose is kept yet")
+        return _int(body, key, 0, len(g.kept) - 1)
+
+    def _do_recall(self, g, body):
+        k = self._kept_index(g, body)
+        g.recall(k)
+        return f"kept pose {k + 1} is the current pose"
+
+    def _do_delete(self, g, body):
+        k = self._kept_index(g, body)
+        g.delete_kept(k)
+        self.saved = False
+        return f"deleted kept pose {k + 1}"
+
+    def _do_move(self, g, body):
+        k, to = self._kept_index(g, body), self._kept_index(g, body, "to")
+        g.move_kept(k, to)
+        self.saved = False
+        return f"kept pose {k + 1} moved to place {to + 1}"
+
+    def _do_frame(self, g, body):
+        k = self._kept_index(g, body)
+        try:
+            g.set_kept_frame(k, _int(body, "frame", 0, 10**6))
+        except ValueError as exc:
+            raise RequestError(str(exc)) from None
+        self.saved = False
+        return f"kept pose {k + 1} at frame {g.kept_frames[k]}"
+
+    def _do_interpolation(self, g, body):
+        method = body.get("method")
+        if method not in interpolation_names():
+            raise RequestError("'method' must be one of " + ", ".join(interpolation_names()))
+        self.method = method
+        self.saved = False
+        return f"the kept poses are joined by {method} interpolation"
+
+    def _do_play(self, g, body):
+        return "playing"  # the state answered carries the frames (see act)
+
     def _do_keep(self, g, body):
-        g.keep()
+        g.keep(self.spacing)
         self.saved = False
         return f"kept pose {len(g.kept)}"
 
@@ -194,7 +310,14 @@ class Session:
         if not g.kept:
             raise RequestError("keep a pose first: the saved motion is made of the kept poses")
         lib = library(
-            g.figure, self.model, self.motion, g.kept, self.spacing, note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept."
+            g.figure,
+            self.model,
+            self.motion,
+            g.kept,
+            self.spacing,
+            note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept.",
+            frames=g.kept_frames,
+            method=self.method,
         )
         if self._warming is not None:
             self._warming.join()  # at most once: the first Save waits for the check it would make itself

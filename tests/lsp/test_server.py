@@ -356,6 +356,20 @@ async def test_rename(client: LanguageClient, folder: pathlib.Path):
         assert "rename" in str(caught.value) or "already" in str(caught.value) or "cannot name" in str(caught.value)
 
 
+async def test_lines_are_counted_as_the_editor_counts_them(client: LanguageClient, folder: pathlib.Path):
+    """A form feed (which LIG text may hold) does not end a line, for the editor or for LIG."""
+    text = "{ page one }\f{ page two }\n      X = 1\n      Y = X + BOX\n"
+    uri = from_fs_path(str(folder / "paged.lig"))
+    client.text_document_did_open(
+        T.DidOpenTextDocumentParams(text_document=T.TextDocumentItem(uri=uri, language_id="lig", version=1, text=text))
+    )
+    found = await diagnostics_for(client, uri, 1)
+    # As liganimate check prints them: 3:15 (BOX needs WIDTH) and 3:11 (the sum).
+    assert sorted((d.range.start.line, d.range.start.character) for d in found) == [(2, 10), (2, 14)]
+    change(client, uri, 2, text.replace("X = 1", "X = 2"))
+    assert {d.range.start.line for d in await diagnostics_for(client, uri, 2)} == {2}
+
+
 async def test_broken_text_keeps_answering(client: LanguageClient, folder: pathlib.Path):
     path = folder / "broken.lig"
     uri = await open_doc(client, path, PROGRAM)

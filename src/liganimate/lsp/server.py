@@ -42,7 +42,10 @@ class LigServer(LanguageServer):
     """The server's state: the documents' analyses, and the worker that makes them."""
 
     def __init__(self) -> None:
-        super().__init__("liganimate", __version__, text_document_sync_kind=lsp.TextDocumentSyncKind.Incremental)
+        # Whole texts, not edits: pygls applies an edit by lines it cuts with str.splitlines, which also
+        # breaks at a form feed (LIG text may hold one; editors and LIG do not break lines there), so an
+        # edit after a form feed would land on the wrong line.
+        super().__init__("liganimate", __version__, text_document_sync_kind=lsp.TextDocumentSyncKind.Full)
         self.latest: dict = {}  # uri -> Analysis of some version (maybe not the newest)
         self.good: dict = {}  # uri -> the last Analysis whose text parsed
         self.pending: dict = {}  # uri -> the asyncio task that will analyse it

@@ -167,3 +167,27 @@ def test_trajectories_hold_positions_in_radians_and_metres_and_the_interpolation
     (model,) = doc["models"]
     assert model["model"] == "ARM" and model["joints"] == head[1:7]
     np.testing.assert_allclose(np.array(model["position"]), body[:, 1:7], atol=0)
+
+
+@pytest.mark.filterwarnings("ignore:Importing PyGLM:PendingDeprecationWarning")
+def test_bvh_carries_slides_as_position_channels_and_axes_exactly(tmp_path):
+    """bvhio (another implementation) puts every exported joint where LIG has it, slides and AXIS included."""
+    import bvhio
+
+    from liganimate.runtime.figure.pose import joint_angles
+
+    export(ARM + SCENE.format(model="ARM", motion="M"), tmp_path, "arm.bvh")
+    text = (tmp_path / "arm.bvh").read_text()
+    assert "JOINT CAR" in text and "CHANNELS 3 Xposition Yposition Zposition" in text
+    program, _ = load_program(text=ARM, name="arm.lig")
+    variables = program.execute("check").variables
+    fig, motion = variables["ARM"], variables["M"]
+    X_ = K.pose_transforms(fig, joint_angles(fig, motion, np.arange(12.0)))
+    hierarchy = bvhio.readAsHierarchy(str(tmp_path / "arm.bvh"))
+    for t in range(12):
+        hierarchy.loadPose(t)
+        got = {j.Name: np.array(j.PositionWorld) for j, _, _ in hierarchy.layout()}
+        for joint in fig.joints:
+            link = fig.links[joint.secondary]
+            where = X_[t, joint.secondary, :3, :3] @ joint.loc2 + X_[t, joint.secondary, :3, 3]
+            np.testing.assert_allclose(got[link.name], where, atol=1e-5)  # bvhio computes in float32
