@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
@@ -64,7 +65,17 @@ DEFAULT_TOLERANCE = 1e-5
 #: Default iteration limits per solver (sweeps for CCD), from the solvers' registry.
 DEFAULT_MAX_ITERATIONS = {name: spec.max_iterations for name, spec in SOLVERS.items()}
 
-_STATUS = {CONVERGED: "converged", STALLED: "stalled", LIMIT: "limit"}
+
+class SolveStatus(StrEnum):
+    """How a solve ended (``PoseSolution.status``); a StrEnum, so each is also its word."""
+
+    CONVERGED = "converged"  # every goal of non-zero weight is within the tolerance
+    STALLED = "stalled"  # no move lowers the weighted cost: the least-squares best pose
+    LIMIT = "limit"  # the iteration limit came first
+
+
+#: The solvers' status codes (runtime/ik/solvers.py) as the solution reports them.
+_STATUS = {CONVERGED: SolveStatus.CONVERGED, STALLED: SolveStatus.STALLED, LIMIT: SolveStatus.LIMIT}
 
 
 @dataclass(frozen=True)
@@ -140,9 +151,9 @@ class PoseSolution:
         goal's angle to its direction (degrees).
     converged : numpy.ndarray of bool, shape (B,)
         Every goal of non-zero weight is within the tolerance.
-    status : numpy.ndarray of str, shape (B,)
-        ``"converged"``, ``"stalled"`` (no move lowers the weighted cost: the
-        least-squares best pose, goals left unmet) or ``"limit"`` (the
+    status : numpy.ndarray of SolveStatus, shape (B,)
+        ``CONVERGED``, ``STALLED`` (no move lowers the weighted cost: the
+        least-squares best pose, goals left unmet) or ``LIMIT`` (the
         iteration limit came first).
     iterations : numpy.ndarray of int, shape (B,)
     tolerance : float
@@ -162,7 +173,7 @@ class PoseSolution:
     translation: np.ndarray
     residuals: np.ndarray
     converged: np.ndarray | bool
-    status: np.ndarray | str
+    status: np.ndarray | SolveStatus
     iterations: np.ndarray | int
     tolerance: float
     weights: np.ndarray
@@ -566,7 +577,7 @@ def _pose_solution(figure, model, stack, result, start_deg, tol: float, translat
     # Wrapping free axes changes no link, so the solver's last distances are the pose's.
     residuals = stack.report(result.dist)
     converged = result.status == CONVERGED
-    status = np.array([_STATUS[s] for s in result.status])
+    status = np.array([_STATUS[s] for s in result.status], dtype=object)
     met = (result.dist <= tol) | ~stack.active
     if batched:
         return PoseSolution(
@@ -587,7 +598,7 @@ def _pose_solution(figure, model, stack, result, start_deg, tol: float, translat
         translation=t[0],
         residuals=residuals[0],
         converged=bool(converged[0]),
-        status=str(status[0]),
+        status=status[0],
         iterations=int(result.iterations[0]),
         tolerance=tol,
         weights=stack.weights[0],
@@ -630,7 +641,7 @@ def unmet_goals(figure: Figure, goals: Sequence, solution: PoseSolution) -> tupl
 
 def _limit_sentence(solution: PoseSolution, unmet: Sequence[UnmetGoal]) -> str | None:
     """The sentence that says the iteration limit stopped a solve leaving ``unmet`` goals, or None."""
-    if unmet and solution.status == "limit":
+    if unmet and solution.status == SolveStatus.LIMIT:
         return f"the solver stopped at its iteration limit ({solution.iterations}) before settling."
     return None
 
