@@ -489,15 +489,16 @@ class Checker(NodeVisitor):
         for j in s.joints:
             args = j.args
             self._joint_args(args, j, in_block=True)
-            if args and _const(args[0]) is not None and isinstance(args[0].value, int):
-                if args[0].value in ids:
+            ident = _const(args[0]) if args else None
+            if isinstance(ident, int):
+                if ident in ids:
                     self.err(
                         args[0],
-                        f"joint {args[0].value} appears twice in model {s.name.name}",
-                        f"the first is at line {ids[args[0].value].line}; joint identifiers must be unique",
+                        f"joint {ident} appears twice in model {s.name.name}",
+                        f"the first is at line {ids[ident].line}; joint identifiers must be unique",
                     )
                 else:
-                    ids[args[0].value] = args[0].pos
+                    ids[ident] = args[0].pos
 
     def _model_target(self, name: A.Name) -> None:
         self._define_as(name, T.MODEL, "{name} is {noun}, not a MODEL")
@@ -526,7 +527,7 @@ class Checker(NodeVisitor):
             t = self.expr(ext)
             if t is not None and t != T.PAIR:
                 self.err(ext, f"joint extremes are pairs (min, max), not {T.NOUN[t]}")
-            elif isinstance(ext, A.Tuple) and all(isinstance(i, (A.Num, A.Neg)) for i in ext.items):
+            elif isinstance(ext, A.Tuple) and len(ext.items) == 2:
                 lo, hi = (_const(i) for i in ext.items)
                 if lo is not None and hi is not None and lo > hi:
                     self.err(
@@ -564,14 +565,15 @@ class Checker(NodeVisitor):
                 seen["ROOT"] = j.joint.pos
             else:
                 self._want(j.joint, T.INTEGER, "a joint identifier")
-            if isinstance(j.joint, A.Num) and _const(j.joint) is not None:
-                if j.joint.value in seen:
+            ident = _const(j.joint)
+            if isinstance(ident, int):
+                if ident in seen:
                     self.err(
                         j.joint,
-                        f"joint {j.joint.value} appears twice in motion {s.name.name}",
-                        f"the first is at line {seen[j.joint.value].line}; put all its keyframes under one JOINT",
+                        f"joint {ident} appears twice in motion {s.name.name}",
+                        f"the first is at line {seen[ident].line}; put all its keyframes under one JOINT",
                     )
-                seen[j.joint.value] = j.joint.pos
+                seen[ident] = j.joint.pos
             if j.start is not None:
                 self._position(j.start, j)
             last = None
@@ -998,12 +1000,17 @@ class Checker(NodeVisitor):
 
 
 def _const(e):
-    """The value of a literal (or a negated one), or None; a literal out of range is reported elsewhere."""
-    if isinstance(e, A.Neg):
-        c = _const(e.operand) if isinstance(e.operand, A.Num) else None
-        return -c if c is not None else None
+    """The value of a constant expression (a literal, negated any number of times), or None.
+
+    Every check that looks at a constant goes through here and uses the value
+    it returns, never the node's own fields: ``-1`` is a ``Neg`` node, not a
+    literal.  A literal out of range is reported elsewhere (None here).
+    """
+    sign = 1
+    while isinstance(e, A.Neg):  # a loop, not recursion: the minus signs may be many
+        sign, e = -sign, e.operand
     if isinstance(e, A.Num) and not isinstance(e.value, numbers.BadLiteral):
-        return e.value
+        return e.value if sign > 0 else -e.value
     return None
 
 
