@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from liganimate.lang import ast as A
-from liganimate.lang import bindings, messages, numbers
+from liganimate.lang import bindings, keyframe_table, messages, numbers
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import DRAW_WITH, MODIFIERS
@@ -552,26 +552,9 @@ class Checker(NodeVisitor):
 
     def _s_MotionBlock(self, s, context):
         self._define_as(s.name, T.MOTION, "{name} is {noun}, not a MOTION")
-        seen = {}
+        seen: dict = {}
         for j in s.joints:
-            if isinstance(j.joint, A.RootTrack):
-                if "ROOT" in seen:
-                    self.err(
-                        j.joint,
-                        f"ROOT appears twice in motion {s.name.name}",
-                        f"the first is at line {seen['ROOT'].line}; a motion has one root track",
-                    )
-                seen["ROOT"] = j.joint.pos
-            else:
-                self._want(j.joint, T.INTEGER, "a joint identifier")
-            if isinstance(j.joint, A.Num) and _const(j.joint) is not None:
-                if j.joint.value in seen:
-                    self.err(
-                        j.joint,
-                        f"joint {j.joint.value} appears twice in motion {s.name.name}",
-                        f"the first is at line {seen[j.joint.value].line}; put all its keyframes under one JOINT",
-                    )
-                seen[j.joint.value] = j.joint.pos
+            self._track(j.joint, seen, s.name.name)
             if j.start is not None:
                 self._position(j.start, j)
             last = None
@@ -581,6 +564,34 @@ class Checker(NodeVisitor):
                 if c is not None and last is not None and c < last:
                     self.err(k.frame, messages.keyframes_out_of_order(c, last))
                 last = c if c is not None else last
+        for t in s.tables:
+            for column in t.columns:
+                self._track(column, seen, s.name.name)
+            try:
+                t.data = keyframe_table.read_rows(t.rows, t.rows_pos, len(t.columns))
+            except keyframe_table.TableProblem as problem:
+                self.err(problem.pos, problem.message, problem.hint)
+
+    def _track(self, joint, seen: dict, motion: str) -> None:
+        """One track of a motion block (a JOINT entry, ROOT, or a table's column): its type, and only once."""
+        if isinstance(joint, A.RootTrack):
+            if "ROOT" in seen:
+                self.err(
+                    joint,
+                    f"ROOT appears twice in motion {motion}",
+                    f"the first is at line {seen['ROOT'].line}; a motion has one root track",
+                )
+            seen["ROOT"] = joint.pos
+            return
+        self._want(joint, T.INTEGER, "a joint identifier")
+        if isinstance(joint, A.Num) and _const(joint) is not None:
+            if joint.value in seen:
+                self.err(
+                    joint,
+                    f"joint {joint.value} appears twice in motion {motion}",
+                    f"the first is at line {seen[joint.value].line}; put all its keyframes under one JOINT",
+                )
+            seen[joint.value] = joint.pos
 
     def _s_ReachBlock(self, s, context):
         if self.primitive is not None:

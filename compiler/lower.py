@@ -16,7 +16,7 @@ import re
 
 from liganimate import __version__
 from liganimate.lang import ast as A
-from liganimate.lang import bindings
+from liganimate.lang import bindings, keyframe_table
 from liganimate.lang import numbers as N
 from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
@@ -360,7 +360,13 @@ class Lowerer(NodeVisitor):
                 kfs.append(f"({self.expr(k.frame)}, {self.position(k.position)}, {method}, {self.at(k)})")
             inner = "".join(x + ", " for x in kfs)
             self.emit(f"    ({self.joint_or_root(j.joint)}, {start}, ({inner}), {self.at(j)}),")
-        self.emit(f"), {self.at(s)})")
+        tables = ""
+        for t in s.tables:
+            # The rows travel as one string of numbers (lang/keyframe_table.py), read in bulk at run time.
+            columns = "".join(self.joint_or_root(c) + ", " for c in t.columns)
+            numbers = keyframe_table.numbers_text(t.rows)
+            tables += f"_host.TableArgs(({columns}), {numbers!r}, {self.at(t)}), "
+        self.emit(f"), {self.at(s)}" + (f", ({tables}))" if tables else ")"))
 
     def s_ReachBlock(self, s, where):
         def opt(e):

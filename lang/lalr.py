@@ -26,7 +26,7 @@ from lark.lexer import Token
 from lark.parse_tree_builder import ChildFilterLALR_NoPlaceholders, ExpandSingleChild
 from lark.parsers.lalr_analysis import Shift
 
-from .lexer import DOLLAR, NUMBER, OPERATOR, SCAN, STRING, WORD, Scanner, Tok
+from .lexer import DOLLAR, NUMBER, OPERATOR, ROWS, SCAN, STRING, WORD, Scanner, Tok
 
 
 class _Inlined(tuple):
@@ -195,6 +195,8 @@ class Driver:
                 ttype = "STRING"
             elif k == DOLLAR:
                 ttype = "DOLLAR_NAME"
+            elif k == ROWS:
+                ttype = "TABLE_ROWS"
             else:
                 # The end of the text: $END goes through the same loop, which
                 # reduces what is left and returns at the start rule's end state.
@@ -206,6 +208,12 @@ class Driver:
                 column = start - line_start + 1
                 tok = _new_tuple(Tok, (ttype, value, start, line, column, column + end - start, end))
                 pos = end
+                if k == ROWS:
+                    # The only token that spans lines: the next one's line counts from its end.
+                    nl = count("\n", start, end)
+                    if nl:
+                        line += nl
+                        line_start = text.rfind("\n", start, end) + 1
                 if tokens is not None:
                     tokens.append(tok)
             # ------------------------------------------------ feed it
