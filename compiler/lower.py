@@ -81,6 +81,7 @@ class Lowerer(NodeVisitor):
         self.consume = False  # see lower()
         self.canvas = None
         self.tmp = 0
+        self.table_spans: list = []  # (start, end) offsets of keyframe-table rows, left out of the embedded source
         # > 0 inside code that runs many times (DO bodies, scene bodies,
         # primitives): there + - * results are range-checked inline, which
         # runs fastest; elsewhere by a call, which CPython compiles several
@@ -228,7 +229,16 @@ class Lowerer(NodeVisitor):
         self.emit("")
 
     def source_literal(self) -> str:
-        return repr(self.c.program.source)
+        source = self.c.program.source
+        if self.table_spans:
+            # A keyframe table's rows are data the module already carries; the source kept for
+            # diagnostics keeps their lines (so every line number holds) but not their numbers.
+            pieces, last = [], 0
+            for start, end in sorted(self.table_spans):
+                pieces += [source[last:start], "|" + "\n|" * source.count("\n", start, end)]
+                last = end
+            source = "".join(pieces) + source[last:]
+        return repr(source)
 
     # --------------------------------------------------------- primitives
     def primitive(self, pdef: A.PrimitiveDef, sig, scope) -> None:
@@ -364,8 +374,9 @@ class Lowerer(NodeVisitor):
         for t in s.tables:
             # The rows travel as one string of numbers (lang/keyframe_table.py), read in bulk at run time.
             columns = "".join(self.joint_or_root(c) + ", " for c in t.columns)
-            numbers = keyframe_table.numbers_text(t.rows)
-            tables += f"_host.TableArgs(({columns}), {numbers!r}, {self.at(t)}), "
+            packed = keyframe_table.pack(t.rows)
+            tables += f"_host.TableArgs(({columns}), {packed!r}, {self.at(t)}), "
+            self.table_spans.append((t.rows_pos.start, t.rows_pos.start + len(t.rows)))
         self.emit(f"), {self.at(s)}" + (f", ({tables}))" if tables else ")"))
 
     def s_ReachBlock(self, s, where):

@@ -66,7 +66,7 @@ class TableArgs:
     """A keyframe table of a STARTMOTION block, as the compiled module passes it to :meth:`Runtime.motion_block`.
 
     ``columns`` are the joint identifiers (None for ROOT), ``numbers`` the
-    rows' numbers as one blank-separated string (lang/keyframe_table.py,
+    rows' numbers, blank-separated, deflated and in base 64 (``keyframe_table.pack``;
     checked by the compiler), ``at`` the table's position index.
     """
 
@@ -594,7 +594,7 @@ class Runtime(Arithmetic):
         arrays: dict = {}
         for t in tables:
             width = 1 + 3 * len(t.columns)
-            data = keyframe_table.parse_numbers(t.numbers)
+            data = keyframe_table.unpack(t.numbers)
             if data is None or data.size == 0 or data.size % width:
                 self.fail(t.at, "this keyframe table's rows do not have one frame and three numbers per column")
             data = data.reshape(-1, width)
