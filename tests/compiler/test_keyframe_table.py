@@ -87,3 +87,13 @@ def test_a_table_starts_at_frame_0_and_a_joint_is_listed_once():
 def test_table_stays_a_variable_name_elsewhere():
     program, _ = load_program(text="      REAL TABLE\n      TABLE = 2.0\n      PRINT TABLE\n")
     assert program.execute("check").variables["TABLE"] == 2.0
+
+
+def test_fmt_keeps_a_table_and_its_rows_as_written():
+    from liganimate.lang.formatter import format_text
+
+    once = format_text(TABLE)
+    assert format_text(once) == once
+    assert "\n  TABLE 1, ROOT, 2\n" in once
+    assert "|  2.5 20 0 0   0.2 0 0   1 2 5" in once
+    assert np.array_equal(_motion(once).evaluate(np.arange(3.0)), _motion(TABLE).evaluate(np.arange(3.0)))
