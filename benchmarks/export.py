@@ -6,14 +6,16 @@ with ``--quick``).  Timed, each from the compiled program (compiling is
 outside every timing, as it is the same for all):
 
 * ``render``: ``Program.render`` to PNG files, as ``liganimate run`` does;
-* ``gltf``: running the scenes without drawing and writing a ``.glb``;
+* ``gltf``: running the scenes without drawing and writing a ``.glb``, with
+  the default skinned rig and with ``rig="nodes"`` (the node tree) beside it;
 * ``bvh``: the same, writing one ``.bvh`` per figure;
 * ``import``: reading a BVH capture of as many frames (the first figure's
   export) and writing its LIG library.
 
 The goal is that export and import each cost less than a tenth of
 rendering.  Each figure is the best of a few rounds (the machine is
-shared).  The last line printed is one JSON object.
+shared); CPU time is reported beside wall time.  The last line printed is
+one JSON object.
 
 Usage: ``python benchmarks/export.py [--quick]``.
 """
@@ -49,12 +51,18 @@ def lengthened(folder: str, ticks: int) -> str:
 
 def best(fn, rounds: int) -> float:
     """The shortest of ``rounds`` wall-clock timings of ``fn()``."""
+    return best_with_cpu(fn, rounds)[0]
+
+
+def best_with_cpu(fn, rounds: int) -> tuple[float, float]:
+    """(wall, CPU) seconds of the round of ``fn()`` with the least CPU time, of ``rounds``."""
     times = []
     for _ in range(rounds):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+        times.append((time.process_time() - c0, time.perf_counter() - t0))
+    cpu, wall = min(times)
+    return wall, cpu
 
 
 def main(argv=None) -> int:
@@ -75,11 +83,16 @@ def main(argv=None) -> int:
             data, _ = X.gltf_bytes(X.collect(program), True)
             X.write_files([(os.path.join(out, "film.glb"), data)])
 
+        def gltf_nodes():
+            data, _ = X.gltf_bytes(X.collect(program), True, rig="nodes")
+            X.write_files([(os.path.join(out, "film-nodes.glb"), data)])
+
         def bvh():
             X.write_files(X.bvh_files(X.collect(program), os.path.join(out, "film.bvh"), 24.0))
 
         t_render = best(render, 1 if args.quick else 2)
-        t_gltf = best(gltf, rounds)
+        t_gltf, c_gltf = best_with_cpu(gltf, rounds)
+        t_nodes, c_nodes = best_with_cpu(gltf_nodes, rounds)
         t_bvh = best(bvh, rounds)
         capture = os.path.join(out, "film-scene1-H1.bvh")
 
@@ -90,6 +103,7 @@ def main(argv=None) -> int:
         t_import = best(import_, rounds)
         sizes = {
             "glb_bytes": os.path.getsize(os.path.join(out, "film.glb")),
+            "glb_nodes_bytes": os.path.getsize(os.path.join(out, "film-nodes.glb")),
             "bvh_bytes": os.path.getsize(capture),
             "lig_bytes": os.path.getsize(os.path.join(out, "capture.lig")),
         }
@@ -98,6 +112,10 @@ def main(argv=None) -> int:
         "figures": 5,
         "render_s": round(t_render, 3),
         "gltf_s": round(t_gltf, 3),
+        "gltf_cpu_s": round(c_gltf, 3),
+        "gltf_nodes_s": round(t_nodes, 3),
+        "gltf_nodes_cpu_s": round(c_nodes, 3),
+        "skin_over_nodes_cpu": round(c_gltf / c_nodes, 3),
         "bvh_s": round(t_bvh, 3),
         "import_s": round(t_import, 3),
         "gltf_over_render": round(t_gltf / t_render, 4),
@@ -108,7 +126,7 @@ def main(argv=None) -> int:
     }
     print(
         f"{ticks} ticks, five figures: render {t_render:.2f} s; glTF {t_gltf:.3f} s "
-        f"({100 * t_gltf / t_render:.1f}%), BVH {t_bvh:.3f} s ({100 * t_bvh / t_render:.1f}%), "
+        f"({100 * t_gltf / t_render:.1f}%; CPU {c_gltf:.3f} s, node tree {c_nodes:.3f} s), BVH {t_bvh:.3f} s ({100 * t_bvh / t_render:.1f}%), "
         f"import of a {ticks}-frame capture {t_import:.3f} s ({100 * t_import / t_render:.1f}%)"
     )
     sys.stdout.write(json.dumps(result) + "\n")

@@ -298,9 +298,9 @@ class Checker(NodeVisitor):
 
     def _check_recursion(self, p: A.PrimitiveDef) -> None:
         """A PRIMITIVE may not call itself, directly or through others (it would never end)."""
-        calls = {}
-        for q in self.program.primitives:
-            calls[q.name.name] = {n for n in _prim_calls(q)}
+        calls = self.__dict__.get("_call_graph")
+        if calls is None:  # once per check: walking every body for every PRIMITIVE was quadratic
+            calls = self.__dict__["_call_graph"] = {q.name.name: _prim_calls(q) for q in self.program.primitives}
         seen, stack = set(), [(c, c) for c in calls.get(p.name.name, ())]
         while stack:
             name, first = stack.pop()

@@ -99,14 +99,16 @@ def _extra(row) -> list:
     """A name-table row's URDF columns (joint name, rpy) for the cache's JSON."""
     joint = row[3] if len(row) > 3 else None
     rpy = row[4] if len(row) > 4 else None
-    return [joint, None if rpy is None else list(rpy)]
+    mimic = row[5] if len(row) > 5 else None
+    return [joint, None if rpy is None else list(rpy), None if mimic is None else list(mimic)]
 
 
 def _extra_back(row) -> tuple:
     """:func:`_extra` read back (a row cached before the columns existed has neither)."""
     joint = row[3] if len(row) > 3 else None
     rpy = row[4] if len(row) > 4 else None
-    return (joint, None if rpy is None else tuple(rpy))
+    mimic = row[5] if len(row) > 5 else None
+    return (joint, None if rpy is None else tuple(rpy), None if mimic is None else tuple(mimic))
 
 
 def stdlib_dir() -> Path:

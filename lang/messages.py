@@ -28,6 +28,19 @@ def did_you_mean(name: str, candidates: Iterable[str], cutoff: float = 0.6) -> s
     return "did you mean " + ", ".join(near[:-1]) + " or " + near[-1] + "?"
 
 
+def sentence(message: str) -> str:
+    """A message as liganimate prints it: no final period, a lower-case start unless it opens with a word in capitals.
+
+    Runtime libraries write full sentences (``"The VIEW WIDTH must be
+    positive."``); a diagnostic and ``liganimate: error:`` print them in the
+    house style: ``the VIEW WIDTH must be positive``.
+    """
+    message = message.strip()
+    if message.endswith(".") and not message.endswith(".."):
+        message = message[:-1]
+    return message[:1].lower() + message[1:] if message[:2] != message[:2].upper() else message
+
+
 def _num(x) -> str:
     return str(x) if isinstance(x, int) else f"{x:g}"
 

@@ -15,7 +15,8 @@ character, ``}`` written ``\\u007d``), its BVH channels in the source's
 order, and ``END x y z`` for a leaf's End Site.  A robot imported from
 URDF adds ``JOINT "name"``, the URDF joint that attaches the link, and
 ``RPY r p y``, the URDF link frame's turn from the LIG link's (radians),
-which URDF export reads back.  A link the source did not
+and for a mimic joint ``MIMIC "leader" multiplier offset``, which URDF
+export reads back.  A link the source did not
 have (the importer's ``ORIGIN``) has no row.  The table is a comment, so a
 library with one still reads as before everywhere else; ``LOAD`` hands the
 rows to the model's links (``Link.source``), and BVH and glTF export use
@@ -34,6 +35,7 @@ CHANNELS = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zr
 _TABLE = re.compile(r"\{@names[ \t]+([A-Za-z][A-Za-z0-9_]*)[ \t]*\n([^}]*)\}")
 _ROW = re.compile(r"[ \t]*([A-Za-z][A-Za-z0-9_]*)[ \t]+(\"(?:[^\"\\\n]|\\.)*\")(.*)")
 _JOINT = re.compile(r"[ \t]JOINT[ \t]+(\"(?:[^\"\\\n]|\\.)*\")")
+_MIMIC = re.compile(r"[ \t]MIMIC[ \t]+(\"(?:[^\"\\\n]|\\.)*\")")
 _DECODE = json.JSONDecoder()
 
 
@@ -60,7 +62,7 @@ def format_table(model: str, rows) -> str:
     """
     out = [f"{{@names {model}"]
     for segment, name, channels, end, *more in rows:
-        joint, rpy = (list(more) + [None, None])[:2]
+        joint, rpy, mimic = (list(more) + [None, None, None])[:3]
         row = f"  {segment} {_quoted(name)}"
         if channels:
             row += " " + " ".join(channels)
@@ -70,6 +72,8 @@ def format_table(model: str, rows) -> str:
             row += " JOINT " + _quoted(joint)
         if rpy is not None:
             row += " RPY " + " ".join(repr(float(x) + 0.0) for x in rpy)
+        if mimic is not None:
+            row += f" MIMIC {_quoted(mimic[0])} {float(mimic[1])!r} {float(mimic[2])!r}"
         out.append(row)
     out.append("}")
     return "\n".join(out) + "\n"
@@ -108,39 +112,54 @@ def _row(line: str):
         return None
     try:
         name, _ = _DECODE.raw_decode(m.group(2))
+        rest, joint, leader = _quoted_columns(m.group(3))
+        channels, end, numbers = _columns(rest.split())
     except ValueError:
         return None
-    rest = m.group(3)
-    joint = None
-    jm = _JOINT.search(rest)
-    if jm is not None:
-        try:
-            joint, _ = _DECODE.raw_decode(jm.group(1))
-        except ValueError:
+    rpy = numbers.get("RPY")
+    mimic = None
+    if "MIMIC" in numbers:
+        if leader is None:
             return None
-        rest = rest[: jm.start()] + rest[jm.end() :]
-    words = rest.split()
-    channels = []
-    end = None
-    rpy = None
+        mimic = (leader, *numbers["MIMIC"])
+    if joint is None and rpy is None and mimic is None:
+        return m.group(1).upper(), name, tuple(channels), end
+    return m.group(1).upper(), name, tuple(channels), end, joint, rpy, mimic
+
+
+def _quoted_columns(rest: str) -> tuple:
+    """``JOINT "name"`` and ``MIMIC "leader"`` taken out of a row's tail: (rest, joint, leader).
+
+    MIMIC's numbers stay behind its word for :func:`_columns`.
+    """
+    joint = leader = None
+    for pattern in (_JOINT, _MIMIC):
+        jm = pattern.search(rest)
+        if jm is None:
+            continue
+        value, _ = _DECODE.raw_decode(jm.group(1))
+        if pattern is _JOINT:
+            joint, mark = value, " "
+        else:
+            leader, mark = value, " MIMIC"
+        rest = rest[: jm.start()] + mark + rest[jm.end() :]
+    return rest, joint, leader
+
+
+_COUNTS = {"END": 3, "RPY": 3, "MIMIC": 2}  # the numbers each word takes
+
+
+def _columns(words: list) -> tuple:
+    """Channels, the End Site and the numbered columns (RPY, MIMIC) of a row; ValueError when malformed."""
+    channels: list = []
+    numbers: dict = {}
     while words:
         w = words.pop(0)
-        if w in CHANNELS and w not in channels and end is None:
+        if w in CHANNELS and w not in channels and "END" not in numbers:
             channels.append(w)
-        elif w == "END" and end is None and len(words) >= 3:
-            try:
-                end = tuple(float(x) for x in words[:3])
-            except ValueError:
-                return None
-            del words[:3]
-        elif w == "RPY" and rpy is None and len(words) >= 3:
-            try:
-                rpy = tuple(float(x) for x in words[:3])
-            except ValueError:
-                return None
-            del words[:3]
+        elif w in _COUNTS and w not in numbers and len(words) >= _COUNTS[w]:
+            numbers[w] = tuple(float(x) for x in words[: _COUNTS[w]])
+            del words[: _COUNTS[w]]
         else:
-            return None
-    if joint is None and rpy is None:
-        return m.group(1).upper(), name, tuple(channels), end
-    return m.group(1).upper(), name, tuple(channels), end, joint, rpy
+            raise ValueError(w)
+    return channels, numbers.pop("END", None), numbers

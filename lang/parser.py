@@ -20,10 +20,11 @@ from . import collector, tables
 from .diagnostics import Diagnostic, LigDiagnostics
 from .lalr import Driver
 from .lexer import TablesOnly
+from .messages import did_you_mean
 from .source import Source, prepare
 from .structure import group_blocks
 from .transform import ToAst
-from .vocabulary import BLOCKS
+from .vocabulary import BLOCKS, GRAPHICAL, INTEGER, MODEL, MOTION, REAL, VECTOR
 
 #: Primitives every program knows without defining them.
 BUILTIN_PRIMITIVES = frozenset({"BOX"})
@@ -163,11 +164,11 @@ def _describe_token(tok: Token) -> str:
     if tok.type == "$END":
         return "the end of the file"
     text = str(tok.value)
-    if tok.type in ("NAME", "PRIM_NAME"):
+    if tok.type in ("NAME", "PRIM_NAME", "CLAUSE_NAME"):
         shown = text.upper() if len(text) <= 40 else text[:40].upper() + "..."
-        return f"the name {shown}"
+        return f"name {shown}"
     if tok.type == "NUMBER":
-        return f"the number {text}" if len(text) <= 40 else f"the number {text[:40]}..."
+        return f"number {text}" if len(text) <= 40 else f"number {text[:40]}..."
     return repr(text) if len(text) <= 20 else repr(text[:20] + "...")
 
 
@@ -414,8 +415,13 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
         hint = "choose another name"
     else:
         message = f"unexpected {_describe_token(tok)}; expected {_describe_expected(expected)}"
+        hint = _misspelt_keyword(tok, expected)
+        if hint is None and {"ASSIGN_OP", "LSQB"} <= expected:
+            d = _misspelt_statement(tok, text, source)
+            if d is not None:
+                return d
         closers = {e for e in expected if e.startswith("END")}
-        if (tok.type.startswith("END") and tok.type not in expected) or closers:
+        if hint is None and ((tok.type.startswith("END") and tok.type not in expected) or closers):
             opened = _open_blocks(text, tok.start_pos)
             if opened:
                 word, at = opened[-1]
@@ -424,6 +430,63 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
         if hint is None and expected & {"RPAR", "RSQB"}:
             hint = _bracket_hint(text, tok.start_pos)
     return Diagnostic(source.filename, pos, message, hint, source=source.text)
+
+
+#: The declarable types, as TYPE_KW spells them.
+TYPE_NAMES = (REAL, INTEGER, VECTOR, GRAPHICAL, MODEL, MOTION)
+
+
+def _keyword_words(expected: set) -> set:
+    """The keywords among the terminals ``expected``, as the user spells them."""
+    words = set()
+    for e in expected:
+        if e == "TYPE_KW":
+            words |= set(TYPE_NAMES)
+            continue
+        shown = _terminal_text(e)
+        if shown.isalpha() and shown.isupper() and len(shown) > 1:
+            words.add(shown)
+    return words
+
+
+def _misspelt_keyword(tok: Token, expected: set) -> str | None:
+    """'did you mean LENGTH?' when a name stands where a keyword close to it was expected."""
+    if tok.type not in ("NAME", "PRIM_NAME", "CLAUSE_NAME"):
+        return None
+    return did_you_mean(str(tok.value), _keyword_words(expected), cutoff=0.75)
+
+
+def _misspelt_statement(tok: Token, text: str, source: Source):
+    """A misspelt statement keyword (STARTMOTON M): the word was read as a variable, so the name after it fails.
+
+    Reported at the misspelt word, with the keyword it is closest to; None
+    when the word before ``tok`` is close to no statement keyword.
+    """
+    before = _blanked(text, _start(tok)).rstrip()
+    m = _LAST_WORD.search(before, max(0, len(before) - 40))
+    if m is None:
+        return None
+    word = m.group(0)
+    hint = did_you_mean(word, _STATEMENT_WORDS, cutoff=0.75)
+    if hint is None or word.upper() in _STATEMENT_WORDS:
+        return None
+    line, col = _line_col(text, m.start())
+    return Diagnostic(
+        source.filename,
+        A.Pos(line, col, line, col + len(word)),
+        f"{word.upper()} is not a keyword: read as a variable, it needs =, := or :- after it",
+        hint,
+        source=source.text,
+    )
+
+
+# The words a statement may start with (a misspelling of one is read as a variable name).
+_STATEMENT_WORDS = frozenset(
+    {w.opener for w in BLOCKS}
+    | set(TYPE_NAMES)
+    | {"ANIMATE", "BACKGROUND", "PRINT", "VIEW", "SHOOTSCENES", "LOAD", "STOP", "RETURN", "DRAW", "FIGURE"}
+    | {"IF", "DO", "PRIMITIVE", "INITIALIZE", "STARTREACH", "ENDMODEL", "ENDMOTION", "ENDSCENE", "STARTSCENE"}
+)
 
 
 # When the file ends inside a block the scan did not see, the closer to suggest.

@@ -32,6 +32,7 @@ from liganimate.runtime.library import Library  # noqa: F401  (generated modules
 from liganimate.runtime.motion import algebra as M
 from liganimate.runtime.motion import edits as E
 from liganimate.runtime.motion.keyframe import Keyframe
+from liganimate.runtime.render import framing
 from liganimate.runtime.values import EMPTY, ZERO, Canvas, Graphical, Vec, box
 
 if TYPE_CHECKING:
@@ -140,6 +141,9 @@ class Program:
         self._positions = positions
         self.main = main
         self.source = source
+        # Scene id -> world box (lo, hi) of what the scene draws, or None when
+        # it sets VIEW: gathered by check, read by the renderer's default framing.
+        self.framings: dict = {}
 
     @property
     def positions(self) -> tuple:
@@ -274,9 +278,12 @@ class Runtime(Arithmetic):
         self.warnings: list = []
         self._warned: set = set()
         self.scenes: dict = {}
+        #: How many scenes SHOOTSCENES has shot (none: the program draws nothing, a library say).
+        self.shot = 0
         self.scene = None
         self.view_point = Vec(0.0, 0.0, 10.0)
         self.view_width = 10.0
+        self.viewed = False  # a VIEW statement has run (outside a scene)
         self.variables: dict = {}
         self._bind_cache: dict = {}
         self.echo_print = False
@@ -531,9 +538,14 @@ class Runtime(Arithmetic):
 
     # ------------------------------------------------------------- REACH
     def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
-        """A STARTREACH block: (the motion to the solved pose, the solved translation)."""
+        """A STARTREACH block: (the motion to the solved pose, the solved translation).
+
+        The arguments are the block's, as the lowering writes them; its
+        options travel on as one ``ReachOptions`` (``ik.language.block_options``).
+        """
         from liganimate.runtime.ik import language as RL
 
+        options = RL.block_options(movable, translate, solver, tolerance, iterations)
         fig = self._model(model, at, "the model of a REACH")
         start_motion = self._motion(start, at) if start is not None else None
         self._guard(at, RL.check_frames, frames)
@@ -548,18 +560,7 @@ class Runtime(Arithmetic):
             built.append(goal)
         block = self._guard(
             at,
-            lambda: RL.reach_block(
-                fig,
-                built,
-                frames,
-                method,
-                start=start_motion,
-                movable=movable,
-                translate=translate,
-                solver=solver,
-                tolerance=tolerance,
-                iterations=iterations,
-            ),
+            lambda: RL.reach_block(fig, built, frames, method, start=start_motion, options=options),
         )
         for w in block.warnings:
             self.warn(at if w.goal is None else goals[w.goal].at, _sentence(w.sentence), w.hint)
@@ -631,8 +632,10 @@ class Runtime(Arithmetic):
             target = "view_width"
         if self.scene is not None:
             setattr(self.scene, target, value)
+            self.scene.viewed = True
         else:
             setattr(self, target, value)
+            self.viewed = True
 
     def define_scene(self, scene_id, fn, snapshot, at):
         if scene_id in self.scenes:
@@ -643,10 +646,14 @@ class Runtime(Arithmetic):
         for scene_id in sorted(self.scenes):
             fn, snapshot, sat = self.scenes[scene_id]
             self.scene = SceneState(scene_id, self.view_point, self.view_width, sat)
+            self.shot += 1
+            self.scene.viewed = self.viewed
             if self.renderer is not None:
                 self.renderer.begin_scene(scene_id)
             try:
                 fn(snapshot)
+                if self.mode == "check":
+                    self.program.framings[scene_id] = None if self.scene.viewed else self.scene.extent
             finally:
                 if self.renderer is not None:
                     self.renderer.end_scene()
@@ -710,6 +717,10 @@ class Runtime(Arithmetic):
                 f"the motion drives joint{'s' if len(missing) > 1 else ''} "
                 f"{', '.join(map(str, missing))}, which the model does not have",
             )
+        if fig.slides.any():
+            problem = P.slide_out_of_range(fig, motion)
+            if problem is not None:
+                self.fail(at, *problem)
 
     def background(self, items, at):
         out = []
@@ -725,6 +736,8 @@ class Runtime(Arithmetic):
         for name, value in pairs:
             if isinstance(value, Posed):
                 state.drawn.append((name, _rooted(value)))
+        if self.mode == "check" and not state.viewed and framing.sampled(state.tick, state.length):
+            state.measure()
         if self.renderer is not None:
             self.renderer.add_tick(state, self)
         state.drawn = []
@@ -776,6 +789,17 @@ class SceneState:
         self.length = 0
         self.sameframe = 1
         self.at = at
+        self.viewed = False  # a VIEW statement has run before or in the scene
+        self.extent = None  # world box of what is drawn at the ticks measured
+
+    def measure(self) -> None:
+        """Add this tick's drawing (and the background) to :attr:`extent`, for the default framing."""
+        for item in self.background:
+            tris = item.triangles if isinstance(item, Graphical) else P.static_triangles(item)[0]
+            self.extent = framing.union(self.extent, framing.extent(tris))
+        for _name, posed in self.drawn:
+            tris = P.posed_graphical(posed.figure, posed.motion, posed.frame).triangles
+            self.extent = framing.union(self.extent, framing.extent(tris))
 
 
 def _rooted(posed: Posed) -> Posed:
@@ -794,8 +818,7 @@ def _joint_kind(kind) -> F.JointKind:
 
 
 def _sentence(message: str) -> str:
-    """Runtime libraries write sentences; diagnostics print them without the final period."""
-    message = message.strip()
-    if message.endswith(".") and not message.endswith(".."):
-        message = message[:-1]
-    return message[:1].lower() + message[1:] if message[:2] != message[:2].upper() else message
+    """Runtime libraries write sentences; diagnostics print them without the final period (messages.sentence)."""
+    from liganimate.lang.messages import sentence
+
+    return sentence(message)

@@ -225,8 +225,43 @@ C       WALK's ROOT track carries the body forward; the scene places its start.
 """
 
 
+# A crane: a carriage SLIDEs along its rail while a boom swings about its own AXIS, and a copy re-rooted
+# at the boom (the slide and the turn walked backwards), both moving every tick.
+CRANE = """\
+GRAPHICAL RAIL, CARRIAGE, BOOM, HOOK
+MODEL CRANE, HANGING
+MOTION WORK
+RAIL :- BOX WIDTH 4.0, HEIGHT 0.2, DEPTH 1.0, LIGHTNESS 30.0
+CARRIAGE :- BOX WIDTH 0.5, HEIGHT 0.5, DEPTH 0.5
+BOOM :- BOX AT (0.0, 1.0, 0.0), WIDTH 0.2, HEIGHT 2.0, DEPTH 0.2, LIGHTNESS 70.0
+HOOK :- BOX WIDTH 0.3, HEIGHT 0.1, DEPTH 0.3
+STARTMODEL CRANE
+  JOINT 1, RAIL, (-1.5, 0.1, 0.0), CARRIAGE, (0.0, -0.25, 0.0), SLIDE (0.0, 3.0), (-0.2, 0.2)
+  JOINT 2, CARRIAGE, (0.0, 0.25, 0.0), BOOM, (0.0, 0.0, 0.0), (-90.0, 90.0), (-30.0, 30.0) AXIS (1.0, 1.0, 0.0)
+  JOINT 3, BOOM, (0.0, 2.0, 0.0), HOOK, (0.0, 0.05, 0.0), SLIDE (-0.5, 0.5), (-0.5, 0.5), (-0.5, 0.5)
+ENDMODEL
+HANGING :- CRANE <SCALE MODEL 0.5>
+FIGURE HANGING MAIN LINK BOOM
+STARTMOTION WORK
+  JOINT 1 POSITION 0.0, 0.0, 0.0
+    FRAME 10 POSITION 2.5, 0.15, 0.0
+  JOINT 2 POSITION -60.0, 10.0, 0.0
+    FRAME 10 POSITION 70.0, -25.0, 0.0
+  JOINT 3 POSITION 0.0, 0.0, 0.0
+    FRAME 10 POSITION 0.3, -0.4, 0.2
+ENDMOTION
+INITIALIZE SCENE 1
+STARTSCENE LENGTH 11
+  ANIMATE CRANE FROM 0 TO 10 USING WORK
+  ANIMATE HANGING FROM 0 TO 10 USING WORK
+  HANGING :- HANGING <ROT Y 30.0> <TRANS (0.5, 2.0, 1.0)>
+ENDSCENE
+SHOOTSCENES
+"""
+
+
 def program_named(tmp_path, name):
-    """A compiled program: ``edges`` or ``walking_humanoid`` (above), or an example's name."""
+    """A compiled program: ``edges``, ``crane`` or ``walking_humanoid`` (above), or an example's name."""
     from paths import ROOT_DIR
 
     from liganimate.cli import load_program
@@ -234,6 +269,9 @@ def program_named(tmp_path, name):
     if name == "edges":
         path = tmp_path / "edges.lig"
         path.write_text(EDGES)
+    elif name == "crane":
+        path = tmp_path / "crane.lig"
+        path.write_text(CRANE)
     elif name == "walking_humanoid":
         path = tmp_path / "walk.lig"
         path.write_text(WALKING_HUMANOID)
@@ -243,7 +281,7 @@ def program_named(tmp_path, name):
     return program
 
 
-PROGRAMS = ["edges", "walking_humanoid", "appendix_a", "rerooting", "big_and_small_robot", "there_and_back"]
+PROGRAMS = ["edges", "walking_humanoid", "crane", "appendix_a", "rerooting", "big_and_small_robot", "there_and_back"]
 
 
 # -- real clients: three.js in node, Blender's bpy ---------------------------------

@@ -35,14 +35,6 @@ ALLOWED: dict[tuple[str, str], str] = {
     ("compiler/check.py", "Checker._e_BinOp"): "arch-check",
     ("runtime/motion/algebra.py", "Motion.describe.render"): "arch-check",
     ("runtime/values.py", "_solid_orientation"): "arch-check",
-    ("runtime/studio/_library.py", "library_text"): "look",
-    ("runtime/ik/goals.py", "GoalStack.__init__"): "arch-options",
-    ("runtime/ik/goals.py", "GoalStack.evaluate"): "arch-options",
-    ("runtime/ik/model.py", "IKModel.__init__"): "arch-options",
-    ("runtime/ik/reach.py", "solve_pose"): "arch-options",
-    ("runtime/ik/solvers.py", "_dls_one"): "arch-options",
-    ("runtime/ik/solvers.py", "_ccd"): "arch-options",
-    ("runtime/render/raster.py", "_spans"): "arch-options",
 }
 
 

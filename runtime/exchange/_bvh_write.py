@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from liganimate.runtime.errors import LigError
-from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
+from liganimate.runtime.figure.kinematics import joint_transforms, matrix_from_euler_zyx
 from liganimate.runtime.values import Graphical
 
 from ._numbers import format_rows
@@ -129,8 +129,13 @@ def _folds_origin(fig, children: dict, edge_of: dict) -> bool:
     return not (isinstance(shape, Graphical) and len(shape) > 0)
 
 
-def _own_channels(source, is_root: bool, rev: bool) -> tuple:
-    """A node's channels: the source's, where they can be written exactly, else the joint convention's."""
+def _own_channels(source, is_root: bool, rev: bool, slide: bool = False) -> tuple:
+    """A node's channels: the source's, where they can be written exactly, else the joint convention's.
+
+    A slide (prismatic joint) moves its node: position channels, and no rotation.
+    """
+    if slide and not is_root:
+        return _POSITIONS
     if source is not None and source.channels:
         rot = [c for c in source.channels if c in _ROTATIONS]
         pos = [c for c in source.channels if c in _POSITIONS]
@@ -161,7 +166,8 @@ def _skeleton(fig, factor: float) -> list:
         else:
             k, near, far, rev = edge_of[i]
             offset = near - far_parent
-        node = _Node(i, parent, offset, _own_channels(link.source, parent < 0, rev), k, rev)
+        slide = k is not None and bool(fig.joints[k].slide)
+        node = _Node(i, parent, offset, _own_channels(link.source, parent < 0, rev, slide), k, rev)
         me = len(nodes)
         nodes.append(node)
         if parent >= 0:
@@ -203,35 +209,51 @@ def _hierarchy(nodes: list, names: list) -> list:
 
 def _node_frames(model, node: _Node, factor: float, fig) -> tuple:
     """(position (T, 3), rotation (T, 3, 3)) of a node relative to its parent node, per tick."""
-    T = len(model.ticks)
     if node.parent >= 0:
-        a = model.angles[:, node.joint]
+        assert node.joint is not None  # every node below the ROOT hangs from a joint
+        Rj, shift = _joint_motion(fig, model.angles, node.joint)
         if node.reversed:
-            return np.broadcast_to(node.offset, (T, 3)), np.swapaxes(matrix_from_euler_zyx(a), -1, -2)
-        return np.broadcast_to(node.offset, (T, 3)), matrix_from_euler_zyx(a)
+            Rt = np.swapaxes(Rj, -1, -2)
+            return node.offset - np.einsum("tij,tj->ti", Rt, shift) * factor, Rt
+        return node.offset + shift * factor, Rj
     t, R, _, _ = decompose_trs(model.placements)
     if node.joint is None:
         return t, R
     # The folded ORIGIN: placement, then the joint at its location on ORIGIN.
     loc1, loc2 = fig.locations
-    Rj = matrix_from_euler_zyx(model.angles[:, node.joint])
+    Rj, shift = _joint_motion(fig, model.angles, node.joint)
     pos = (
         t
-        + np.einsum("tij,j->ti", R, loc1[node.joint] * factor)
+        + np.einsum("tij,tj->ti", R, (loc1[node.joint] + shift) * factor)
         - np.einsum("tij,j->ti", R @ Rj, loc2[node.joint] * factor)
     )
     return pos, R @ Rj
+
+
+def _joint_motion(fig, angles: np.ndarray, k: int) -> tuple:
+    """Joint ``k``'s rotation (T, 3, 3) and a slide's shift (T, 3) per tick (AXIS and SLIDE included)."""
+    a = angles[:, k]
+    joint = fig.joints[k]
+    if joint.axes is None and not joint.slide:
+        return matrix_from_euler_zyx(a), np.zeros((len(a), 3))
+    X = joint_transforms(fig, angles)[:, k]
+    R = X[:, :3, :3]
+    shift = X[:, :3, 3] - joint.loc1 + np.einsum("tij,j->ti", R, joint.loc2)
+    if not joint.slide:
+        shift = np.zeros_like(shift)
+    return R, shift
 
 
 def _node_columns(model, node: _Node, factor: float, fig) -> np.ndarray:
     """The node's channel values, (T, len(channels)), in its channels' order."""
     pos, R = _node_frames(model, node, factor, fig)
     rot = [c[0] for c in node.channels if c in _ROTATIONS]
-    if node.parent >= 0 and node.joint is not None and not node.reversed and rot and _zyx_subsequence(rot):
+    plain = node.joint is not None and fig.joints[node.joint].axes is None
+    if node.parent >= 0 and plain and not node.reversed and rot and _zyx_subsequence(rot):
         # The joint convention's own axes: the very angles drawn, no conversion.
         a = model.angles[:, node.joint]
         angles = {axis: a[:, "XYZ".index(axis)] for axis in rot}
-    elif node.parent >= 0 and node.reversed and "".join(rot) == "XYZ":
+    elif node.parent >= 0 and plain and node.reversed and "".join(rot) == "XYZ":
         a = -model.angles[:, node.joint]
         angles = {axis: a[:, "XYZ".index(axis)] for axis in rot}
     else:

@@ -49,6 +49,22 @@ class ModelTake:
     ticks: np.ndarray
     angles: np.ndarray
     placements: np.ndarray
+    # (rows, figure, motion, frames) per group of ticks: what velocities() evaluates.
+    sources: tuple = field(default=(), repr=False)
+
+    def velocities(self) -> np.ndarray:
+        """Joint velocities at the ticks, per tick (degrees or lengths), from the interpolation's own derivatives.
+
+        Returns
+        -------
+        numpy.ndarray, shape (T, J, 3)
+            Zero where a joint is held by its extremes (as the pose record's).
+        """
+        out = np.zeros_like(self.angles)
+        for rows, fig, motion, frames in self.sources:
+            # ANIMATE plays one motion frame per tick.
+            out[rows] = joint_angles(fig, motion, frames, full=True)[1]
+        return out
 
 
 @dataclass
@@ -217,8 +233,10 @@ def _model_take(d: _Drawn) -> ModelTake:
     for n, (fig, motion) in enumerate(zip(d.figures, d.motions)):
         groups.setdefault((id(fig.joints), id(motion)), []).append(n)
     frames = np.asarray(d.frames, dtype=np.float64)
+    sources = []
     for rows in groups.values():
         fig, motion = d.figures[rows[0]], d.motions[rows[0]]
         angles[rows] = joint_angles(fig, motion, frames[rows])
+        sources.append((rows, fig, motion, frames[rows]))
     placements = np.stack([np.asarray(f.placement, dtype=np.float64) for f in d.figures])
-    return ModelTake(d.name, d.figure, np.asarray(d.ticks, dtype=np.int64), angles, placements)
+    return ModelTake(d.name, d.figure, np.asarray(d.ticks, dtype=np.int64), angles, placements, tuple(sources))

@@ -15,13 +15,16 @@ import tempfile
 __all__ = ["write_files"]
 
 
-def write_files(contents) -> None:
+def write_files(contents, folders=()) -> None:
     """Write several files atomically as a group.
 
     Parameters
     ----------
     contents : iterable of (str, bytes)
         Destination paths and their bytes.
+    folders : iterable of str, optional
+        Folders to make first if they are missing (a URDF's meshes folder);
+        those made are removed again if the writing fails.
 
     Raises
     ------
@@ -29,7 +32,12 @@ def write_files(contents) -> None:
         From creating or writing a temporary file; nothing is replaced then.
     """
     temps = []
+    made = []
     try:
+        for folder in folders:
+            if not os.path.isdir(folder):
+                os.mkdir(folder)
+                made.append(folder)
         for path, data in contents:
             folder = os.path.dirname(os.path.abspath(path))
             fd, tmp = tempfile.mkstemp(dir=folder, prefix="." + os.path.basename(path) + ".", suffix=".tmp")
@@ -44,6 +52,9 @@ def write_files(contents) -> None:
         for tmp, _ in temps:
             with contextlib.suppress(FileNotFoundError):
                 os.remove(tmp)
+        for folder in reversed(made):
+            with contextlib.suppress(OSError):
+                os.rmdir(folder)
         raise
     for tmp, path in temps:
         os.replace(tmp, path)

@@ -56,10 +56,13 @@ class Export:
         Destination paths and their contents.
     warnings : tuple of str
         Plain sentences (what the format cannot express, for example).
+    folders : tuple of str
+        Folders the files go into that are made if missing (URDF's meshes).
     """
 
     files: tuple[tuple[str, bytes], ...]
     warnings: tuple[str, ...] = ()
+    folders: tuple[str, ...] = ()  # made (if missing) before the files are written
 
 
 @dataclass(frozen=True)
@@ -195,6 +198,26 @@ def _write_bvh(scenes: Sequence[SceneTake], path: str, *, fps: float) -> Export:
     return Export(tuple(bvh_files(scenes, path, fps)))
 
 
+def _write_urdf(scenes: Sequence[SceneTake], path: str) -> Export:
+    from ._urdf_write import urdf_files
+
+    files, warnings = urdf_files(scenes, path)
+    folders = tuple(sorted({os.path.dirname(p) for p, _ in files if p.endswith(".stl")}))
+    return Export(tuple(files), tuple(warnings), folders)
+
+
+def _write_csv(scenes: Sequence[SceneTake], path: str, *, fps: float) -> Export:
+    from ._trajectory import trajectory_csv_files
+
+    return Export(tuple(trajectory_csv_files(scenes, path, fps)))
+
+
+def _write_json(scenes: Sequence[SceneTake], path: str, *, fps: float) -> Export:
+    from ._trajectory import trajectory_json
+
+    return Export(((path, trajectory_json(scenes, fps)),))
+
+
 #: Every export format, in the order the documentation lists them.
 EXPORT_FORMATS: tuple[ExportFormat, ...] = (
     ExportFormat(
@@ -212,6 +235,19 @@ EXPORT_FORMATS: tuple[ExportFormat, ...] = (
         _write_gltf,
     ),
     ExportFormat("bvh", (".bvh",), "BVH (Biovision hierarchy): one file per drawn model", ("fps",), _write_bvh),
+    ExportFormat(
+        "urdf", (".urdf",), "URDF robot description: one file per drawn model, STL meshes beside it", (), _write_urdf
+    ),
+    ExportFormat(
+        "csv",
+        (".csv",),
+        "joint-space trajectory (radians, metres, per second): one file per drawn model",
+        ("fps",),
+        _write_csv,
+    ),
+    ExportFormat(
+        "json", (".json",), "joint-space trajectories of every drawn model in one file", ("fps",), _write_json
+    ),
 )
 
 

@@ -24,6 +24,7 @@ import pygltflib as G
 from numpy.typing import ArrayLike
 
 from liganimate.runtime.errors import LigError
+from liganimate.runtime.figure.kinematics import joint_transforms
 from liganimate.runtime.figure.pose import static_triangles
 from liganimate.runtime.render.camera import Camera
 from liganimate.runtime.values import Graphical, rgb_levels
@@ -31,7 +32,6 @@ from liganimate.runtime.values import Graphical, rgb_levels
 from ._rotations import (
     continuous_quaternions,
     decompose_trs,
-    matrix_from_euler_zyx,
     quaternion_from_matrix,
 )
 
@@ -136,25 +136,41 @@ def linear_from_grey(grey: ArrayLike) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 
 
-def joint_quaternions(model) -> np.ndarray:
-    """The rotation of every joint node at every drawn tick, shape (T, J, 4), continuous along T.
+def joint_motion(model):
+    """Every joint node's rotation and extra translation at every drawn tick.
 
-    A joint walked from secondary to primary (FIGURE ... MAIN) turns by the
-    inverse rotation, the transpose.
+    A joint's transform (:func:`~liganimate.runtime.figure.kinematics.joint_transforms`,
+    which knows AXIS frames and SLIDE joints) is ``Trans(L1) R Trans(-L2)``
+    moved by a slide's shift ``d``.  Walked forwards, the joint node at ``L1``
+    turns by ``R`` and moves by ``d``; walked backwards (FIGURE ... MAIN),
+    the node at ``L2`` turns by ``R^T`` and moves by ``-R^T d``.
+
+    Returns
+    -------
+    q : ndarray, shape (T, J, 4)
+        Rotations as quaternions, continuous along T.
+    shift : ndarray, shape (T, J, 3)
+        Translations to add to the joint node's location (zero but for slides).
     """
     fig = model.figure
-    Rj = matrix_from_euler_zyx(model.angles)  # (T, J, 3, 3)
+    X = joint_transforms(fig, model.angles)  # (T, J, 4, 4)
+    R = X[..., :3, :3].copy()
+    loc1, loc2 = fig.locations
+    shift = X[..., :3, 3] - loc1 + np.einsum("...ij,...j->...i", R, np.broadcast_to(loc2, R.shape[:-1]))
     rev = fig.reversed_joints
     if rev.any():
-        Rj[:, rev] = np.swapaxes(Rj[:, rev], -1, -2)
-    return continuous_quaternions(quaternion_from_matrix(Rj))
+        Rt = np.swapaxes(R[:, rev], -1, -2)
+        R[:, rev] = Rt
+        shift[:, rev] = -np.einsum("...ij,...j->...i", Rt, shift[:, rev])
+    shift[:, ~fig.slides] = 0.0  # exactly zero where nothing slides, not rounding noise
+    return continuous_quaternions(quaternion_from_matrix(R)), shift
 
 
-def moving_joints(q: np.ndarray) -> np.ndarray:
-    """Per joint, whether its rotation changes over the ticks of ``q`` (T, J, 4)."""
-    if len(q) < 2:
-        return np.zeros(q.shape[1], dtype=bool)
-    return (q != q[:1]).any(axis=(0, 2))
+def moving_joints(values: np.ndarray) -> np.ndarray:
+    """Per joint, whether ``values`` (T, J, k) change over the ticks."""
+    if len(values) < 2:
+        return np.zeros(values.shape[1], dtype=bool)
+    return (values != values[:1]).any(axis=(0, 2))
 
 
 class Builder:

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from liganimate.runtime.values import Graphical
 
-from ._gltf import joint_quaternions, moving_joints
-from ._names import link_names
+from ._gltf import joint_motion, moving_joints
+from ._names import joint_names, link_names
 
 __all__ = ["node_rig"]
 
@@ -24,9 +24,10 @@ def node_rig(b, take, model, anim, interp) -> list[int]:
     fig = model.figure
     root = b.model_node(take, model, anim, interp)
     label = b.doc.nodes[root].name
-    qj = joint_quaternions(model)  # (T, J, 4)
-    moving = moving_joints(qj)
+    qj, shift = joint_motion(model)  # (T, J, 4), (T, J, 3)
+    turning, sliding = moving_joints(qj), moving_joints(shift)
     names = link_names(fig)
+    sourced = joint_names(fig)
     scales = fig.link_scales
     loc1, loc2 = fig.locations
     seg = {fig.main: _segment(b, take, model, f"{label} {names[fig.main]}", fig.main, root)}
@@ -35,17 +36,20 @@ def node_rig(b, take, model, anim, interp) -> list[int]:
             near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
             sp = scales[p]
             jid = fig.joints[k].id
+            place = (near + shift[:, k]) / sp  # (T, 3): a slide moves the joint node
             jn = b.node(
-                name=f"{label} joint {jid}",
-                translation=[float(v) for v in near / sp],
+                name=f"{label} {sourced[k]}" if sourced[k] else f"{label} joint {jid}",
+                translation=[float(v) for v in place[0]],
                 rotation=[float(v) for v in qj[0, k]],
                 extras={"liganimate": {"scene": take.id, "model": model.name, "joint": jid, "reversed": bool(r)}},
             )
             if sp != 1.0:
                 b.doc.nodes[jn].scale = [1.0 / sp] * 3
             b.doc.nodes[seg[p]].children.append(jn)
-            if moving[k]:
+            if turning[k]:
                 b.channel(anim, jn, "rotation", model.ticks, qj[:, k], interp)
+            if sliding[k]:
+                b.channel(anim, jn, "translation", model.ticks, place, interp)
             seg[c] = _segment(b, take, model, f"{label} {names[c]}", c, jn, offset=-far)
     return [root]
 

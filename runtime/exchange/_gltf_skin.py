@@ -9,8 +9,9 @@ the renderer walks it:
   bone hangs from the model node, as the capture had it);
 * the bone of a link reached through a joint sits at the joint's pivot: its
   translation is the joint's location on the parent link less the parent
-  bone's own pivot on that link, and its rotation is the joint's rotation
-  (its inverse when FIGURE ... MAIN walks the joint backwards).
+  bone's own pivot on that link (plus a SLIDE joint's displacement), and its
+  rotation is the joint's rotation (its inverse when FIGURE ... MAIN walks
+  the joint backwards).
 
 So a bone's world transform is the ``--poses`` matrix of its segment,
 without the segment's SCALE MODEL factor, moved to the joint: ``placement @
@@ -32,8 +33,8 @@ import pygltflib as G
 
 from liganimate.runtime.figure.pose import mesh_table
 
-from ._gltf import joint_quaternions, moving_joints
-from ._names import added_origin, link_names
+from ._gltf import joint_motion, moving_joints
+from ._names import added_origin, joint_names, link_names
 
 __all__ = ["skin_rig"]
 
@@ -42,9 +43,9 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
     """Add one drawn model as a skeleton and a skinned mesh to builder ``b``; its scene-root nodes."""
     fig = model.figure
     root = b.model_node(take, model, anim, interp)
-    qj = joint_quaternions(model)  # (T, J, 4)
-    moving = moving_joints(qj)
-    names = link_names(fig)
+    qj, shift = joint_motion(model)  # (T, J, 4), (T, J, 3)
+    turning, sliding = moving_joints(qj), moving_joints(shift)
+    names, sourced = link_names(fig), joint_names(fig)
     loc1, loc2 = fig.locations
     rest = np.zeros((fig.n_links, 3))  # each bone's pivot in the rest pose, in the model node's space
     pivot = np.zeros((fig.n_links, 3))  # each bone's pivot on its own link
@@ -54,13 +55,16 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
         for k, p, c, r in zip(level.joints, level.parents, level.children, level.reversed):
             near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
             offset = near - pivot[p]
-            bone = _bone(b, take, model, names, int(c), (int(k), bool(r)), bones.get(int(p), root))
+            bone = _bone(b, take, model, names, int(c), (int(k), bool(r), sourced[k]), bones.get(int(p), root))
             node = b.doc.nodes[bone]
-            if offset.any():
-                node.translation = [float(v) for v in offset]
+            place = offset + shift[:, k]  # (T, 3): a slide moves the bone
+            if place[0].any():
+                node.translation = [float(v) for v in place[0]]
             node.rotation = [float(v) for v in qj[0, k]]
-            if moving[k]:
+            if turning[k]:
                 b.channel(anim, bone, "rotation", model.ticks, qj[:, k], interp)
+            if sliding[k]:
+                b.channel(anim, bone, "translation", model.ticks, place, interp)
             bones[int(c)] = bone
             rest[c] = rest[p] + offset
             pivot[c] = far
@@ -89,7 +93,7 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
 
 
 def _bone(b, take, model, names, i: int, joint, parent: int) -> int:
-    """The bone node of link ``i``; ``joint`` is (joint index, walked backwards) or None for the main link."""
+    """The bone node of link ``i``; ``joint`` is (joint index, walked backwards, source's name) or None for the main link."""
     fig = model.figure
     link = fig.links[i]
     up = fig.parent_joint_of(i)
@@ -104,6 +108,8 @@ def _bone(b, take, model, names, i: int, joint, parent: int) -> int:
     if joint is not None:
         info["moved_by"] = fig.joints[joint[0]].id
         info["reversed"] = joint[1]
+        if joint[2]:
+            info["source_joint"] = joint[2]
     n = b.node(name=names[i], extras={"liganimate": info})
     b.doc.nodes[parent].children.append(n)
     return n

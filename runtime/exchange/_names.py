@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from liganimate.runtime.values import Graphical
 
-__all__ = ["added_origin", "link_names"]
+__all__ = ["added_origin", "joint_names", "link_names"]
 
 
 def link_names(fig) -> list[str]:
@@ -55,6 +55,20 @@ def link_names(fig) -> list[str]:
         taken.add(unique)
         names[i] = unique
     return names
+
+
+def joint_names(fig) -> list:
+    """Per joint of ``fig``, the name its source gave it (a URDF joint's), or None.
+
+    The name is the one the source gave the joint that attaches the joint's
+    secondary link (``Link.source.joint``), whichever way FIGURE ... MAIN
+    walks it.
+    """
+    out = []
+    for j in fig.joints:
+        source = fig.links[j.secondary].source
+        out.append(None if source is None else getattr(source, "joint", None))
+    return out
 
 
 def added_origin(fig) -> bool:

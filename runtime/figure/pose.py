@@ -11,6 +11,7 @@ import weakref
 
 import numpy as np
 
+from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.motion.algebra import Motion
@@ -251,3 +252,38 @@ def posed_graphical(fig: F.Figure, motion: Motion | None, frame: float) -> Graph
     table = mesh_table(fig)
     closed = table.closed & (np.linalg.det(placement[:3, :3]) > 0)
     return Graphical(world_triangles(table, X)[0], table.lightness, closed, table.colour)
+
+
+def slide_out_of_range(fig: F.Figure, motion: Motion, limit: int = 100_000) -> tuple[str, str] | None:
+    """The first keyframe that asks a slide for a displacement beyond its extremes, as ``(sentence, hint)``.
+
+    A turn past its extremes is clamped, as the thesis has it ("the joint
+    will enforce its extreme rotation limit"); a slide's extremes are the
+    length of its rail, and a keyframe beyond them is a mistake in the
+    program, so ANIMATE refuses it.  In-betweens are still clamped.  A
+    motion too long to list (beyond ``limit`` keyframes) is not checked.
+
+    Returns
+    -------
+    tuple of (str, str), or None when every keyframe is within range.
+    """
+    driven = set(motion.joints)
+    for joint in fig.joints:
+        if not joint.slide or joint.id not in driven:
+            continue
+        try:
+            start, keys = motion.keyframes(joint.id, limit)
+        except LigError:
+            continue
+        lo, hi = joint.extremes[:, 0], joint.extremes[:, 1]
+        for frame, value in [(0.0, start)] + [(k.frame, k.position) for k in keys]:
+            v = np.asarray(value, dtype=np.float64)
+            bad = np.flatnonzero((v < lo - 1e-9) | (v > hi + 1e-9))
+            if bad.size:
+                a = int(bad[0])
+                return (
+                    f"joint {joint.id} slides within ({lo[a]:g}, {hi[a]:g}) along {F.AXES[a]}, but the motion "
+                    f"puts it at {v[a]:g} at frame {frame:g}",
+                    "keep the keyframe within the SLIDE extremes, or widen them",
+                )
+    return None

@@ -246,6 +246,8 @@ class LinkSource(NamedTuple):
         The source link frame's turn from this link's frame, as URDF roll,
         pitch and yaw in radians (URDF: LIG link frames keep their
         primary's orientation at neutral, a URDF link's need not).
+    mimic : tuple or None
+        For a URDF mimic joint: ``(leader's name, multiplier, offset)``.
     """
 
     name: str
@@ -253,6 +255,7 @@ class LinkSource(NamedTuple):
     end: tuple | None = None
     joint: str | None = None
     rpy: tuple | None = None
+    mimic: tuple | None = None  # (leader joint's source name, multiplier, offset)
 
 
 @dataclass(frozen=True, eq=False)

@@ -265,6 +265,70 @@ _LEVI_CIVITA[0, 1, 2] = _LEVI_CIVITA[1, 2, 0] = _LEVI_CIVITA[2, 0, 1] = 1.0
 _LEVI_CIVITA[0, 2, 1] = _LEVI_CIVITA[2, 1, 0] = _LEVI_CIVITA[1, 0, 2] = -1.0
 
 
+def _gathered(model: IKModel, goals: tuple, B: int, warnings: list) -> tuple[dict, dict, dict]:
+    """The goals sorted by kind (point, plane, axis), each field a list in the user's order within its kind.
+
+    Warnings (an ambiguous link name) are appended to ``warnings``.
+
+    Raises
+    ------
+    GoalError
+        As :class:`GoalStack`.
+    """
+    scale = model.link_scale
+    pts: dict[str, list] = {"link": [], "local": [], "target": [], "w": [], "index": []}
+    pls: dict[str, list] = {"link": [], "local": [], "origin": [], "normal": [], "w": [], "index": []}
+    axs: dict[str, list] = {"link": [], "local": [], "dir": [], "ell": [], "w": [], "index": []}
+    mean_length = None  # only axis goals need it
+    for i, g in enumerate(goals):
+        if not isinstance(g, (PointGoal, PlaneGoal, AxisGoal)):
+            raise GoalError(f"goal {i + 1} is not a point, plane or axis goal.")
+        what = f"goal {i + 1}"
+        link, warning = resolve_link(model.figure, g.link)
+        if warning:
+            warnings.append(f"{what}: {warning}")
+        w = _batched(_weights(g.weight, f"the weight of {what}"), (B,))
+        if isinstance(g, AxisGoal):
+            a = _vectors(g.axis, f"the axis of {what}", None)
+            if a.ndim != 1:
+                raise GoalError(f"the axis of {what} is a direction in the link and cannot be batched.")
+            # A mirrored link (negative scale) turns its own directions round.
+            axs["local"].append(_unit(a, f"the axis of {what}") * np.sign(scale[link]))
+            axs["dir"].append(
+                _batched(
+                    _unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)
+                )
+            )
+            ell = model.lengths[link]
+            if mean_length is None:
+                positive = model.lengths[model.lengths > 0]
+                mean_length = float(positive.mean()) if positive.size else model.length
+            axs["ell"].append(ell if ell > 0 else mean_length)
+            d = axs
+        else:
+            point = _vectors(g.point, f"the link point of {what}", None)
+            if point.ndim != 1:
+                raise GoalError(f"the link point of {what} cannot be batched.")
+            local = point * scale[link]  # shape coordinates to link frame
+            if isinstance(g, PointGoal):
+                pts["target"].append(_batched(_vectors(g.target, f"the target of {what}", B), (B, 3)))
+                d = pts
+            else:
+                pls["origin"].append(_batched(_vectors(g.origin, f"the plane point of {what}", B), (B, 3)))
+                pls["normal"].append(
+                    _batched(
+                        _unit(_vectors(g.normal, f"the plane normal of {what}", B), f"the plane normal of {what}"),
+                        (B, 3),
+                    )
+                )
+                d = pls
+            d["local"].append(local)
+        d["link"].append(link)
+        d["w"].append(w)
+        d["index"].append(i)
+    return pts, pls, axs
+
+
 class GoalStack:
     """A list of goals packed into arrays, evaluated for a batch of poses.
 
@@ -298,57 +362,7 @@ class GoalStack:
         self.batch = B
         self.goals = tuple(goals)
         self.warnings: list[str] = []
-        scale = model.link_scale
-        pts: dict[str, list] = {"link": [], "local": [], "target": [], "w": [], "index": []}
-        pls: dict[str, list] = {"link": [], "local": [], "origin": [], "normal": [], "w": [], "index": []}
-        axs: dict[str, list] = {"link": [], "local": [], "dir": [], "ell": [], "w": [], "index": []}
-        mean_length = None  # only axis goals need it
-        for i, g in enumerate(self.goals):
-            if not isinstance(g, (PointGoal, PlaneGoal, AxisGoal)):
-                raise GoalError(f"goal {i + 1} is not a point, plane or axis goal.")
-            what = f"goal {i + 1}"
-            link, warning = resolve_link(model.figure, g.link)
-            if warning:
-                self.warnings.append(f"{what}: {warning}")
-            w = _batched(_weights(g.weight, f"the weight of {what}"), (B,))
-            if isinstance(g, AxisGoal):
-                a = _vectors(g.axis, f"the axis of {what}", None)
-                if a.ndim != 1:
-                    raise GoalError(f"the axis of {what} is a direction in the link and cannot be batched.")
-                # A mirrored link (negative scale) turns its own directions round.
-                axs["local"].append(_unit(a, f"the axis of {what}") * np.sign(scale[link]))
-                axs["dir"].append(
-                    _batched(
-                        _unit(_vectors(g.direction, f"the direction of {what}", B), f"the direction of {what}"), (B, 3)
-                    )
-                )
-                ell = model.lengths[link]
-                if mean_length is None:
-                    positive = model.lengths[model.lengths > 0]
-                    mean_length = float(positive.mean()) if positive.size else model.length
-                axs["ell"].append(ell if ell > 0 else mean_length)
-                d = axs
-            else:
-                point = _vectors(g.point, f"the link point of {what}", None)
-                if point.ndim != 1:
-                    raise GoalError(f"the link point of {what} cannot be batched.")
-                local = point * scale[link]  # shape coordinates to link frame
-                if isinstance(g, PointGoal):
-                    pts["target"].append(_batched(_vectors(g.target, f"the target of {what}", B), (B, 3)))
-                    d = pts
-                else:
-                    pls["origin"].append(_batched(_vectors(g.origin, f"the plane point of {what}", B), (B, 3)))
-                    pls["normal"].append(
-                        _batched(
-                            _unit(_vectors(g.normal, f"the plane normal of {what}", B), f"the plane normal of {what}"),
-                            (B, 3),
-                        )
-                    )
-                    d = pls
-                d["local"].append(local)
-            d["link"].append(link)
-            d["w"].append(w)
-            d["index"].append(i)
+        pts, pls, axs = _gathered(model, self.goals, B, self.warnings)
 
         def stack(lst, shape):
             return np.stack(lst, axis=1) if lst else np.zeros(shape)
@@ -453,59 +467,22 @@ class GoalStack:
             a plane goal's absolute signed distance, an axis goal's angle
             in radians times its length scale.  The tolerance applies to it.
         """
-        m = self.model
         B = R.shape[0]
-        V, Pn = m.n_vars, m.n_params
         want_j = omega is not None
         rows, jacs, dists = [], [], []
-        L = m.length
-
-        if len(self.p_link):
-            y = self._link_points(R, p, self.p_link, self.p_local)  # (B, G, 3)
-            res = m.to_world(y, t) - self.p_target
-            rows.append(res.reshape(B, 3 * len(self.p_link)))
-            dists.append(np.sqrt(np.einsum("bgi,bgi->bg", res, res)))
-            if want_j:
-                Jw = self._point_jacobian(y, omega, c, self._downstream_p)  # (B, G, 3, V)
-                Jp = np.zeros(Jw.shape[:3] + (Pn,))
-                Jp[..., :V] = Jw
-                if m.translate:
-                    Jp[..., V:] = np.eye(3) * L
-                jacs.append(Jp.reshape(B, 3 * len(self.p_link), Pn))
-
-        if len(self.q_link):
-            y = self._link_points(R, p, self.q_link, self.q_local)
-            n = self.q_normal
-            s = np.einsum("bqi,bqi->bq", n, m.to_world(y, t) - self.q_origin)
-            rows.append(s)
-            dists.append(np.abs(s))
-            if want_j:
-                Jw = self._point_jacobian(y, omega, c, self._downstream_q)  # (B, Q, 3, V)
-                Jq = np.zeros((B, len(self.q_link), Pn))
-                Jq[..., :V] = np.einsum("bqi,bqiv->bqv", n, Jw)
-                if m.translate:
-                    Jq[..., V:] = n * L
-                jacs.append(Jq)
-
-        if len(self.h_link):
-            vm = matvec3(R[:, self.h_link], self.h_local)  # model frame
-            vw = m.to_world_vectors(vm)
-            nv = np.linalg.norm(vw, axis=-1, keepdims=True)
-            u = vw / nv
-            ell = self.h_ell[:, None]
-            diff = u - self.h_dir
-            rows.append((diff * ell).reshape(B, 3 * len(self.h_link)))
-            chord = np.linalg.norm(diff, axis=-1)
-            dists.append(2.0 * np.arcsin(np.minimum(chord / 2.0, 1.0)) * self.h_ell)
-            if want_j:
-                dv = cross3(omega[:, None], vm[:, :, None]) * self._downstream_h[None, :, :, None]  # (B, H, V, 3)
-                dv = m.to_world_vectors(dv)
-                # d(v/|v|) = (I - u u^T) dv / |v|
-                du = (dv - u[:, :, None] * np.einsum("bhi,bhvi->bhv", u, dv)[..., None]) / nv[:, :, None]
-                Jh = np.zeros((B, len(self.h_link), 3, Pn))
-                Jh[..., :V] = np.swapaxes(du, -1, -2) * self.h_ell[None, :, None, None]
-                jacs.append(Jh.reshape(B, 3 * len(self.h_link), Pn))
-
+        kinds = (
+            (self.p_link, self._point_rows),
+            (self.q_link, self._plane_rows),
+            (self.h_link, self._axis_rows),
+        )
+        for links, rows_of in kinds:
+            if len(links):
+                row, jac_rows, dist_rows = rows_of(R, p, t, omega, c)
+                rows.append(row)
+                dists.append(dist_rows)
+                if want_j:
+                    jacs.append(jac_rows)
+        Pn = self.model.n_params
         r = np.concatenate(rows, axis=1) if rows else np.zeros((B, 0))
         r = r * self.row_weight
         jac = None
@@ -516,6 +493,62 @@ class GoalStack:
         dist = np.empty_like(packed)
         dist[:, self.order] = packed
         return r, jac, dist
+
+    def _point_rows(self, R, p, t, omega, c):
+        """Point goals: residual rows (B, 3G), Jacobian rows (B, 3G, n_params) or None, distances (B, G)."""
+        m = self.model
+        B, V, Pn = R.shape[0], m.n_vars, m.n_params
+        y = self._link_points(R, p, self.p_link, self.p_local)  # (B, G, 3)
+        res = m.to_world(y, t) - self.p_target
+        row = res.reshape(B, 3 * len(self.p_link))
+        dist = np.sqrt(np.einsum("bgi,bgi->bg", res, res))
+        if omega is None:
+            return row, None, dist
+        Jw = self._point_jacobian(y, omega, c, self._downstream_p)  # (B, G, 3, V)
+        Jp = np.zeros(Jw.shape[:3] + (Pn,))
+        Jp[..., :V] = Jw
+        if m.translate:
+            Jp[..., V:] = np.eye(3) * m.length
+        return row, Jp.reshape(B, 3 * len(self.p_link), Pn), dist
+
+    def _plane_rows(self, R, p, t, omega, c):
+        """Plane goals: signed distances as rows (B, Q), their Jacobian (B, Q, n_params) or None, |distance|."""
+        m = self.model
+        B, V, Pn = R.shape[0], m.n_vars, m.n_params
+        y = self._link_points(R, p, self.q_link, self.q_local)
+        n = self.q_normal
+        s = np.einsum("bqi,bqi->bq", n, m.to_world(y, t) - self.q_origin)
+        if omega is None:
+            return s, None, np.abs(s)
+        Jw = self._point_jacobian(y, omega, c, self._downstream_q)  # (B, Q, 3, V)
+        Jq = np.zeros((B, len(self.q_link), Pn))
+        Jq[..., :V] = np.einsum("bqi,bqiv->bqv", n, Jw)
+        if m.translate:
+            Jq[..., V:] = n * m.length
+        return s, Jq, np.abs(s)
+
+    def _axis_rows(self, R, p, t, omega, c):
+        """Axis goals: rows (B, 3H), Jacobian rows (B, 3H, n_params) or None, angles times length (B, H)."""
+        m = self.model
+        B, V, Pn = R.shape[0], m.n_vars, m.n_params
+        vm = matvec3(R[:, self.h_link], self.h_local)  # model frame
+        vw = m.to_world_vectors(vm)
+        nv = np.linalg.norm(vw, axis=-1, keepdims=True)
+        u = vw / nv
+        ell = self.h_ell[:, None]
+        diff = u - self.h_dir
+        row = (diff * ell).reshape(B, 3 * len(self.h_link))
+        chord = np.linalg.norm(diff, axis=-1)
+        dist = 2.0 * np.arcsin(np.minimum(chord / 2.0, 1.0)) * self.h_ell
+        if omega is None:
+            return row, None, dist
+        dv = cross3(omega[:, None], vm[:, :, None]) * self._downstream_h[None, :, :, None]  # (B, H, V, 3)
+        dv = m.to_world_vectors(dv)
+        # d(v/|v|) = (I - u u^T) dv / |v|
+        du = (dv - u[:, :, None] * np.einsum("bhi,bhvi->bhv", u, dv)[..., None]) / nv[:, :, None]
+        Jh = np.zeros((B, len(self.h_link), 3, Pn))
+        Jh[..., :V] = np.swapaxes(du, -1, -2) * self.h_ell[None, :, None, None]
+        return row, Jh.reshape(B, 3 * len(self.h_link), Pn), dist
 
     def evaluate_one(self, X, t, omega, c):
         """:meth:`evaluate` with the Jacobian, for a batch of one, from 4x4 link transforms.

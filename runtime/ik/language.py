@@ -18,7 +18,7 @@ import numpy as np
 from liganimate.lang import numbers as N
 from liganimate.runtime.figure.tree import Figure
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, PlaneGoal, PointGoal, resolve_link
-from liganimate.runtime.ik.reach import reach
+from liganimate.runtime.ik.reach import ReachOptions, reach
 from liganimate.runtime.motion.algebra import Motion
 
 __all__ = ["UNMET_HINT", "ReachWarning", "ReachBlock", "check_frames", "language_goal", "reach_block"]
@@ -115,6 +115,25 @@ def language_goal(
     return AxisGoal(index, tuple(normal), tuple(target), w), ambiguous
 
 
+def block_options(movable, translate, solver: str, tolerance, iterations) -> ReachOptions:
+    """A STARTREACH block's options as the compiled program gives them, as one :class:`ReachOptions`.
+
+    Parameters
+    ----------
+    movable : ("joints", ids) or ("chain", n) or None
+        MOVE JOINTS or MOVE CHAIN.
+    translate : bool
+        Whether the whole model may move (TRANSLATE INTO).
+    solver, tolerance, iterations
+        USING, TOLERANCE and ITERATIONS (None where the block does not say).
+    """
+    if movable is not None:
+        movable = tuple(movable[1]) if movable[0] == "joints" else int(movable[1])
+    return ReachOptions(
+        movable=movable, translate=bool(translate), solver=solver, tolerance=tolerance, max_iterations=iterations
+    )
+
+
 def reach_block(
     figure: Figure,
     goals: Sequence,
@@ -122,11 +141,7 @@ def reach_block(
     method: str,
     *,
     start: Motion | None,
-    movable,
-    translate,
-    solver: str,
-    tolerance,
-    iterations,
+    options: ReachOptions,
 ) -> ReachBlock:
     """Solve a STARTREACH block.
 
@@ -141,12 +156,8 @@ def reach_block(
         The interpolation method to the solved pose.
     start : Motion or None
         The motion whose last pose the solve starts from; None for the neutral pose.
-    movable : ("joints", ids) or ("chain", n) or None
-        MOVE JOINTS or MOVE CHAIN, as the compiled program gives it.
-    translate : bool
-        Whether the whole model may move (TRANSLATE INTO).
-    solver, tolerance, iterations
-        As for :func:`reach.reach` (``iterations`` is its ``max_iterations``).
+    options : ReachOptions
+        MOVE, TRANSLATE INTO, the solver and its settings (:func:`block_options`).
 
     Returns
     -------
@@ -157,20 +168,7 @@ def reach_block(
     GoalError
         For a solved translation beyond the geometry limit, and as :func:`reach.reach`.
     """
-    if movable is not None:
-        movable = list(movable[1]) if movable[0] == "joints" else int(movable[1])
-    result = reach(
-        figure,
-        goals,
-        float(frames),
-        method,
-        start=start,
-        movable=movable,
-        translate=bool(translate),
-        solver=solver,
-        tolerance=tolerance,
-        max_iterations=iterations,
-    )
+    result = reach(figure, goals, float(frames), method, start=start, options=options)
     t = np.asarray(result.translation, dtype=float).reshape(3)
     if not np.all(np.abs(t) <= N.GEOMETRY_MAX):
         raise GoalError(

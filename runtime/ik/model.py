@@ -200,6 +200,93 @@ def _conjugate(r: list, joints: np.ndarray, F: np.ndarray) -> None:
             r[i][j][joints] = out[i, j]
 
 
+def _tree_walk(figure: Figure) -> tuple:
+    """Each joint's depth from the main link; per link its parent link and the joint into it; which links each joint moves."""
+    J = figure.n_joints
+    depth = np.zeros(J, dtype=int)
+    for d, level in enumerate(figure.traversal):
+        depth[level.joints] = d
+    parent_of = np.full(figure.n_links, -1)
+    into = np.full(figure.n_links, -1)  # the joint through which the walk reaches each link
+    for level in figure.traversal:
+        parent_of[level.children] = level.parents
+        into[level.children] = level.joints
+    moves = np.zeros((J, figure.n_links), dtype=bool)
+    for link in range(figure.n_links):
+        # Walk up from the link to the main link, marking every joint passed.
+        cur = link
+        while cur != figure.main:
+            moves[into[cur], link] = True
+            cur = parent_of[cur]
+    return depth, parent_of, into, moves
+
+
+def _variable_order(rev: np.ndarray, is_var: np.ndarray, depth: np.ndarray) -> tuple[list, list]:
+    """The variables' joints and axes, in the solvers' order.
+
+    Deepest joints first (stable within a depth, in joint order), then X, Y,
+    Z within a joint -- Z, Y, X for a joint walked backwards.  CCD relies on
+    this order: turning a variable changes neither the axis nor the pivot of
+    any variable visited after it in the same sweep.  (Forward, ax turns
+    about Rz Ry e_x, which ay and az change; walked backwards the axes are
+    -Rs e_x, -Rs Rx^T e_y and -Rs Rx^T Ry^T e_z, Rs the near link's rotation.)
+    """
+    order = sorted(range(len(rev)), key=lambda k: (-depth[k], k))
+    vj, va = [], []
+    for k in order:
+        for a in (2, 1, 0) if rev[k] else (0, 1, 2):
+            if is_var[k, a]:
+                vj.append(k)
+                va.append(a)
+    return vj, va
+
+
+def _joint_term_maps(figure: Figure, near_all: np.ndarray, far_all: np.ndarray, rev: np.ndarray) -> np.ndarray:
+    """For :meth:`IKModel.forward_one`: per joint, the (16, 25) map from its cosine and sine products.
+
+    Each joint's 4x4 transform and local axes are linear in the products of
+    its cosines and sines (_TERMS), so a matrix per joint maps the products
+    to them, with the joint's locations, and its direction (R or R^T),
+    folded in.
+    """
+    J = figure.n_joints
+    SJ = np.zeros((J, 16, 25))
+    frames = figure.frames
+    for k in range(J):
+        near, far = near_all[k], far_all[k]
+        # AXIS turns the rotation into F R F^T, linear in R's entries.
+        sums = _framed_term_sums(frames[k]) if figure.has_frames[k] else _TERM_SUMS
+        for i in range(3):
+            for j in range(3):
+                src = 3 * j + i if rev[k] else 3 * i + j
+                SJ[k, :, 4 * i + j] = sums[:, src]
+            # t_i = near_i - sum_j R_ij far_j; the constant rides on the product "1".
+            SJ[k, :, 4 * i + 3] = -(SJ[k, :, 4 * i : 4 * i + 3] @ far)
+            SJ[k, 15, 4 * i + 3] += near[i]
+        SJ[k, 15, 15] = 1.0
+        SJ[k, :, 16:] = sums[:, 9:]
+    return SJ
+
+
+def _single_chain(levels: list, main: int):
+    """(joints, links) when the figure is one chain from the main link (each level one joint, hanging from the last).
+
+    Its link transforms are then prefix products, computed in log2(J)
+    batched products instead of J single ones.  None otherwise.
+    """
+    chain = all(isinstance(lv[0], int) for lv in levels)
+    prev = main
+    for lv in levels if chain else ():
+        chain = chain and lv[1] == prev
+        prev = lv[2]
+    if not chain:
+        return None
+    return (
+        np.array([lv[0] for lv in levels], dtype=np.intp),
+        np.array([lv[2] for lv in levels], dtype=np.intp),
+    )
+
+
 class IKModel:
     """The figure's free variables, their bounds and batched kinematics.
 
@@ -248,38 +335,9 @@ class IKModel:
         free_range = hi - lo >= 360.0
         is_var = movable & (hi > lo)
 
-        # Depth of each joint from the main link, and which links each joint moves.
-        depth = np.zeros(J, dtype=int)
-        for d, level in enumerate(figure.traversal):
-            depth[level.joints] = d
-        parent_of = np.full(figure.n_links, -1)
-        into = np.full(figure.n_links, -1)  # the joint through which the walk reaches each link
-        for level in figure.traversal:
-            parent_of[level.children] = level.parents
-            into[level.children] = level.joints
-        moves = np.zeros((J, figure.n_links), dtype=bool)
-        for link in range(figure.n_links):
-            # Walk up from the link to the main link, marking every joint passed.
-            cur = link
-            while cur != figure.main:
-                moves[into[cur], link] = True
-                cur = parent_of[cur]
-
-        # Variables: deepest joints first (stable within a depth, in joint
-        # order), then X, Y, Z within a joint -- Z, Y, X for a joint walked
-        # backwards.  CCD relies on this order: turning a variable changes
-        # neither the axis nor the pivot of any variable visited after it in
-        # the same sweep.  (Forward, ax turns about Rz Ry e_x, which ay and az
-        # change; walked backwards the axes are -Rs e_x, -Rs Rx^T e_y and
-        # -Rs Rx^T Ry^T e_z, Rs the near link's rotation.)
+        depth, parent_of, into, moves = _tree_walk(figure)
         rev = figure.reversed_joints
-        order = sorted(range(J), key=lambda k: (-depth[k], k))
-        vj, va = [], []
-        for k in order:
-            for a in (2, 1, 0) if rev[k] else (0, 1, 2):
-                if is_var[k, a]:
-                    vj.append(k)
-                    va.append(a)
+        vj, va = _variable_order(rev, is_var, depth)
         self.var_joint = np.array(vj, dtype=np.intp)
         self.var_axis = np.array(va, dtype=np.intp)
         self.var_flat = self.var_joint * 3 + self.var_axis
@@ -320,48 +378,14 @@ class IKModel:
         self._axis_vars = [(np.flatnonzero(self.var_axis == a), self.var_joint[self.var_axis == a]) for a in range(3)]
         self.lengths = link_lengths(figure)
         self.length = figure_length(figure)
-        # For :meth:`forward_one`: each joint's 4x4 transform and local axes
-        # are linear in the products of its cosines and sines (_TERMS), so a
-        # (16, 25) matrix per joint maps the products to them, with the
-        # joint's locations, and its direction (R or R^T), folded in.
-        SJ = np.zeros((J, 16, 25))
-        frames = figure.frames
-        for k in range(J):
-            near, far = self._near[k], self._far[k]
-            # AXIS turns the rotation into F R F^T, linear in R's entries.
-            sums = _framed_term_sums(frames[k]) if figure.has_frames[k] else _TERM_SUMS
-            for i in range(3):
-                for j in range(3):
-                    src = 3 * j + i if rev[k] else 3 * i + j
-                    SJ[k, :, 4 * i + j] = sums[:, src]
-                # t_i = near_i - sum_j R_ij far_j; the constant rides on the product "1".
-                SJ[k, :, 4 * i + 3] = -(SJ[k, :, 4 * i : 4 * i + 3] @ far)
-                SJ[k, 15, 4 * i + 3] += near[i]
-            SJ[k, 15, 15] = 1.0
-            SJ[k, :, 16:] = sums[:, 9:]
-        self._term_maps = SJ
+        self._term_maps = _joint_term_maps(figure, self._near, self._far, rev)  # for forward_one
         self._term_index = (
             (np.arange(J)[:, None] * 7 + _TERMS[:, None, :]) if J else np.zeros((3, 0, 16), dtype=np.intp)
         )
         # Where the variables' cosines and sines go among [c, s, 1] per joint.
         self._cos_at = self.var_joint * 7 + self.var_axis
         self._sin_at = self._cos_at + 3
-        # A chain from the main link (every level one joint, each hanging
-        # from the last): its link transforms are prefix products, computed
-        # in log2(J) batched products instead of J single ones.
-        chain = all(isinstance(lv[0], int) for lv in self._levels)
-        prev = figure.main
-        for lv in self._levels if chain else ():
-            chain = chain and lv[1] == prev
-            prev = lv[2]
-        self._chain = (
-            (
-                np.array([lv[0] for lv in self._levels], dtype=np.intp),
-                np.array([lv[2] for lv in self._levels], dtype=np.intp),
-            )
-            if chain and J
-            else None
-        )
+        self._chain = _single_chain(self._levels, figure.main) if J else None
         # Each variable's local axis in column 0, its pivot in column 1
         # (homogeneous): one product with the primary's 4x4 gives both.
         M = np.zeros((V, 4, 2))

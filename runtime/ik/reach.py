@@ -40,6 +40,7 @@ from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
 __all__ = [
+    "ReachOptions",
     "PointGoal",
     "PlaneGoal",
     "AxisGoal",
@@ -64,6 +65,57 @@ DEFAULT_TOLERANCE = 1e-5
 DEFAULT_MAX_ITERATIONS = {name: spec.max_iterations for name, spec in SOLVERS.items()}
 
 _STATUS = {CONVERGED: "converged", STALLED: "stalled", LIMIT: "limit"}
+
+
+@dataclass(frozen=True)
+class ReachOptions:
+    """How a pose is solved: the one value REACH, :func:`reach`, :func:`reach_keyframes` and :func:`solve_pose` pass on.
+
+    Attributes
+    ----------
+    movable : None, int or tuple of int
+        Which joints may turn: all (None), the ``n`` joints nearest each
+        goal's link toward the main link (an int: a chain length), or joint
+        ids.  The others keep their start angles, and so does every axis
+        locked by its extremes (``min == max``).
+    translate : bool
+        Whether the whole figure may also move (POSIT's root translation).
+    solver : str
+        A name in :data:`solvers.SOLVER_NAMES`: "dls" (the default), "transpose" or "ccd".
+    tolerance : float or None
+        World units; default :data:`DEFAULT_TOLERANCE` times the figure's
+        length.  The solve stops when every goal is this close (an axis goal
+        counts its angle in radians times its link's length).
+    max_iterations : int or None
+        Default :data:`DEFAULT_MAX_ITERATIONS` for the solver.
+    restarts : int
+        When the goals are not met from the start pose (a local minimum,
+        often against joint limits), try up to this many other start poses,
+        drawn within the limits by a fixed-seed generator, and keep the
+        first that meets them (see :func:`solvers.solve`).
+    """
+
+    movable: int | tuple[int, ...] | None = None
+    translate: bool = False
+    solver: str = DEFAULT_SOLVER
+    tolerance: float | None = None
+    max_iterations: int | None = None
+    restarts: int = 0
+
+
+def reach_options(options: ReachOptions | None = None, **fields) -> ReachOptions:
+    """``options`` (default :class:`ReachOptions`) with ``fields`` replacing its values.
+
+    Raises
+    ------
+    GoalError
+        For a keyword that is not a field of :class:`ReachOptions`.
+    """
+    base = options if options is not None else ReachOptions()
+    unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(ReachOptions)})
+    if unknown:
+        raise GoalError(f"there is no REACH option {', '.join(unknown)}.")
+    return dataclasses.replace(base, **fields) if fields else base
 
 
 @dataclass(frozen=True)
@@ -338,13 +390,9 @@ def solve_pose(
     goals: Sequence,
     *,
     start=None,
-    movable=None,
-    translate: bool = False,
-    solver: str = DEFAULT_SOLVER,
-    tolerance: float | None = None,
-    max_iterations: int | None = None,
-    restarts: int = 0,
+    options: ReachOptions | None = None,
     trace: bool = False,
+    **fields,
 ) -> PoseSolution:
     """The pose that best meets weighted goals.
 
@@ -360,28 +408,13 @@ def solve_pose(
     start : None, Motion or array_like, optional
         See :func:`start_pose`.  An array may also be batched,
         ``(B, n_joints, 3)``.
-    movable : None, int or iterable of int, optional
-        Which joints may turn: all (None), the ``n`` joints nearest each
-        goal's link toward the main link (an int: a chain length), or a list
-        of joint ids.  The others keep their start angles, and so does every
-        axis locked by its extremes (``min == max``).
-    translate : bool, default False
-        Whether the whole figure may also move (POSIT's root translation).
-    solver : str, default :data:`solvers.DEFAULT_SOLVER` ("dls")
-        A name in :data:`solvers.SOLVER_NAMES`: "dls", "transpose" or "ccd".
-    tolerance : float, optional
-        World units; default :data:`DEFAULT_TOLERANCE` times the figure's
-        length.  The solve stops when every goal is this close (an axis goal
-        counts its angle in radians times its link's length).
-    max_iterations : int, optional
-        Default :data:`DEFAULT_MAX_ITERATIONS` for the solver.
-    restarts : int, default 0
-        When the goals are not met from ``start`` (a local minimum, often
-        against joint limits), try up to this many other start poses, drawn
-        within the limits by a fixed-seed generator, and keep the first
-        that meets them (see :func:`solvers.solve`).
+    options : ReachOptions, optional
+        Which joints and whether the figure may move, the solver and its
+        tolerance, iteration limit and restarts (default ``ReachOptions()``).
     trace : bool, default False
         Keep the cost after every iteration (``history``).
+    **fields
+        Fields of :class:`ReachOptions` (``movable=``, ``solver=``...), replacing ``options``' values.
 
     Returns
     -------
@@ -395,26 +428,45 @@ def solve_pose(
         error: see ``PoseSolution.status`` and ``residuals``.
     """
     goals = list(goals)
+    o = reach_options(options, **fields)
     if figure.slides.any():
         held, start, values = _hold_slides(figure, start)
-        solution = solve_pose(
-            held,
-            goals,
-            start=start,
-            movable=movable,
-            translate=translate,
-            solver=solver,
-            tolerance=tolerance,
-            max_iterations=max_iterations,
-            restarts=restarts,
-            trace=trace,
-        )
+        solution = solve_pose(held, goals, start=start, options=o, trace=trace)
         angles = np.array(solution.angles)
         angles[..., figure.slides, :] = values
         return dataclasses.replace(solution, angles=angles)
-    tol, max_iter = _options(figure, solver, tolerance, max_iterations)
+    tol, max_iter = _options(figure, o.solver, o.tolerance, o.max_iterations)
+    restarts, translate = o.restarts, o.translate
     if isinstance(restarts, bool) or not isinstance(restarts, (int, np.integer)) or restarts < 0:
         raise GoalError(f"the number of restarts must be a non-negative whole number, not {restarts!r}.")
+    start_deg, base, B, batched = _start_batch(figure, goals, start)
+    model = IKModel.cached(figure, _movable_mask(figure, goals, o.movable), translate)
+    stack = GoalStack(model, goals, B)
+    x0 = np.zeros((B, model.n_params))
+    x0[:, : model.n_vars] = np.deg2rad(start_deg).reshape(B, -1)[:, model.var_flat]
+    result = solve(
+        model,
+        stack,
+        x0,
+        base,
+        method=o.solver,
+        tolerance=tol,
+        max_iterations=max_iter,
+        restarts=int(restarts),
+        trace=trace,
+    )
+
+    return _pose_solution(figure, model, stack, result, start_deg, tol, translate, batched)
+
+
+def _start_batch(figure: Figure, goals: list, start) -> tuple:
+    """The start poses for a solve: ``(degrees (B, J, 3), radians (1 or B, J, 3), B, batched)``.
+
+    Raises
+    ------
+    GoalError
+        When the goals and the start poses are batches of different sizes.
+    """
     start_deg = start_pose(figure, start)
     B_goals = batch_size(goals)
     B_start = start_deg.shape[0] if start_deg.ndim == 3 else None
@@ -426,23 +478,12 @@ def solve_pose(
     start_deg = (
         start_deg[None] if start_deg.ndim == 2 and B == 1 else np.broadcast_to(start_deg, (B, figure.n_joints, 3))
     )
+    return start_deg, base, B, batched
 
-    model = IKModel.cached(figure, _movable_mask(figure, goals, movable), translate)
-    stack = GoalStack(model, goals, B)
-    x0 = np.zeros((B, model.n_params))
-    x0[:, : model.n_vars] = np.deg2rad(start_deg).reshape(B, -1)[:, model.var_flat]
-    result = solve(
-        model,
-        stack,
-        x0,
-        base,
-        method=solver,
-        tolerance=tol,
-        max_iterations=max_iter,
-        restarts=int(restarts),
-        trace=trace,
-    )
 
+def _pose_solution(figure, model, stack, result, start_deg, tol: float, translate: bool, batched: bool):
+    """The solver's result as a :class:`PoseSolution`: angles clamped, batched or not as the input was."""
+    B = start_deg.shape[0]
     q = result.x[:, : model.n_vars]
     angles = start_deg.copy()
     flat = angles.reshape(B, -1)
@@ -565,19 +606,15 @@ def reach(
     method: str = "LINEAR",
     *,
     start=None,
-    movable=None,
-    translate: bool = False,
-    solver: str = DEFAULT_SOLVER,
-    tolerance: float | None = None,
-    max_iterations: int | None = None,
-    restarts: int = 0,
     joints: Iterable[int] | None = None,
+    options: ReachOptions | None = None,
+    **fields,
 ) -> Reach:
     """A motion from a start pose to the pose that best meets the goals.
 
     Parameters
     ----------
-    figure, goals, start, movable, translate, solver, tolerance, max_iterations, restarts
+    figure, goals, start, options, **fields
         As for :func:`solve_pose`; the goals must not be batched (see
         :func:`reach_keyframes`).
     frames : float
@@ -611,19 +648,10 @@ def reach(
     goals = list(goals)
     if batch_size(goals) is not None:
         raise GoalError("reach() takes unbatched goals; use reach_keyframes() for a batch.")
-    sol = solve_pose(
-        figure,
-        goals,
-        start=start,
-        movable=movable,
-        translate=translate,
-        solver=solver,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        restarts=restarts,
-    )
+    o = reach_options(options, **fields)
+    sol = solve_pose(figure, goals, start=start, options=o)
     s0 = start_pose(figure, start)
-    driven = _driven(figure, goals, movable, start, joints)
+    driven = _driven(figure, goals, o.movable, start, joints)
     tracks = {}
     for jid in driven:
         k = figure.joint_index(jid)
@@ -638,13 +666,9 @@ def reach_keyframes(
     method: str = "LINEAR",
     *,
     start=None,
-    movable=None,
-    translate: bool = False,
-    solver: str = DEFAULT_SOLVER,
-    tolerance: float | None = None,
-    max_iterations: int | None = None,
-    restarts: int = 0,
     joints: Iterable[int] | None = None,
+    options: ReachOptions | None = None,
+    **fields,
 ) -> Reach:
     """One motion through the solutions of a batch of goals (a moving target).
 
@@ -654,7 +678,7 @@ def reach_keyframes(
 
     Parameters
     ----------
-    figure, goals, start, movable, translate, solver, tolerance, max_iterations, restarts, joints
+    figure, goals, start, joints, options, **fields
         As for :func:`reach`; the goals carry a batch dimension ``B``.
     frames : sequence of float, length B
         Non-decreasing keyframe frames.
@@ -676,18 +700,9 @@ def reach_keyframes(
     s0 = start_pose(figure, start)
     if s0.ndim == 3:
         raise GoalError("reach_keyframes() starts every solve from one pose; give an unbatched start.")
-    sol = solve_pose(
-        figure,
-        goals,
-        start=np.broadcast_to(s0, (B,) + s0.shape),
-        movable=movable,
-        translate=translate,
-        solver=solver,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        restarts=restarts,
-    )
-    driven = _driven(figure, goals, movable, start, joints)
+    o = reach_options(options, **fields)
+    sol = solve_pose(figure, goals, start=np.broadcast_to(s0, (B,) + s0.shape), options=o)
+    driven = _driven(figure, goals, o.movable, start, joints)
     tracks = {}
     for jid in driven:
         k = figure.joint_index(jid)

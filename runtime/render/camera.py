@@ -49,7 +49,11 @@ class Camera:
         Image size ``(W, H)`` in pixels; default ``(640, 480)``.
     near : float, optional
         Distance of the near clipping plane from the eye along the viewing
-        direction; default ``1e-4 * |point|``.
+        direction; default ``1e-4 * |point - target|``.
+    target : array_like, shape (3,), optional
+        The point looked at, the origin by default (as the thesis' VIEW
+        always does; the modern look's default framing looks elsewhere).
+        ``width`` is then measured in the plane through ``target``.
 
     Attributes
     ----------
@@ -60,7 +64,7 @@ class Camera:
     size : tuple of int
         ``(W, H)``.
     distance : float
-        ``|point|``, the eye's distance from the origin.
+        ``|point - target|``, the eye's distance from the point looked at.
     focal : float
         Pixels per unit of camera-space x/z: ``distance * W / width``.
     near : float
@@ -75,14 +79,16 @@ class Camera:
         positive finite number, or the size is not two positive integers.
     """
 
-    def __init__(self, point, width: float, size=DEFAULT_SIZE, near: float | None = None):
+    def __init__(self, point, width: float, size=DEFAULT_SIZE, near: float | None = None, target=None):
         p = np.asarray(point, dtype=np.float64)
+        self.target = np.zeros(3) if target is None else np.asarray(target, dtype=np.float64)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise RenderError(
                 "The VIEW POINT must be three finite numbers.",
                 hint="Write it as a 3-vector, e.g. VIEW POINT (0, 1, 10).",
             )
-        distance = math.sqrt(float(p @ p))
+        rel = p - self.target
+        distance = math.sqrt(float(rel @ rel))
         if distance == 0.0:
             raise RenderError(
                 "The VIEW POINT is the origin, so the camera has no direction to look in.",
@@ -98,7 +104,7 @@ class Camera:
                 hint="VIEW WIDTH is the width of the visible region around the origin, in world units.",
             )
         W, H = image_size(size)
-        forward = -p / distance
+        forward = -rel / distance
         up_hint = np.array([0.0, 1.0, 0.0])
         if np.linalg.norm(np.cross(forward, up_hint)) < _PARALLEL_SINE:
             up_hint = np.array([0.0, 0.0, -1.0])
@@ -139,7 +145,9 @@ class Camera:
         cam = self._supersampled.get(factor)
         if cam is None:
             W, H = self.size
-            cam = self._supersampled[factor] = Camera(self.point, self.width, (W * factor, H * factor), self.near)
+            cam = self._supersampled[factor] = Camera(
+                self.point, self.width, (W * factor, H * factor), self.near, self.target
+            )
         return cam
 
     def __repr__(self) -> str:

@@ -52,6 +52,7 @@ from liganimate.runtime.figure.pose import (
 )
 from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
+from liganimate.runtime.render.framing import framing_view
 from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
 from liganimate.runtime.render.look import DEFAULT_LOOK, draw_modern, look_params
 from liganimate.runtime.render.options import RenderOptions, checked, executor_for
@@ -120,6 +121,7 @@ class Renderer:
         self.size = options.size
         self.aa = options.aa
         self.look = options.look
+        self._framed: dict = {}  # (scene id, size) -> default framing view
         self.fps = options.fps
         self.quiet = options.quiet
         self.workers = options.workers if options.workers is not None else min(os.cpu_count() or 1, 8)
@@ -196,13 +198,13 @@ class Renderer:
 
     def add_tick(self, state, rt) -> None:
         with self._failing():
-            self._add_tick(state)
+            self._add_tick(state, rt.program.framings)
 
-    def _add_tick(self, state) -> None:
+    def _add_tick(self, state, framings) -> None:
         tick, k = state.tick, state.sameframe
         image = tick // k
         self.scene_total = -(-state.length // k)
-        camera = (tuple(float(x) for x in state.view_point), float(state.view_width))
+        camera = self._view(state, framings)
         if self.current is None or self.current["image"] != image:
             if self.current is not None:
                 self.pending.append(self.current)
@@ -218,6 +220,20 @@ class Renderer:
             self.current = None
             if len(self.pending) >= BATCH:
                 self.flush()
+
+    def _view(self, state, framings) -> tuple:
+        """The scene's camera: VIEW's, or in the modern look, for a scene without VIEW, the default framing.
+
+        The framing needs the box of what the scene draws, which checking
+        the program gathers (:mod:`.framing`); unchecked, the thesis' camera stays.
+        """
+        if self.look != "thesis" and not state.viewed and framings.get(state.id) is not None:
+            key = (state.id, self.size)
+            view = self._framed.get(key)
+            if view is None:
+                view = self._framed[key] = framing_view(framings[state.id], self.size)
+            return view
+        return (tuple(float(x) for x in state.view_point), float(state.view_width))
 
     def _background(self, state, camera):
         parts = []
@@ -332,12 +348,9 @@ class Renderer:
             # The first submit forks the workers.  With SIGINT and SIGTERM blocked
             # meanwhile, a signal cannot reach a worker before it has set itself to
             # ignore them; this process receives it once the mask is restored.
-            old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
-            try:
+            with _signals_blocked():
                 self.futures.append((self.pool.submit(draw_images, *args), names))
                 self._worker_procs = list((getattr(self.pool, "_processes", None) or {}).values())
-            finally:
-                signal.pthread_sigmask(signal.SIG_SETMASK, old)
             return
         if self.pool is None:
             self._deliver(names, draw_images(*args))
@@ -510,6 +523,19 @@ def _result(future):
         ) from None
 
 
+@contextlib.contextmanager
+def _signals_blocked():
+    """SIGINT and SIGTERM held back in this thread (where the system can: not on Windows)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def _worker_init(parent: int) -> None:
     """Set up a worker process: signals are the parent's business, die with it, keep freed memory for reuse.
 
@@ -528,14 +554,15 @@ def _worker_init(parent: int) -> None:
     """
     for s in _SIGNALS:
         signal.signal(s, signal.SIG_IGN)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent while it forked us
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent while it forked us
     try:
         import ctypes
 
         libc = ctypes.CDLL(None)
         mallopt = libc.mallopt
-    except (OSError, AttributeError):
-        return  # not glibc
+    except (OSError, AttributeError, TypeError, ImportError):
+        return  # not glibc (Windows' CDLL takes no None)
     if sys.platform.startswith("linux"):
         PR_SET_PDEATHSIG = 1
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
@@ -619,13 +646,13 @@ _cameras: dict = {}
 
 
 def _camera(camera, size) -> Camera:
-    """The :class:`Camera` of a ``((x, y, z), width)`` view, remembered (a few)."""
+    """The :class:`Camera` of a ``((x, y, z), width)`` or ``((x, y, z), width, target)`` view, remembered (a few)."""
     key = (camera, size)
     cam = _cameras.get(key)
     if cam is None:
         if len(_cameras) >= 64:
             _cameras.clear()
-        cam = _cameras[key] = Camera(camera[0], camera[1], size)
+        cam = _cameras[key] = Camera(camera[0], camera[1], size, target=camera[2] if len(camera) > 2 else None)
     return cam
 
 

@@ -87,10 +87,10 @@ class Look:
 
     outline: float = 1.0
     ink: float = 0.25
-    crease: float = 35.0
-    light: tuple = (-0.45, 0.75, -0.5)
-    ambient: float = 0.7
-    key: float = 0.45
+    crease: float = 50.0
+    light: tuple = (-0.3, 0.6, -0.75)
+    ambient: float = 0.75
+    key: float = 0.4
     shadow: float = 0.55
     shadow_reach: float = 0.5
     background: int = 244

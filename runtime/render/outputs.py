@@ -14,18 +14,24 @@ locked; a lock file left behind by a killed run is harmless and is reused.
 A finished or interrupted run removes its lock files.  Record locks, unlike
 ``flock``, are not inherited by forked worker processes, so only the run
 itself ever holds them.
+
+Where there is no ``fcntl`` (Windows) the lock is ``msvcrt.locking`` on the
+lock file's first byte, which Windows also drops when the process ends.
+With neither, a lock is the lock file itself, created exclusively with the
+holder's pid in it; a lock file whose process is gone is a killed run's and
+is taken over.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
-import fcntl
 import math
 import os
 import re
 import struct
 import sys
+import time
 from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
@@ -33,6 +39,21 @@ from liganimate.runtime.errors import RenderError
 
 if TYPE_CHECKING:
     from liganimate.runtime.render.options import RenderOptions
+
+# POSIX record locks where there are (fcntl), Windows' byte locks where not (msvcrt).
+try:
+    import fcntl
+except ImportError:
+    fcntl = None  # type: ignore[assignment]
+try:
+    import msvcrt
+except ImportError:
+    msvcrt = None  # type: ignore[assignment]
+
+# Flags that only some systems have: none of them is needed for the lock to work.
+_OPEN_FLAGS = getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
+# A lock file without a pid yet, younger than this, is being created by its holder.
+_CREATING = 10.0
 
 LOCK_NAME = ".liganimate.lock"
 # The names AtomicWriter's temporary files take (mkstemp: 8 characters of [a-z0-9_]).
@@ -175,10 +196,12 @@ def holder_of(lock_path: str):
     Uses ``F_GETLK`` where the layout of ``struct flock`` is known (Linux);
     elsewhere it says nothing and the lock is found taken when acquired.
     """
-    if not sys.platform.startswith("linux"):
+    if fcntl is None and msvcrt is None:
+        return _live_holder(lock_path)
+    if fcntl is None or not sys.platform.startswith("linux"):
         return None
     try:
-        fd = os.open(lock_path, os.O_RDONLY | os.O_CLOEXEC | os.O_NOFOLLOW | os.O_NONBLOCK)
+        fd = os.open(lock_path, os.O_RDONLY | _OPEN_FLAGS | getattr(os, "O_NONBLOCK", 0))
     except OSError:
         return None
     try:
@@ -209,11 +232,91 @@ def _words(exc: OSError) -> str:
 
 
 def _taken(shown: str, is_folder: bool, pid) -> RenderError:
-    who = f" (pid {pid})" if pid else ""
+    who = f" (pid {pid})" if pid and pid > 0 else ""
     what = (shown.rstrip(os.sep) + os.sep) if is_folder else shown
     return RenderError(
         f"{what} is being written by another liganimate run{who}; wait for it to end or choose another output"
     )
+
+
+def _try_lock(fd: int) -> bool:
+    """Lock the open lock file ``fd`` without waiting; False when another process holds it."""
+    try:
+        if fcntl is not None:
+            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        else:
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+    except OSError as exc:
+        if exc.errno in (errno.EACCES, errno.EAGAIN, errno.EDEADLK):
+            return False
+        raise
+    return True
+
+
+def _acquire(lock: str, shown: str, is_folder: bool) -> int:
+    """Open and lock ``lock``; its descriptor, or a RenderError saying who holds it."""
+    if fcntl is None and msvcrt is None:
+        return _acquire_by_creation(lock, shown, is_folder)
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | _OPEN_FLAGS, 0o644)
+        except OSError as exc:
+            raise RenderError(f"cannot create the lock file {lock} for {shown}: {_words(exc)}") from None
+        try:
+            locked = _try_lock(fd)
+        except OSError as exc:
+            os.close(fd)
+            raise RenderError(f"cannot lock {lock} for {shown}: {_words(exc)}") from None
+        if not locked:
+            os.close(fd)
+            raise _taken(shown, is_folder, holder_of(lock))
+        # The previous holder may have removed the file between our open and our lock:
+        # then we hold a lock on a file nobody else will ever open, so start again.
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(lock, follow_symlinks=False))
+        except FileNotFoundError:
+            same = False
+        if same:
+            return fd
+        os.close(fd)
+
+
+def _acquire_by_creation(lock: str, shown: str, is_folder: bool) -> int:
+    """The lock without an OS lock: create ``lock`` exclusively, taking over a dead holder's."""
+    for _ in range(8):
+        try:
+            return os.open(lock, os.O_RDWR | os.O_CREAT | os.O_EXCL | _OPEN_FLAGS, 0o644)
+        except FileExistsError:
+            pid = _live_holder(lock)
+            if pid is not None:
+                raise _taken(shown, is_folder, pid) from None
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(lock)  # a killed run's: nobody holds it
+        except OSError as exc:
+            raise RenderError(f"cannot create the lock file {lock} for {shown}: {_words(exc)}") from None
+    raise _taken(shown, is_folder, None)
+
+
+def _live_holder(lock: str):
+    """The pid written in a creation lock if that process is alive (or the file is still being made); else None."""
+    try:
+        with open(lock, "rb") as fh:
+            text = fh.read(32).decode("ascii", "replace").strip()
+        age = time.time() - os.stat(lock).st_mtime
+    except OSError:
+        return None
+    if not text.isdigit():
+        return -1 if age < _CREATING else None
+    pid = int(text)
+    if pid == os.getpid():
+        return pid
+    try:
+        os.kill(pid, 0)  # only where there is neither fcntl nor msvcrt: not Windows, where this would kill
+    except ProcessLookupError:
+        return None
+    except OSError:
+        return pid  # alive, another user's
+    return pid
 
 
 class OutputLock:
@@ -262,27 +365,7 @@ class OutputLock:
         key = os.path.realpath(lock)
         if key in _HELD:
             raise _taken(shown, is_folder, os.getpid())
-        while True:
-            try:
-                fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC | os.O_NOFOLLOW, 0o644)
-            except OSError as exc:
-                raise RenderError(f"cannot create the lock file {lock} for {shown}: {_words(exc)}") from None
-            try:
-                fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError as exc:
-                os.close(fd)
-                if exc.errno in (errno.EACCES, errno.EAGAIN):
-                    raise _taken(shown, is_folder, holder_of(lock)) from None
-                raise RenderError(f"cannot lock {lock} for {shown}: {_words(exc)}") from None
-            # The previous holder may have removed the file between our open and our lock:
-            # then we hold a lock on a file nobody else will ever open, so start again.
-            try:
-                same = os.path.samestat(os.fstat(fd), os.stat(lock, follow_symlinks=False))
-            except FileNotFoundError:
-                same = False
-            if same:
-                break
-            os.close(fd)
+        fd = _acquire(lock, shown, is_folder)
         with contextlib.suppress(OSError):
             os.ftruncate(fd, 0)
             os.write(fd, f"{os.getpid()}\n".encode())
@@ -325,6 +408,9 @@ class OutputLock:
                 os.unlink(lock)
             with contextlib.suppress(OSError):
                 os.close(fd)
+            if msvcrt is not None:  # Windows cannot remove an open file: now it is closed
+                with contextlib.suppress(OSError):
+                    os.unlink(lock)
             _HELD.discard(key)
 
 

@@ -72,6 +72,9 @@ class Generator:
         1 for the first population.
     kept : list of ndarray, shape (J, 3)
         Poses kept as keyframes, in order.
+    kept_frames : list of int
+        The frame of each kept pose in the motion Save writes: 0 for the
+        first (the motion's starting position), increasing.
     frozen : ndarray of bool, shape (J,)
         Joints that mutation leaves alone.
     """
@@ -84,6 +87,7 @@ class Generator:
         self.neutral = K.clamp(figure, np.zeros((figure.n_joints, 3)))
         self.current = self.neutral.copy()
         self.kept: list = []
+        self.kept_frames: list = []
         self.frozen = np.zeros(figure.n_joints, dtype=bool)
         self.intensity = 0.25
         self.mode = "flexion"
@@ -150,18 +154,73 @@ class Generator:
         self._push()
         self.current = self.neutral.copy()
 
-    def keep(self) -> None:
-        """Append the current pose to the kept poses (the next keyframe)."""
+    def keep(self, spacing: int = 24) -> None:
+        """Append the current pose to the kept poses (the next keyframe, ``spacing`` frames after the last)."""
         self._push()
         self.kept = self.kept + [self.current.copy()]
+        self.kept_frames = self.kept_frames + [self.kept_frames[-1] + spacing if self.kept_frames else 0]
+
+    def set_angles(self, joint: int, angles) -> None:
+        """Set one joint's three angles in the current pose, clamped into its extremes (a direct edit)."""
+        joint = self._check_joint(joint)
+        a = np.asarray(angles, dtype=np.float64).reshape(-1)
+        if a.shape != (3,) or not np.isfinite(a).all():
+            raise ValueError("the angles must be three finite numbers")
+        ext = np.asarray(self.figure.extremes[joint], dtype=np.float64).reshape(3, 2)
+        self._push()
+        self.current = self.current.copy()
+        self.current[joint] = np.clip(a, ext[:, 0], ext[:, 1])
+
+    def recall(self, k: int) -> None:
+        """Make kept pose ``k`` the current pose again (to edit it, or keep a variation)."""
+        k = self._check_index(k, len(self.kept), "kept pose")
+        self._push()
+        self.current = self.kept[k].copy()
+
+    def delete_kept(self, k: int) -> None:
+        """Remove kept pose ``k``; the poses after it keep their frames (the first, if removed, gives 0 to the next)."""
+        k = self._check_index(k, len(self.kept), "kept pose")
+        self._push()
+        self.kept = self.kept[:k] + self.kept[k + 1 :]
+        frames = self.kept_frames[:k] + self.kept_frames[k + 1 :]
+        self.kept_frames = [0] + frames[1:] if frames else []
+
+    def move_kept(self, k: int, to: int) -> None:
+        """Move kept pose ``k`` to place ``to``; the frames stay where they are, the poses change places."""
+        k = self._check_index(k, len(self.kept), "kept pose")
+        to = self._check_index(to, len(self.kept), "place")
+        self._push()
+        kept = list(self.kept)
+        kept.insert(to, kept.pop(k))
+        self.kept = kept
+
+    def set_kept_frame(self, k: int, frame: int) -> None:
+        """Give kept pose ``k`` (not the first, whose frame is 0) the frame ``frame``, between its neighbours'."""
+        k = self._check_index(k, len(self.kept), "kept pose")
+        lo = self.kept_frames[k - 1] + 1 if k > 0 else 0
+        hi = self.kept_frames[k + 1] - 1 if k + 1 < len(self.kept) else 10**6
+        if k == 0 and frame != 0:
+            raise ValueError("the first kept pose is the motion's starting position, at frame 0")
+        if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or not lo <= frame <= hi:
+            raise ValueError(f"kept pose {k + 1}'s frame must be a whole number from {lo} to {hi}")
+        self._push()
+        self.kept_frames = self.kept_frames[:k] + [int(frame)] + self.kept_frames[k + 1 :]
 
     def undo(self) -> bool:
-        """Go back one action (take, generation, seed, freeze, stand, keep); False if there is none."""
+        """Go back one action (take, set, generation, seed, freeze, stand, keep, an edit of the kept poses); False if none."""
         if not self._history:
             return False
-        (self.current, self.candidates, self.levels, self.generation, state, self.kept, self.frozen, self.seed) = (
-            self._history.pop()
-        )
+        (
+            self.current,
+            self.candidates,
+            self.levels,
+            self.generation,
+            state,
+            self.kept,
+            self.kept_frames,
+            self.frozen,
+            self.seed,
+        ) = self._history.pop()
         self._rng.bit_generator.state = state
         return True
 
@@ -254,6 +313,7 @@ class Generator:
                 self.generation,
                 copy.deepcopy(self._rng.bit_generator.state),
                 self.kept,
+                self.kept_frames,
                 self.frozen,
                 self.seed,
             )

@@ -20,12 +20,13 @@ extremes and angles are written with Python's shortest round-trip
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
 from liganimate.compiler.names import reserved
 
-__all__ = ["library_text", "lig_name"]
+__all__ = ["Library", "library", "library_text", "lig_name"]
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 # Keywords and built-ins (compiler/names.py, read from the grammar), and the
@@ -109,7 +110,39 @@ def widened_extremes(fig, kept: np.ndarray) -> np.ndarray:
     return ext
 
 
-def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: str = "") -> str:
+@dataclass(frozen=True)
+class Library:
+    """A saved library in its parts: what depends on the figure alone, and what the kept poses change.
+
+    Attributes
+    ----------
+    head : str
+        The header comment.
+    shapes : str
+        One PRIMITIVE per distinct segment shape, drawing its triangles:
+        most of the text, the same for every Save of one figure.
+    skeleton : str
+        The same PRIMITIVEs, each drawing only its first triangle: what
+        checking the rest needs of them (their names and that they draw).
+    body : str
+        The declarations, the segments' assignments, STARTMODEL (with the
+        widened extremes) and the motion.
+    """
+
+    head: str
+    shapes: str
+    skeleton: str
+    body: str
+
+    @property
+    def text(self) -> str:
+        """The library's text."""
+        return self.head + self.shapes + self.body
+
+
+def library_text(
+    fig, model: str, motion: str, kept, spacing: int = 24, note: str = "", frames=None, method: str = "LINEAR"
+) -> str:
     """The text of a library with ``fig`` as MODEL ``model`` and the kept poses as MOTION ``motion``.
 
     Parameters
@@ -123,17 +156,42 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
         Frames between kept poses.
     note : str
         One line for the header comment (no braces or line breaks).
+    frames : sequence of int, optional
+        Each kept pose's frame: 0, then increasing (default ``k * spacing``).
+    method : str
+        The interpolation method that leads to each keyframe (a name of
+        :mod:`liganimate.runtime.motion.interpolation`); LINEAR is written
+        as no INTERPOLATE clause.
 
     Returns
     -------
     str
         Library text that ``LOAD model, motion FROM 'file.lig'`` takes.
     """
+    return library(fig, model, motion, kept, spacing, note, frames, method).text
+
+
+def library(
+    fig, model: str, motion: str, kept, spacing: int = 24, note: str = "", frames=None, method: str = "LINEAR"
+) -> Library:
+    """The library of :func:`library_text`, in its parts (see :class:`Library`)."""
     kept = np.asarray(kept, dtype=np.float64).reshape(-1, fig.n_joints, 3)
+    frames = [k * spacing for k in range(len(kept))] if frames is None else [int(f) for f in frames]
     model, motion = model.upper(), motion.upper()
     taken = {model, motion}
     segs = _segment_names(fig, taken)
     ext = widened_extremes(fig, kept)
+    head = _header(fig, model, motion, kept, spacing, note, ext, frames)
+    shapes, skeleton, assign = _shapes(fig, segs, taken)
+    body = []
+    for k in range(0, len(segs), 6):
+        body.append("      GRAPHICAL " + ", ".join(segs[k : k + 6]))
+    body += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + [""]
+    body += _startmodel(fig, model, segs, ext) + [""] + _motion(fig, motion, kept, frames, method)
+    return Library("\n".join(head) + "\n", "\n".join(shapes) + "\n", "\n".join(skeleton) + "\n", "\n".join(body) + "\n")
+
+
+def _header(fig, model: str, motion: str, kept, spacing: int, note: str, ext, frames) -> list:
     grown = [
         fig.joints[k].id
         for k in range(fig.n_joints)
@@ -148,7 +206,12 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
     out += [
         "C",
         f"C {motion} holds {len(kept)} kept pose(s): the first is its starting position and pose k",
-        f"C is its keyframe at FRAME k * {spacing}. Play it with ANIMATE ... USING {motion}.",
+        (
+            f"C is its keyframe at FRAME k * {spacing}."
+            if frames == [k * spacing for k in range(len(kept))]
+            else "C is its keyframe at FRAME " + ", ".join(str(f) for f in frames[1:]) + " in turn."
+        )
+        + f" Play it with ANIMATE ... USING {motion}.",
         f"C {model} is the model as drawn: each segment's triangles, its joints and extremes.",
     ]
     if grown:
@@ -157,14 +220,20 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
             + ", ".join(str(j) for j in grown)
             + " are widened to hold poses the Generator took beyond them."
         )
-    out += [
+    return out + [
         "",
         f"{{@ {model}: the posed model, {fig.n_links} segments and {fig.n_joints} joints }}",
-        f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}",
+        f"{{@ {motion}: {len(kept)} kept pose(s), {spacing} frames apart }}"
+        if frames == [k * spacing for k in range(len(kept))]
+        else f"{{@ {motion}: {len(kept)} kept pose(s), over {frames[-1]} frames }}",
         "",
     ]
+
+
+def _shapes(fig, segs: list, taken: set) -> tuple:
+    """(PRIMITIVE lines, the same with one triangle each, the segments' assignments)."""
     shapes: dict = {}  # (id(shape), scale) -> primitive name
-    assign = []
+    full, skeleton, assign = [], [], []
     for i, link in enumerate(fig.links):
         tris = getattr(link.shape, "triangles", None)
         if tris is None or len(tris) == 0:
@@ -177,11 +246,16 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
                 prim += "_"
             taken.add(prim)
             shapes[key] = prim
-            out += _primitive(prim, tris * link.scale, link.shape.lightness)
+            lines = _primitive(prim, tris * link.scale, link.shape.lightness)
+            full += lines
+            draws = [n for n, line in enumerate(lines) if line.startswith("      DRAW POLY")]
+            skeleton += lines[: draws[0] + 1] + lines[-2:] if draws else lines
         assign.append(f"      {segs[i]} :- ({prim})")
-    for k in range(0, len(segs), 6):
-        out.append("      GRAPHICAL " + ", ".join(segs[k : k + 6]))
-    out += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + ["", f"      STARTMODEL {model}"]
+    return full, skeleton, assign
+
+
+def _startmodel(fig, model: str, segs: list, ext) -> list:
+    out = [f"      STARTMODEL {model}"]
     for k, j in enumerate(fig.joints):
         pairs = ", ".join(f"({_num(a)}, {_num(b)})" for a, b in ext[k])
         out.append(f"        JOINT {j.id}, {segs[j.primary]}, {_vec(j.loc1)}, {segs[j.secondary]}, {_vec(j.loc2)},")
@@ -190,12 +264,17 @@ def library_text(fig, model: str, motion: str, kept, spacing: int = 24, note: st
     if fig.main is not None and fig.main != fig.root:
         parent = fig.parent_joint_of(fig.main)
         out.append(f"      FIGURE {model} MAIN JOINT {parent.id}")
-    out += ["", f"      STARTMOTION {motion}"]
+    return out
+
+
+def _motion(fig, motion: str, kept, frames, method: str) -> list:
+    out = [f"      STARTMOTION {motion}"]
+    how = "" if method == "LINEAR" else f" INTERPOLATE {method}"
     for k, j in enumerate(fig.joints):
         a = kept[0, k]
         out.append(f"        JOINT {j.id} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
         for n in range(1, len(kept)):
             a = kept[n, k]
-            out.append(f"          FRAME {n * spacing} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}")
+            out.append(f"          FRAME {frames[n]} POSITION {_num(a[0])}, {_num(a[1])}, {_num(a[2])}{how}")
     out.append("      ENDMOTION")
-    return "\n".join(out) + "\n"
+    return out

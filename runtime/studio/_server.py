@@ -60,6 +60,7 @@ class StudioServer(ThreadingHTTPServer):
 
     def __init__(self, session: Session, page: str, port: int = 0, quiet: bool = True):
         self.session = session
+        session.warm()  # checks the library Save will write while the user poses
         self.page = page.encode("utf-8")
         self.quiet = quiet
         super().__init__((HOST, port), _Handler)

@@ -9,17 +9,40 @@ state (:meth:`Session.state`).  All the posing logic is the
 from __future__ import annotations
 
 import base64
+import hashlib
 import os
 import threading
 
 import numpy as np
 
+from liganimate.runtime.motion.interpolation import names as interpolation_names
+
 from ._generator import MODES, POPULATION, SEED_MAX, Generator
-from ._library import library_text
+from ._library import library
 
 __all__ = ["ACTIONS", "RequestError", "Session"]
 
-ACTIONS = ("state", "next", "take", "freeze", "undo", "keep", "stand", "seed", "settings", "save")
+ACTIONS = (
+    "state",
+    "next",
+    "take",
+    "set",
+    "freeze",
+    "undo",
+    "keep",
+    "stand",
+    "seed",
+    "settings",
+    "recall",
+    "delete",
+    "move",
+    "frame",
+    "interpolation",
+    "play",
+    "save",
+)
+#: Frames a played motion may have at most (its matrices go to the page).
+MAX_PLAY_FRAMES = 2400
 
 
 class RequestError(ValueError):
@@ -57,8 +80,37 @@ class Session:
         self.model, self.motion = model, motion
         self.save_path = os.path.abspath(save_path)
         self.spacing = spacing
+        self.method = "LINEAR"  # how the saved motion reaches each kept pose
         self.saved = False
         self.lock = threading.Lock()
+        # Digests of PRIMITIVE texts (Library.shapes) a whole library with them has compiled with.
+        self._shapes_ok: set = set()
+        self._warming: threading.Thread | None = None
+
+    def warm(self) -> None:
+        """Check, in a background thread, the library Save will write, so that Save need not.
+
+        Almost all of a saved library is the figure's PRIMITIVEs, the same
+        at every Save; compiling all of it took seconds for the humanoid.
+        Once a whole library with these PRIMITIVEs has compiled, a Save
+        compiles the library with each PRIMITIVE cut to one triangle
+        instead (the rest, which the kept poses change, in full).
+        """
+        if self._warming is not None:
+            return
+        g = self.generator
+        pose = g.current.copy()
+
+        def check():
+            lib = library(g.figure, self.model, self.motion, [pose], self.spacing)
+            try:
+                check_library(lib.text, self.save_path)
+            except Exception:  # noqa: BLE001 - Save then checks the whole library itself, and reports
+                return
+            self._shapes_ok.add(_digest(lib.shapes))
+
+        self._warming = threading.Thread(target=check, name="liganimate-studio-warm", daemon=True)
+        self._warming.start()
 
     # ---------------------------------------------------------------- state
     def state(self, message: str = "") -> dict:
@@ -80,6 +132,10 @@ class Session:
             "matrices": _b64(X),
             "angles": np.round(poses, 4).tolist(),
             "levels": g.levels.tolist(),
+            "keptFrames": list(g.kept_frames),
+            "keptMatrices": _b64(g.transforms(np.asarray(g.kept))[:, :, :3, :]) if g.kept else "",
+            "interpolation": self.method,
+            "interpolations": list(interpolation_names()),
         }
 
     # -------------------------------------------------------------- actions
@@ -100,7 +156,41 @@ class Session:
         g = self.generator
         with self.lock:
             message = getattr(self, "_do_" + action)(g, body)
-            return self.state(message or "")
+            state = self.state(message or "")
+            if action == "play":
+                state["play"] = self.played()
+            return state
+
+    def played(self) -> dict:
+        """The kept poses as the saved motion plays them: segment matrices for every frame from 0 to the last.
+
+        Raises
+        ------
+        RequestError
+            When no pose is kept, or the motion is longer than :data:`MAX_PLAY_FRAMES`.
+        """
+        from liganimate.runtime.motion import algebra as M
+        from liganimate.runtime.motion.keyframe import Keyframe
+
+        g = self.generator
+        if not g.kept:
+            raise RequestError("keep a pose first: the motion is made of the kept poses")
+        frames = g.kept_frames
+        if frames[-1] + 1 > MAX_PLAY_FRAMES:
+            raise RequestError(
+                f"the motion is {frames[-1] + 1} frames long; the studio plays at most {MAX_PLAY_FRAMES}"
+            )
+        spec = {}
+        for k, j in enumerate(g.figure.joints):
+            start = tuple(float(a) for a in g.kept[0][k])
+            keys = [
+                Keyframe(frames[n], tuple(float(a) for a in g.kept[n][k]), self.method) for n in range(1, len(frames))
+            ]
+            spec[j.id] = (start, keys)
+        motion = M.Motion.from_tracks(spec)
+        times = np.arange(frames[-1] + 1, dtype=np.float64)
+        angles = motion.evaluate(times, g.figure.joint_ids)
+        return {"frames": len(times), "matrices": _b64(g.transforms(angles)[:, :, :3, :])}
 
     def _settings(self, g, body) -> None:
         intensity, mode = body.get("intensity"), body.get("mode")
@@ -148,8 +238,63 @@ class Session:
     def _do_undo(self, g, body):
         return "undone" if g.undo() else "nothing to undo"
 
+    def _do_set(self, g, body):
+        joint, name = self._link_joint(g, body)
+        angles = body.get("angles")
+        if (
+            not isinstance(angles, list)
+            or len(angles) != 3
+            or any(isinstance(a, bool) or not isinstance(a, (int, float)) or not np.isfinite(a) for a in angles)
+        ):
+            raise RequestError("'angles' must be three numbers (degrees about X, Y and Z)")
+        g.set_angles(joint, angles)
+        a = g.current[joint]
+        return f"{name} (joint {g.figure.joints[joint].id}) set to X {a[0]:.2f} Y {a[1]:.2f} Z {a[2]:.2f}"
+
+    def _kept_index(self, g, body, key: str = "index") -> int:
+        if not g.kept:
+            raise RequestError("no pose is kept yet")
+        return _int(body, key, 0, len(g.kept) - 1)
+
+    def _do_recall(self, g, body):
+        k = self._kept_index(g, body)
+        g.recall(k)
+        return f"kept pose {k + 1} is the current pose"
+
+    def _do_delete(self, g, body):
+        k = self._kept_index(g, body)
+        g.delete_kept(k)
+        self.saved = False
+        return f"deleted kept pose {k + 1}"
+
+    def _do_move(self, g, body):
+        k, to = self._kept_index(g, body), self._kept_index(g, body, "to")
+        g.move_kept(k, to)
+        self.saved = False
+        return f"kept pose {k + 1} moved to place {to + 1}"
+
+    def _do_frame(self, g, body):
+        k = self._kept_index(g, body)
+        try:
+            g.set_kept_frame(k, _int(body, "frame", 0, 10**6))
+        except ValueError as exc:
+            raise RequestError(str(exc)) from None
+        self.saved = False
+        return f"kept pose {k + 1} at frame {g.kept_frames[k]}"
+
+    def _do_interpolation(self, g, body):
+        method = body.get("method")
+        if method not in interpolation_names():
+            raise RequestError("'method' must be one of " + ", ".join(interpolation_names()))
+        self.method = method
+        self.saved = False
+        return f"the kept poses are joined by {method} interpolation"
+
+    def _do_play(self, g, body):
+        return "playing"  # the state answered carries the frames (see act)
+
     def _do_keep(self, g, body):
-        g.keep()
+        g.keep(self.spacing)
         self.saved = False
         return f"kept pose {len(g.kept)}"
 
@@ -164,16 +309,44 @@ class Session:
     def _do_save(self, g, body):
         if not g.kept:
             raise RequestError("keep a pose first: the saved motion is made of the kept poses")
-        text = library_text(
-            g.figure, self.model, self.motion, g.kept, self.spacing, note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept."
+        lib = library(
+            g.figure,
+            self.model,
+            self.motion,
+            g.kept,
+            self.spacing,
+            note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept.",
+            frames=g.kept_frames,
+            method=self.method,
         )
-        write_library(self.save_path, text)
+        if self._warming is not None:
+            self._warming.join()  # at most once: the first Save waits for the check it would make itself
+        digest = _digest(lib.shapes)
+        known = digest in self._shapes_ok
+        write_library(self.save_path, lib.text, checked_as=lib.head + lib.skeleton + lib.body if known else None)
+        self._shapes_ok.add(digest)
         self.saved = True
         return f"saved {len(g.kept)} pose(s) to {self.save_path}"
 
 
-def write_library(path: str, text: str) -> None:
+def _digest(text: str) -> bytes:
+    return hashlib.sha256(text.encode("utf-8")).digest()
+
+
+def check_library(text: str, path: str) -> None:
+    """Compile ``text`` as the library at ``path``; LigDiagnostics if it does not compile."""
+    from liganimate.compiler import compile_source
+    from liganimate.lang.source import prepare
+
+    compile_source(prepare(text, path), path=path)
+
+
+def write_library(path: str, text: str, checked_as: str | None = None) -> None:
     """Check that ``text`` compiles as a library at ``path``, then write it atomically.
+
+    ``checked_as``, if given, is compiled instead: ``text`` with its
+    PRIMITIVEs' drawing cut short (:class:`._library.Library`), whose
+    full PRIMITIVEs have compiled before.
 
     Raises
     ------
@@ -182,9 +355,7 @@ def write_library(path: str, text: str) -> None:
     OSError
         If it cannot be written (the old file stays).
     """
-    from liganimate.compiler import compile_source
-    from liganimate.lang.source import prepare
     from liganimate.runtime.exchange import write_files
 
-    compile_source(prepare(text, path), path=path)
+    check_library(text if checked_as is None else checked_as, path)
     write_files([(path, text.encode("utf-8"))])

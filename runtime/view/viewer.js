@@ -14,10 +14,17 @@
   var bytes = LigGL.decodeBase64(el('lig-blob').textContent);
   var V = function (ref) { return LigGL.view(bytes, ref); };
 
+  /* Options in the address: #size=640x480&scene=0&frame=12&look=thesis (the tests use them). */
+  var opts = {};
+  location.hash.replace(/^#/, '').split('&').forEach(function (kv) {
+    var p = kv.split('=');
+    if (p.length === 2) opts[p[0]] = p[1];
+  });
+
   var canvas = el('view');
   var renderer;
   try {
-    renderer = new LigGL.Renderer(canvas);
+    renderer = new LigGL.Renderer(canvas, opts.look === 'thesis' ? 'thesis' : 'modern');
   } catch (err) {
     el('info').textContent = 'Cannot draw: ' + err.message;
     return;
@@ -297,12 +304,6 @@
   });
   window.addEventListener('resize', function () { layout(); draw(); });
 
-  /* Options in the address: #size=640x480&scene=0&frame=12 (the tests use them). */
-  var opts = {};
-  location.hash.replace(/^#/, '').split('&').forEach(function (kv) {
-    var p = kv.split('=');
-    if (p.length === 2) opts[p[0]] = p[1];
-  });
   if (/^\d+x\d+$/.test(opts.size || '')) fixed = opts.size.split('x').map(Number);
   layout();
   setScene(+(opts.scene || 0));
@@ -315,6 +316,17 @@
     frame: function () { return state.image; },
     play: function (on) { setPlaying(on !== false); },
     hoverAt: function (x, y) { state.hover = pickAt(x, y); draw(); return el('info').textContent; },
+    /* What view --watch keeps across a reload: the scene, the frame and the camera. */
+    view: function () { return { scene: scenes[state.scene].id, image: state.image, cam: state.userCam }; },
+    restore: function (v) {
+      var i = scenes.map(function (s) { return s.id; }).indexOf(v.scene);
+      if (i < 0) return;
+      setScene(i);
+      setFrame(v.image);
+      state.userCam = v.cam || null;
+      draw();
+    },
+    camera: function () { return state.userCam; },
     ready: performance.now()
   };
 })();

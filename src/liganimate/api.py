@@ -242,7 +242,7 @@ class LoadedProgram:
             written = fmt.write(self._shot("export"), os.fspath(path), **checked)
         for note in written.warnings:
             _warnings.warn(note, UserWarning, stacklevel=2)
-        write_files(written.files)
+        write_files(written.files, written.folders)
         return [p for p, _ in written.files]
 
     def view(self, scene: int | None = None, height: int = 560) -> View:

@@ -12,6 +12,7 @@ cleanly (exit status 130 and 143), leaving only whole files.
 from __future__ import annotations
 
 import argparse
+import io
 import os
 import signal
 import sys
@@ -68,10 +69,7 @@ def shot_scenes(path: str, doing: str) -> list:
     scenes = X.collect(program, run_warnings)
     _print_diagnostics(run_warnings)
     if not scenes:
-        raise LigError(
-            f"the program shoots no scene, so there is nothing to {doing}.",
-            "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES",
-        )
+        raise LigError(NO_SCENE.format(doing=doing), NO_SCENE_HINT)
     return scenes
 
 
@@ -126,6 +124,37 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _usage_checked(args, parser: argparse.ArgumentParser) -> None:
+    """Refuse option values that are wrong whatever the files say: exit status 2 and the usage line, as argparse does.
+
+    ``--aa 9`` is as much a usage error as ``--size 640``; so is a movie
+    file whose suffix is not its format's (``--gif out.png`` would be a GIF
+    named .png). What depends on the files (a missing folder, an output
+    another run is writing, no ffmpeg) stays an error of exit status 1.
+    """
+    from liganimate.lang.messages import sentence
+    from liganimate.runtime.errors import RenderError
+    from liganimate.runtime.render.options import MOVIES, check_aa
+    from liganimate.runtime.render.outputs import check_fps
+    from liganimate.runtime.render.video import check_crf, check_preset
+
+    try:
+        for movie in MOVIES:
+            path = getattr(args, movie.name, None)
+            if path is not None and not path.lower().endswith("." + movie.name):
+                raise RenderError(
+                    f"the file of --{movie.name} must end in .{movie.name} (it is a {movie.label}), not {path!r}"
+                )
+        check_fps(args.fps, "--fps")
+        check_aa(args.aa, "--aa")
+        if args.crf is not None:
+            check_crf(args.crf, "--crf")
+        if args.preset is not None:
+            check_preset(args.preset, "--preset")
+    except RenderError as exc:
+        parser.error(sentence(exc.message))
+
+
 def _render_options(args, stem: str):
     """The command line's RenderOptions, checked before compiling (nothing is written here).
 
@@ -175,22 +204,41 @@ class _CheckProgress:
             sys.stderr.flush()
 
 
-def _checked(program, quiet: bool, stdout=None) -> list:
-    """``program.check(...)`` with a progress line on a terminal; returns the warnings."""
+def _checked(program, quiet: bool, stdout=None):
+    """Run every check (``Program.check``) with a progress line on a terminal; returns the runtime.
+
+    Its ``warnings`` are the run's warnings, its ``shot`` the number of
+    scenes the program shot.
+    """
     progress = _CheckProgress() if not quiet and sys.stderr.isatty() else None
     try:
-        return program.check(stdout=stdout, progress=progress)
+        if stdout is None:
+            # PRINT output is dropped: a run prints it once, when it renders.
+            return program.execute("check", stdout=io.StringIO(), progress=progress)
+        return program.execute("check", stdout=stdout, echo_print=True, progress=progress)
     finally:
         if progress is not None:
             progress.done()
+
+
+#: A program that shoots no scene (a library, an empty file, SHOOTSCENES left out): ``run`` runs it
+#: for its PRINTs, writes nothing (no empty folder, no movie), says so in a warning and exits 0.
+NO_SCENE = "the program shoots no scene, so there is nothing to {doing}"
+NO_SCENE_HINT = "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES"
 
 
 def _render(program, warnings, options) -> int:
     from liganimate.runtime.render.options import MOVIES
 
     _print_diagnostics(warnings)
-    warnings_run = _checked(program, options.quiet)
-    _print_diagnostics(warnings_run)
+    checked = _checked(program, options.quiet)
+    _print_diagnostics(checked.warnings)
+    if not checked.shot:
+        # Nothing to draw: no empty folder, no "frames written".
+        program.execute("check", stdout=sys.stdout, echo_print=True)  # its PRINTs, once
+        sys.stderr.write(f"liganimate: warning: {NO_SCENE.format(doing='render')}; nothing was written\n")
+        sys.stderr.write(f"  hint: {NO_SCENE_HINT}\n")
+        return 0
     program.render(checked=True, options=options)
     if not options.quiet:
         written = [f"frames written to {options.out}"] if options.out is not None else []
@@ -207,6 +255,7 @@ def guarded(fn):
     """
     from liganimate.lang.diagnostics import LigDiagnostics
     from liganimate.lang.display import escape_text
+    from liganimate.lang.messages import sentence
     from liganimate.runtime.errors import LigError
     from liganimate.runtime.files import os_error_words
 
@@ -218,9 +267,9 @@ def guarded(fn):
     except LigError as exc:
         # Messages can quote program-derived text (names, paths): escaped like
         # every diagnostic, so no control sequence reaches the terminal.
-        sys.stderr.write(f"liganimate: error: {escape_text(exc.message)}\n")
+        sys.stderr.write(f"liganimate: error: {escape_text(sentence(exc.message))}\n")
         if exc.hint:
-            sys.stderr.write(f"  hint: {escape_text(exc.hint)}\n")
+            sys.stderr.write(f"  hint: {escape_text(sentence(exc.hint))}\n")
         return EXIT_USER_ERROR
     except BrokenPipeError:
         # The reader went away (liganimate lib | head): not an error of ours.
@@ -278,6 +327,7 @@ def _stoppable(fn, whole_process: bool) -> int:
 def cmd_run(args) -> int:
     def go():
         stem = os.path.splitext(os.path.basename(args.file))[0]
+        _usage_checked(args, args.parser)
         options = _render_options(args, stem)
         program, warnings = load_program(args.file)
         return _render(program, warnings, options)
@@ -289,7 +339,7 @@ def cmd_check(args) -> int:
     def go():
         program, warnings = load_program(args.file)
         _print_diagnostics(warnings)
-        _print_diagnostics(_checked(program, False, stdout=sys.stdout))
+        _print_diagnostics(_checked(program, False, stdout=sys.stdout).warnings)
         return 0
 
     return guarded(go)
@@ -377,35 +427,64 @@ def cmd_lsp(args) -> int:
     return serve()
 
 
+def suffixed(suffix: str, what: str):
+    """An argparse ``type`` for an output file that must end in ``suffix`` (``what`` names its format)."""
+
+    def check(text: str) -> str:
+        if not text.lower().endswith(suffix):
+            raise argparse.ArgumentTypeError(f"{text!r} must end in {suffix}, as the file is {what}")
+        return text
+
+    return check
+
+
+#: What a program file argument is, for every command's --help.
+PROGRAM_HELP = "the LIG program (a .lig file)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``liganimate`` command."""
     parser = argparse.ArgumentParser(
         prog="liganimate", description="LIG ANIMATE: model and animate articulated figures."
     )
     parser.add_argument("--version", action="version", version=f"liganimate {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     p = sub.add_parser("run", help="compile a program and render its scenes")
-    p.add_argument("file")
+    p.add_argument("file", help=PROGRAM_HELP)
     _add_render_options(p)
-    p.set_defaults(func=cmd_run)
+    p.set_defaults(func=cmd_run, parser=p)
     p = sub.add_parser("check", help="run every check without rendering")
-    p.add_argument("file")
+    p.add_argument("file", help=PROGRAM_HELP)
     p.set_defaults(func=cmd_check)
     p = sub.add_parser("compile", help="write the program as a standalone Python module")
-    p.add_argument("file")
-    p.add_argument("-o", "--output", metavar="FILE.py")
+    p.add_argument("file", help=PROGRAM_HELP)
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="FILE.py",
+        type=suffixed(".py", "a Python module"),
+        help="the module to write (default: <stem>.py in the current folder); run it with python FILE.py -o DIR",
+    )
     p.set_defaults(func=cmd_compile)
     p = sub.add_parser("lib", help="list the standard library's models, motions and primitives")
     p.add_argument("library", nargs="?", help="one library (a standard name or a path)")
     p.set_defaults(func=cmd_lib)
     p = sub.add_parser("archive", help="write a program's models and motions out as a library file")
-    p.add_argument("file")
-    p.add_argument("-o", "--output", metavar="LIB.lig", help="default: <stem>_lib.lig")
+    p.add_argument("file", help=PROGRAM_HELP)
+    p.add_argument(
+        "-o", "--output", metavar="LIB.lig", type=suffixed(".lig", "a LIG library"), help="default: <stem>_lib.lig"
+    )
     p.set_defaults(func=cmd_archive)
     p = sub.add_parser("plot", help="draw a motion's joint angle curves with matplotlib")
-    p.add_argument("file")
-    p.add_argument("motion")
-    p.add_argument("-o", "--output", metavar="FILE.png")
+    p.add_argument("file", help=PROGRAM_HELP)
+    p.add_argument("motion", help="the MOTION variable to draw, as the program names it")
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="FILE.png",
+        type=suffixed(".png", "a PNG image"),
+        help="the image to write (default: <motion>.png in the current folder)",
+    )
     p.set_defaults(func=cmd_plot)
     # Export/import and the browser tools register their own subcommands.
     from liganimate import exchange_cli, fmt_cli, view_cli
@@ -415,7 +494,23 @@ def build_parser() -> argparse.ArgumentParser:
     fmt_cli.add_commands(sub)
     p = sub.add_parser("lsp", help="serve the LIG language to an editor (the Language Server Protocol, over stdio)")
     p.set_defaults(func=cmd_lsp)
+    p = sub.add_parser(
+        "completion",
+        help="print a shell completion script (bash, zsh or tcsh)",
+        description="Print the script that completes liganimate's commands, options and files in a shell. "
+        'In bash: eval "$(liganimate completion bash)"; in zsh: liganimate completion zsh > ~/.zfunc/_liganimate.',
+    )
+    p.add_argument("shell", choices=("bash", "zsh", "tcsh"), help="the shell to complete in")
+    p.set_defaults(func=cmd_completion)
     return parser
+
+
+def cmd_completion(args) -> int:
+    """``liganimate completion SHELL``: the completion script, made by shtab from the argument parser itself."""
+    import shtab
+
+    sys.stdout.write(shtab.complete(build_parser(), shell=args.shell))
+    return 0
 
 
 def main(argv=None) -> int:
@@ -441,6 +536,7 @@ def run_program_cli(program, argv=None) -> int:
 
     def go():
         args = parser.parse_args(argv)
+        _usage_checked(args, parser)
         stem = os.path.splitext(os.path.basename(program.name))[0]
         return guarded(lambda: _render(program, [], _render_options(args, stem)))
 

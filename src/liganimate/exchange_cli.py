@@ -73,7 +73,7 @@ def add_commands(subparsers) -> None:
         + "; ".join(f"{'/'.join(f.suffixes)}: {f.summary}" for f in formats)
         + ".",
     )
-    p.add_argument("file")
+    p.add_argument("file", help="the LIG program whose scenes to export")
     p.add_argument(
         "-o",
         "--output",
@@ -99,7 +99,7 @@ def add_commands(subparsers) -> None:
         description="Write a library file that LOAD takes: from a BVH file, the capture's skeleton as "
         "a MODEL and its frames as a MOTION; from a URDF file, the robot as a MODEL (see docs/exchange.md).",
     )
-    p.add_argument("file", metavar="FILE.bvh|FILE.urdf")
+    p.add_argument("file", metavar="FILE.bvh|FILE.urdf", help="the BVH capture or URDF robot to read")
     p.add_argument("-o", "--output", metavar="OUT.lig", help="default: <stem>.lig beside the current folder")
     p.add_argument("--model", type=lig_name, help="the MODEL's name (default: <STEM>_FIGURE)")
     p.add_argument("--motion", type=lig_name, help="the MOTION's name (default: <STEM>)")
@@ -198,7 +198,7 @@ def cmd_export(args) -> int:
         for note in export.warnings:
             sys.stderr.write(f"liganimate: warning: {note}\n")
         files = export.files
-        X.write_files(files)
+        X.write_files(files, export.folders)
         if not args.quiet:
             for path, _ in files:
                 sys.stderr.write(f"wrote {path}\n")

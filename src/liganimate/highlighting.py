@@ -1,11 +1,13 @@
-"""Highlighting LIG text: the word classes every highlighter uses, and the Pygments lexer.
+"""Highlighting LIG text: the word classes every highlighter uses, the Pygments lexer, the TextMate grammar.
 
 Pygments finds :class:`LigLexer` through the ``pygments.lexers`` entry
 point in pyproject.toml, so ``pygmentize -l lig`` and any documentation
 tool that uses Pygments (Sphinx, MkDocs) colour ```` ```lig ```` blocks once
 liganimate is installed. The TextMate grammar of the VS Code extension
-(editors/vscode/syntaxes/lig.tmLanguage.json) uses the same word classes;
-tests/lsp/test_highlighting.py checks that both agree with the grammar's
+(editors/vscode/syntaxes/lig.tmLanguage.json) is written from the same word
+classes by ``python -m liganimate.highlighting editors/vscode/syntaxes/lig.tmLanguage.json``;
+tests/lsp/test_highlighting.py checks that the file is what
+:func:`textmate_grammar` gives and that the word classes are the grammar's
 own keywords (lang/lig.lark), the built-in functions, the interpolation
 methods and the solvers.
 
@@ -92,4 +94,113 @@ class LigLexer(RegexLexer):
     }
 
 
-__all__ = ["CONSTANTS", "CONTROL", "FUNCTIONS", "KEYWORDS", "LigLexer", "PRIMITIVES", "TYPES", "WORD_OPERATORS"]
+def _alternation(words_: tuple) -> str:
+    """A TextMate (Oniguruma) pattern matching any of ``words_`` as a whole word, in any case."""
+    ordered = sorted(words_, key=lambda w: (-len(w), w))
+    return r"(?<![A-Za-z0-9_$])(?i:" + "|".join(ordered) + r")(?![A-Za-z0-9_])"
+
+
+def textmate_grammar() -> dict:
+    """The TextMate grammar of LIG (scope ``source.lig``), from the same word classes as :class:`LigLexer`."""
+    number = r"(?<![A-Za-z0-9_])(?:(?:\d+\.\d*|\.\d+)(?:[eE][-+]?\d+)?|\d+[eE][-+]?\d+)°?"
+    return {
+        "$schema": "https://raw.githubusercontent.com/martinring/tmlanguage/master/tmlanguage.json",
+        "name": "LIG ANIMATE",
+        "scopeName": "source.lig",
+        "fileTypes": ["lig"],
+        "patterns": [
+            {"include": f"#{part}"} for part in ("comments", "strings", "numbers", "declarations", "words", "operators")
+        ],
+        "repository": {
+            "comments": {
+                "patterns": [
+                    {"name": "comment.line.c.lig", "match": r"^[Cc](?=[ \t\r]|$).*$"},
+                    {"name": "comment.line.flag.lig", "match": r"^\*"},
+                    {"name": "comment.block.documentation.lig", "begin": r"\{@", "end": r"\}"},
+                    {"name": "comment.block.lig", "begin": r"\{", "end": r"\}"},
+                ]
+            },
+            "strings": {
+                "patterns": [
+                    {"name": "string.quoted.single.lig", "match": r"'[^']*'"},
+                    {"name": "invalid.illegal.unclosed-string.lig", "match": r"'[^']*$"},
+                ]
+            },
+            "numbers": {
+                "patterns": [
+                    {"name": "constant.numeric.float.lig", "match": number},
+                    {"name": "constant.numeric.integer.lig", "match": r"(?<![A-Za-z0-9_])\d+°?"},
+                ]
+            },
+            "declarations": {
+                "patterns": [
+                    {
+                        "match": r"(?<![A-Za-z0-9_])(?i:(PRIMITIVE|STARTMODEL|STARTMOTION|STARTREACH))\s+([A-Za-z][A-Za-z0-9_]*)",
+                        "captures": {
+                            "1": {"name": "keyword.other.block.lig"},
+                            "2": {"name": "entity.name.function.lig"},
+                        },
+                    }
+                ]
+            },
+            "words": {
+                "patterns": [
+                    {"name": "keyword.control.lig", "match": _alternation(CONTROL)},
+                    {"name": "storage.type.lig", "match": _alternation(TYPES)},
+                    {"name": "keyword.operator.word.lig", "match": _alternation(WORD_OPERATORS)},
+                    {"name": "keyword.other.lig", "match": _alternation(KEYWORDS)},
+                    {"name": "support.function.builtin.lig", "match": _alternation(FUNCTIONS + PRIMITIVES)},
+                    {"name": "support.constant.lig", "match": _alternation(CONSTANTS)},
+                    {"name": "variable.language.dollar.lig", "match": r"\$[A-Za-z][A-Za-z0-9_]*"},
+                    {"name": "variable.other.lig", "match": r"[A-Za-z][A-Za-z0-9_]*"},
+                ]
+            },
+            "operators": {
+                "patterns": [
+                    {"name": "keyword.operator.lig", "match": r"::=|:-|:=|<=|>=|<>|/=|[=<>/+\-*]"},
+                    {"name": "punctuation.separator.lig", "match": r"[,;]"},
+                    {"name": "punctuation.section.brackets.lig", "match": r"[\[\]()]"},
+                ]
+            },
+        },
+    }
+
+
+def textmate_json() -> str:
+    """:func:`textmate_grammar` as the extension's file holds it."""
+    import json
+
+    return json.dumps(textmate_grammar(), indent=2, ensure_ascii=False) + "\n"
+
+
+def main(argv: list | None = None) -> int:
+    """``python -m liganimate.highlighting PATH``: write the TextMate grammar to PATH."""
+    import sys
+
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) != 1:
+        sys.stderr.write("usage: python -m liganimate.highlighting editors/vscode/syntaxes/lig.tmLanguage.json\n")
+        return 2
+    from liganimate.runtime.files import AtomicWriter
+
+    with AtomicWriter(args[0]) as fh:
+        fh.write(textmate_json().encode("utf-8"))
+    return 0
+
+
+__all__ = [
+    "CONSTANTS",
+    "CONTROL",
+    "FUNCTIONS",
+    "KEYWORDS",
+    "LigLexer",
+    "PRIMITIVES",
+    "TYPES",
+    "WORD_OPERATORS",
+    "textmate_grammar",
+    "textmate_json",
+]
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -47,9 +47,16 @@ def add_commands(subparsers) -> None:
         description="Run the program once without drawing and write a self-contained "
         "HTML page that shows its scenes in 3D (see docs/viewer.md).",
     )
-    p.add_argument("file")
+    p.add_argument("file", help="the LIG program whose scenes to show")
     p.add_argument("-o", "--output", metavar="OUT.html", help="default: <stem>.html in the current folder")
     p.add_argument("--quiet", action="store_true", help="do not say what was written")
+    p.add_argument(
+        "--watch",
+        action="store_true",
+        help="serve the page on 127.0.0.1 instead, and reload it within a second of each save, keeping the view",
+    )
+    p.add_argument("--port", type=_port, default=0, help="with --watch, the port (default: a free one, printed)")
+    p.add_argument("--no-browser", action="store_true", help="with --watch, do not open a browser")
     p.set_defaults(func=cmd_view)
     p = subparsers.add_parser(
         "studio",
@@ -75,9 +82,20 @@ def add_commands(subparsers) -> None:
     p.set_defaults(func=cmd_studio)
 
 
+def _page(path: str) -> str:
+    """The viewer page of the program at ``path`` (an exception when it is wrong or shoots no scene)."""
+    from liganimate.cli import shot_scenes
+    from liganimate.runtime.view import viewer_html
+
+    return viewer_html(shot_scenes(path, "view"), os.path.basename(path))
+
+
 def cmd_view(args) -> int:
-    """``liganimate view FILE [-o OUT.html]``."""
+    """``liganimate view FILE [-o OUT.html]``, or ``--watch``: served and reloaded on each save."""
     from liganimate.cli import guarded, shot_scenes
+
+    if args.watch:
+        return guarded(lambda: _watch(args))
 
     def go():
         from liganimate.runtime import exchange as X
@@ -93,6 +111,30 @@ def cmd_view(args) -> int:
         return 0
 
     return guarded(go)
+
+
+def _watch(args) -> int:
+    """Serve the program's page until Ctrl-C (see liganimate.watch)."""
+    import webbrowser
+
+    from liganimate import watch
+
+    if not os.path.isfile(args.file):
+        raise FileNotFoundError(2, "no such file", args.file)
+
+    def ready(url, program) -> None:
+        print(f"liganimate view: watching {args.file}", flush=True)
+        print(f"  open {url}  (127.0.0.1 only; Ctrl-C stops the server)", flush=True)
+        if program.error:
+            print(program.error, file=sys.stderr, flush=True)
+        if not args.no_browser:
+            webbrowser.open(url)
+
+    try:
+        watch.serve(args.file, _page, port=args.port, ready=ready)
+    except KeyboardInterrupt:
+        print("\nliganimate view: stopped", flush=True)
+    return 0
 
 
 def cmd_studio(args) -> int:

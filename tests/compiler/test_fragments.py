@@ -266,7 +266,8 @@ def _dark_pixels(path):
 
 def test_reversed_squat_renders_two_scenes(tmp_path):
     program, _ = load_program(SQUAT)
-    program.render(str(tmp_path), size=(220, 100), quiet=True)
+    # The thesis look: dark pixels are the figures alone (no contact shadow under them).
+    program.render(str(tmp_path), size=(220, 100), quiet=True, look="thesis")
     one, two = tmp_path / "scene1" / "00000.png", tmp_path / "scene2" / "00000.png"
     assert sorted(p.name for p in (tmp_path / "scene1").iterdir()) == ["00000.png"]
     image1, dark1 = _dark_pixels(one)

@@ -10,7 +10,7 @@ DECLARED = "REAL A, B\nVECTOR V\nA = 2\nB = 3\nV = (1, 2, 3)\n"
 def printed(body: str) -> list[str]:
     """The lines the program's PRINT statements write."""
     out = io.StringIO()
-    liganimate.load(DECLARED + body).program.check(stdout=out)
+    liganimate.loads(DECLARED + body).program.check(stdout=out)
     return out.getvalue().splitlines()
 
 

@@ -446,4 +446,4 @@ def test_a_syntax_error_via_the_cli_names_no_internal_terminal(tmp_path):
     # Inside a PRIMITIVE its name may start a pattern (P ::= ...), an anonymous terminal.
     status, err = check_cli(tmp_path, "PRIMITIVE P\n  P X\nEND\n")
     assert status == 1
-    assert err.splitlines()[0] == "t.lig:2:5: error: unexpected the name X; expected ::="
+    assert err.splitlines()[0] == "t.lig:2:5: error: unexpected name X; expected ::="

@@ -83,7 +83,12 @@ def _alternatives(pattern: str) -> set:
     return set(m.group(1).split("|"))
 
 
-def test_the_textmate_grammar_has_the_same_word_classes():
+def test_the_textmate_grammar_is_written_from_the_word_classes():
+    """Fails when a word class changed and the grammar was not written again.
+
+    Write it with ``python -m liganimate.highlighting editors/vscode/syntaxes/lig.tmLanguage.json``.
+    """
+    assert open(GRAMMAR, encoding="utf-8").read() == H.textmate_json()
     grammar = json.load(open(GRAMMAR, encoding="utf-8"))
     by_scope = {p["name"]: p["match"] for p in grammar["repository"]["words"]["patterns"]}
     assert _alternatives(by_scope["keyword.control.lig"]) == set(H.CONTROL)

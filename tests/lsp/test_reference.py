@@ -18,7 +18,9 @@ def test_the_shipped_table_is_what_the_document_gives():
     Write it with ``python -m liganimate.lsp.reference docs/language.md``.
     """
     built = reference.build(DOC.read_text(encoding="utf-8"), reference.grammar_keywords())
-    assert reference.dumps(built) == reference.dumps(reference.table())
+    assert reference.dumps(built) == reference.dumps(reference.table()), (
+        "docs/language.md changed: run  python -m liganimate.lsp.reference docs/language.md  and commit reference.json"
+    )
 
 
 def test_every_statement_keyword_has_its_section():

@@ -203,6 +203,8 @@ async def hover_text(client: LanguageClient, uri: str, position: T.Position) -> 
 
 async def test_hover(client: LanguageClient, folder: pathlib.Path):
     uri = from_fs_path(str(folder / "scene.lig"))
+    method = await hover_text(client, uri, pos_of(PROGRAM, "ACCDCC", into=2))
+    assert "STARTMOTION ... ENDMOTION" in method
     animate = await hover_text(client, uri, pos_of(PROGRAM, "ANIMATE HUMANOID", into=2))
     assert "4.10 ANIMATE" in animate and "animate_stmt = ANIMATE name FROM expr TO expr USING expr" in animate
     arm = await hover_text(client, uri, pos_of(PROGRAM, "ARM FROM", into=1))
@@ -267,8 +269,12 @@ async def test_completion(client: LanguageClient, folder: pathlib.Path):
 
     view = await at_end_of("      VIEW ")
     assert {"POINT", "WIDTH"} <= view and "ANIMATE" not in view
-    modifiers = await at_end_of("      X = BEND <")
-    assert {"SCALE", "TRANS", "ROT", "LIGHTNESS", "COLOUR"} <= modifiers and "VIEW" not in modifiers
+    # The modifiers the grammar takes after <, narrowed to those of the value's type.
+    graphical = await at_end_of("      X = UPPER <")
+    assert graphical == {"SCALE", "TRANS", "ROT", "LIGHTNESS", "COLOUR", "COLOR"}
+    assert await at_end_of("      X = BEND <") == {"SCALE"}
+    assert await at_end_of("      X = BEND <SCALE ") == {"FRAMES", "FRAME", "EXTREMES", "EXTREME"}
+    assert {"TRANS", "ROT", "SCALE"} == await at_end_of("      X = ARM <")
     methods = await at_end_of("      BEND[1, 3] = FRAME 30 POSITION 0, 0, 0 INTERPOLATION ")
     assert {"LINEAR", "ACCELERATE", "DECELERATE", "ACCDCC"} <= methods
     statement = await at_end_of("      ")
@@ -348,6 +354,20 @@ async def test_rename(client: LanguageClient, folder: pathlib.Path):
                 T.RenameParams(text_document=doc, position=pos_of(PROGRAM, refused, into=1), new_name=new)
             )
         assert "rename" in str(caught.value) or "already" in str(caught.value) or "cannot name" in str(caught.value)
+
+
+async def test_lines_are_counted_as_the_editor_counts_them(client: LanguageClient, folder: pathlib.Path):
+    """A form feed (which LIG text may hold) does not end a line, for the editor or for LIG."""
+    text = "{ page one }\f{ page two }\n      X = 1\n      Y = X + BOX\n"
+    uri = from_fs_path(str(folder / "paged.lig"))
+    client.text_document_did_open(
+        T.DidOpenTextDocumentParams(text_document=T.TextDocumentItem(uri=uri, language_id="lig", version=1, text=text))
+    )
+    found = await diagnostics_for(client, uri, 1)
+    # As liganimate check prints them: 3:15 (BOX needs WIDTH) and 3:11 (the sum).
+    assert sorted((d.range.start.line, d.range.start.character) for d in found) == [(2, 10), (2, 14)]
+    change(client, uri, 2, text.replace("X = 1", "X = 2"))
+    assert {d.range.start.line for d in await diagnostics_for(client, uri, 2)} == {2}
 
 
 async def test_broken_text_keeps_answering(client: LanguageClient, folder: pathlib.Path):

@@ -12,17 +12,23 @@ program text; ``liganimate check`` still does that.
 from __future__ import annotations
 
 import os
+import threading
 from dataclasses import dataclass, field
 
 from liganimate.compiler import NotParsed, parse_program
 from liganimate.compiler.check import Checked, check
 from liganimate.lang import ast as A
+from liganimate.lang import collector
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
 from liganimate.lang.source import MAX_SOURCE_BYTES, prepare
 
 from . import index as I
 from . import libraries, statics
 from .text import Text
+
+#: Held while the compiler works (parsing, checking, opening libraries): it pauses and freezes the
+#: process's garbage collector (lang/collector.py) and keeps caches, so two threads must not run it at once.
+COMPILER_LOCK = threading.RLock()
 
 
 @dataclass
@@ -54,7 +60,9 @@ def _too_large(filename: str) -> Diagnostic:
     )
 
 
-def analyse(source: str, path: str | None, version: int | None = None, encoding: str | None = None) -> Analysis:
+def analyse(
+    source: str, path: str | None, version: int | None = None, encoding: str | None = None, *, whole: bool = True
+) -> Analysis:
     """Analyse document text.
 
     Parameters
@@ -67,7 +75,19 @@ def analyse(source: str, path: str | None, version: int | None = None, encoding:
         The editor's version of the text.
     encoding : str, optional
         The position encoding agreed with the client.
+    whole : bool
+        False stops once the diagnostics are known (the server publishes
+        them, then calls :func:`complete`); True also builds the index and
+        the values.
     """
+    # The stages build trees, not cycles: the cyclic collector is paused while
+    # they run, as the compiler pauses it (lang/collector.py), so that the
+    # trees of earlier analyses the server still holds are not walked again and again.
+    with COMPILER_LOCK, collector.paused():
+        return _analyse(source, path, version, encoding, whole)
+
+
+def _analyse(source: str, path: str | None, version: int | None, encoding: str | None, whole: bool) -> Analysis:
     text = Text(source) if encoding is None else Text(source, encoding)
     filename = path or "<untitled>"
     if len(source) > MAX_SOURCE_BYTES or len(source.encode("utf-8", errors="replace")) > MAX_SOURCE_BYTES:
@@ -84,10 +104,19 @@ def analyse(source: str, path: str | None, version: int | None = None, encoding:
         result.diagnostics = list(prepared.warnings) + list(result.checked.warnings)
     except LigDiagnostics as exc:
         result.diagnostics = list(exc.diagnostics)
-    result.index = I.build(program, text)
-    result.libraries = libraries.libraries_of(program, where)
-    result.env = statics.evaluate(program, libraries.loaded_values(program, where))
-    return result
+    return complete(result) if whole else result
 
 
-__all__ = ["Analysis", "analyse"]
+def complete(a: Analysis) -> Analysis:
+    """Build the index, the libraries and the values of an analysis whose text parsed (in place; returns it)."""
+    if a.program is None or a.index is not None:
+        return a
+    where = a.path if a.path is not None else os.path.join(os.getcwd(), "<untitled>")
+    with COMPILER_LOCK:
+        a.index = I.build(a.program, a.text)
+        a.libraries = libraries.libraries_of(a.program, where)
+        a.env = statics.evaluate(a.program, libraries.loaded_values(a.program, where))
+    return a
+
+
+__all__ = ["COMPILER_LOCK", "Analysis", "analyse", "complete"]

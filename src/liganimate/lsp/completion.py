@@ -238,6 +238,40 @@ def word_context(text: str, offset: int) -> str | None:
     return None
 
 
+_MODIFIER_TARGET = re.compile(r"([A-Za-z][A-Za-z0-9_]*)\s*<([^<>;]*)$")
+_VARIANTS = {"EXTREMES": ("EXTREME",), "FRAMES": ("FRAME",), "COLOUR": ("COLOR",)}
+
+
+def modifier_words(before: str, target_type) -> tuple | None:
+    """What may continue a modifier of a value of type ``target_type`` after the text ``before``.
+
+    ``before`` ends inside a ``< ... >`` list that follows a name; the
+    words already written of the current modifier (``SCALE``) narrow the
+    choice (``FRAMES`` for a MOTION; ``MODEL``, ``EXTREMES`` or a value for
+    a MODEL). Returns ``(words, value)``: the next words, and whether a
+    value may come instead; None when this is not known (no list, no type),
+    so the grammar's own choice stands.
+    """
+    from liganimate.lang.vocabulary import MODIFIERS
+
+    m = _MODIFIER_TARGET.search(before)
+    if m is None or target_type is None:
+        return None
+    written = [w.upper() for w in re.findall(r"[A-Za-z]+", m.group(2).rsplit(",", 1)[-1])]
+    labels = [mod.label.split() for mod in MODIFIERS.values() if target_type in mod.targets]
+    if not any(words[: len(written)] == written for words in labels):
+        return None  # past the modifier's words: the grammar knows
+    nxt = set()
+    for words in labels:
+        if len(words) > len(written) and words[: len(written)] == written:
+            word = words[len(written)]
+            nxt.add(word)
+            nxt.update(_VARIANTS.get(word, ()))
+    if not nxt:
+        return None  # only a value (or ROT's axis) comes next: the grammar knows
+    return frozenset(nxt), bool(written) and written in labels
+
+
 def methods() -> list:
     """The interpolation methods a keyframe may name, plugins included."""
     from liganimate.runtime.motion import interpolation
@@ -288,6 +322,7 @@ __all__ = [
     "library_files",
     "load_context",
     "methods",
+    "modifier_words",
     "primitive_words",
     "solvers",
     "terminals_at",

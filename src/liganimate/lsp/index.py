@@ -51,7 +51,9 @@ class Index:
 
     def at(self, offset: int) -> Occurrence | None:
         """The occurrence under offset ``offset`` (its end included, where a cursor after a name stands)."""
-        starts = [o.start for o in self.occurrences]
+        starts = self.__dict__.get("_starts")
+        if starts is None:
+            starts = self.__dict__["_starts"] = [o.start for o in self.occurrences]
         i = bisect.bisect_right(starts, offset) - 1
         if i >= 0 and self.occurrences[i].start <= offset <= self.occurrences[i].end:
             return self.occurrences[i]

@@ -4,10 +4,10 @@ This module only wires the protocol to the modules that do the work: the
 analysis of a change runs in one worker thread (:mod:`.analysis`), and
 every request is answered at once from the latest analysis, the last one
 whose text parsed, and the tolerant scan of the text as it is now, never
-waiting for an analysis to finish. Each change is analysed after a pause
-of :data:`DEBOUNCE` seconds without another, so a burst of keystrokes
-costs one analysis; its diagnostics are published unless a newer version
-of the text has arrived meanwhile.
+waiting for an analysis to finish. A change is analysed at once; changes
+that arrive while an analysis runs are taken together by the next one, and
+only the diagnostics of an analysis whose text is still current are
+published.
 """
 
 from __future__ import annotations
@@ -29,12 +29,10 @@ from . import completion as C
 from . import hover as H
 from . import navigation as N
 from . import outline, scan
-from .analysis import Analysis, analyse
+from .analysis import COMPILER_LOCK, Analysis, analyse
 from .lookup import target
 from .text import Text
 
-#: Seconds without a further change before a change is analysed.
-DEBOUNCE = 0.05
 _REQUEST_FAILED = -32803  # the protocol's RequestFailed
 
 log = logging.getLogger(__name__)
@@ -44,7 +42,10 @@ class LigServer(LanguageServer):
     """The server's state: the documents' analyses, and the worker that makes them."""
 
     def __init__(self) -> None:
-        super().__init__("liganimate", __version__, text_document_sync_kind=lsp.TextDocumentSyncKind.Incremental)
+        # Whole texts, not edits: pygls applies an edit by lines it cuts with str.splitlines, which also
+        # breaks at a form feed (LIG text may hold one; editors and LIG do not break lines there), so an
+        # edit after a form feed would land on the wrong line.
+        super().__init__("liganimate", __version__, text_document_sync_kind=lsp.TextDocumentSyncKind.Full)
         self.latest: dict = {}  # uri -> Analysis of some version (maybe not the newest)
         self.good: dict = {}  # uri -> the last Analysis whose text parsed
         self.pending: dict = {}  # uri -> the asyncio task that will analyse it
@@ -71,26 +72,36 @@ def _path(uri: str) -> str | None:
 
 
 def _schedule(ls: LigServer, uri: str) -> None:
-    old = ls.pending.pop(uri, None)
-    if old is not None:
-        old.cancel()
-    ls.pending[uri] = asyncio.ensure_future(_analyse_later(ls, uri))
+    """Analyse ``uri``'s text now, or, if an analysis of it is running, once more when it ends."""
+    task = ls.pending.get(uri)
+    if task is None or task.done():
+        ls.pending[uri] = asyncio.ensure_future(_analyse_until_current(ls, uri))
 
 
-async def _analyse_later(ls: LigServer, uri: str) -> None:
-    await asyncio.sleep(DEBOUNCE)
-    doc = ls.workspace.get_text_document(uri)
-    version, source = doc.version, doc.source
+async def _analyse_until_current(ls: LigServer, uri: str) -> None:
+    """Analyse the document until an analysis ends on the text it started from; publish that one's diagnostics.
+
+    A change that arrives while an analysis runs is not analysed on its
+    own: the next round takes the text as it is then, so a burst of
+    keystrokes costs one analysis more than the one running, and a single
+    change is analysed at once, with no pause.
+    """
     loop = asyncio.get_running_loop()
-    result = await loop.run_in_executor(ls.worker, _analyse_safely, source, _path(uri), version, ls.encoding())
-    if ls.workspace.get_text_document(uri).version != version:
-        return  # a newer change is on its way
-    ls.latest[uri] = result
-    if result.parsed:
-        ls.good[uri] = result
-    ls.text_document_publish_diagnostics(
-        lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
-    )
+    await asyncio.sleep(0)  # the change's own handler first
+    while uri in ls.workspace.text_documents:
+        doc = ls.workspace.get_text_document(uri)
+        version, source = doc.version, doc.source
+        result = await loop.run_in_executor(ls.worker, _analyse_safely, source, _path(uri), version, ls.encoding())
+        if uri not in ls.workspace.text_documents:
+            return  # closed meanwhile
+        ls.latest[uri] = result
+        if result.parsed:
+            ls.good[uri] = result
+        if ls.workspace.get_text_document(uri).version == version:
+            ls.text_document_publish_diagnostics(
+                lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
+            )
+            return
 
 
 def _analyse_safely(source: str, path: str | None, version, encoding: str) -> Analysis:
@@ -163,8 +174,9 @@ async def did_change(ls: LigServer, params: lsp.DidChangeTextDocumentParams) -> 
 
 @server.feature(lsp.TEXT_DOCUMENT_DID_SAVE)
 async def did_save(ls: LigServer, params: lsp.DidSaveTextDocumentParams) -> None:
-    """Analyse again on save: a library it LOADs may have changed."""
-    _schedule(ls, params.text_document.uri)
+    """Analyse every open document again on save: the saved file may be a library the others LOAD."""
+    for uri in list(ls.workspace.text_documents):
+        _schedule(ls, uri)
 
 
 @server.feature(lsp.TEXT_DOCUMENT_DID_CLOSE)
@@ -248,7 +260,14 @@ def _completions(source: str, offset: int, good: Analysis | None, path: str | No
     loaded_prims = {n for n, info in (good.libraries if good else {}).items() if info.offered.get(n) == "PRIMITIVE"}
     primitives = frozenset(BUILTIN_PRIMITIVES | prepare(source, "").primitive_names() | loaded_prims)
     terminals = C.terminals_at(source, start, primitives)
-    items = [C.Item(k, "keyword") for k in C.keywords_for(terminals)]
+    keywords = C.keywords_for(terminals)
+    narrowed = C.modifier_words(source[max(0, start - 400) : start], _type_before(source, start, good))
+    if narrowed is not None:
+        words, value = narrowed
+        keywords = [k for k in keywords if k in words]
+        if not value:
+            terminals = terminals - {"NAME", "PRIM_NAME"}
+    items = [C.Item(k, "keyword") for k in keywords]
     if "NAME" in terminals and good is not None and good.index is not None:
         scope = good.index.scope_at(min(start, len(good.text.source)))
         types = good.checked.main.types if good.checked is not None else {}
@@ -259,6 +278,21 @@ def _completions(source: str, offset: int, good: Analysis | None, path: str | No
     if "CLAUSE_NAME" in terminals:
         items += _clause_items(source, start, primitives, good)
     return items
+
+
+def _type_of_name(good: Analysis | None, name: str) -> str | None:
+    if good is None:
+        return None
+    if good.checked is not None and name in good.checked.main.types:
+        return good.checked.main.types[name]
+    info = good.libraries.get(name)
+    return info.offered.get(name) if info is not None else None
+
+
+def _type_before(source: str, start: int, good: Analysis | None) -> str | None:
+    """The type of the name a ``<`` list before ``start`` modifies, if the last good analysis knows it."""
+    m = C._MODIFIER_TARGET.search(source[max(0, start - 400) : start])
+    return _type_of_name(good, m.group(1).upper()) if m is not None else None
 
 
 def _in_comment_or_string(source: str, offset: int) -> bool:
@@ -299,7 +333,8 @@ def _load_items(context: tuple, path: str | None) -> list:
     kind, value = context
     if kind == "library":
         return C.library_files(os.path.dirname(path) if path else None)
-    info = libraries.open_library(value, path)
+    with COMPILER_LOCK:  # opening a library compiles it: not beside an analysis
+        info = libraries.open_library(value, path)
     if info is None:
         return []
     return [C.Item(n, "variable", info.offered[n] + " " + info.descriptions.get(n, "")) for n in sorted(info.offered)]

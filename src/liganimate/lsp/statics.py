@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 
 from liganimate.lang import ast as A
 from liganimate.lang.bindings import assigned, plain_name
+from liganimate.lang.visitor import BLOCKS
 
 #: A joint's extremes: three (min, max) pairs, X, Y, Z (an omitted axis is locked at (0, 0)).
 Extremes = tuple
@@ -264,8 +265,29 @@ class _Statements:
             if handler is not None:
                 handler(s)
             elif kind in (A.Do, A.If, A.Scene):
-                for n in assigned(s):
-                    self.env.values[n.name] = None  # its value depends on the run
+                self._block(s)
+
+    def _block(self, s) -> None:
+        """A loop, an IF or a scene: a name it assigns keeps its value only where every pass leaves it so.
+
+        The block's statements are walked on a copy of the values; a name
+        whose value they change (or cannot tell) is unknown from here on.
+        Walked again until nothing more changes, so a name changed late in
+        the block also unsettles what was computed from it earlier.
+        """
+        names = {n.name for n in assigned(s)}
+        if isinstance(s, A.Do):
+            self.env.values[s.var.name] = None  # the loop's variable takes many values
+        inner = [t for field in BLOCKS[type(s)] for t in (getattr(s, field) or ())]
+        for _ in range(4):
+            scratch = Env(dict(self.env.values), self.env.loaded)
+            _Statements(scratch).run(inner)
+            changed = {n for n in names if scratch.values.get(n) != self.env.values.get(n)}
+            changed = {n for n in changed if self.env.values.get(n) is not None or n not in self.env.values}
+            if not changed:
+                return
+            for n in changed:
+                self.env.values[n] = None  # its value depends on the run
 
     def set(self, name: str, value) -> None:
         self.env.values[name] = value

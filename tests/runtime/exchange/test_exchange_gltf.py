@@ -229,3 +229,91 @@ def test_cli_export_chooses_the_rig(tmp_path):
     )
     assert r.returncode == 2 and "'bones' is not a glTF rig; the rigs are skin and nodes" in r.stderr
     assert not (tmp_path / "x.glb").exists()
+
+
+@pytest.mark.parametrize("rig", X.RIGS)
+def test_the_same_program_exports_the_same_bytes(tmp_path, rig):
+    program = program_named(tmp_path, "edges")
+    first, _ = X.gltf_bytes(X.collect(program), True, fps=FPS, rig=rig)
+    again, _ = X.gltf_bytes(X.collect(program_named(tmp_path, "edges")), True, fps=FPS, rig=rig)
+    assert first == again
+
+
+def test_key_times_never_follow_the_tick_and_a_collision_is_refused():
+    from liganimate.runtime.errors import LigError
+    from liganimate.runtime.exchange import _gltf
+
+    ticks = np.arange(100_000)
+    for fps in (24.0, 25.0, 30.0, 60.0, 120.0, 29.97):
+        t = X.key_times(ticks, fps)
+        assert t.dtype == np.float32 and (t.astype(np.float64) <= ticks / fps).all()
+        assert (np.diff(t) > 0).all()
+        # Still the nearest float32 below: one step up is past the tick.
+        assert (np.nextafter(t, np.float32(np.inf)).astype(np.float64) > ticks / fps).all()
+    # At a million ticks a second, 16.777216 s and one tick later share a float32.
+    b = _gltf.Builder(1e6, (640, 480), "skin")
+    b.length = 2**25
+    with pytest.raises(LigError, match="too long for glTF's 32-bit key times"):
+        b._times(np.array([2**24, 2**24 + 1]))
+
+
+NAMED_ARM = """\
+      GRAPHICAL BASE, UPPER, LOWER
+      MODEL ARM
+      BASE :- BOX WIDTH 0.4, HEIGHT 0.2, DEPTH 0.4
+      UPPER :- BOX AT (0.0, 0.5, 0.0), WIDTH 0.1, HEIGHT 1.0, DEPTH 0.1
+      LOWER :- BOX AT (0.0, 0.4, 0.0), WIDTH 0.08, HEIGHT 0.8, DEPTH 0.08
+      STARTMODEL ARM
+        JOINT 1, BASE, (0.0, 0.1, 0.0), UPPER, (0.0, 0.0, 0.0), (-90.0, 90.0)
+        JOINT 2, UPPER, (0.0, 1.0, 0.0), LOWER, (0.0, 0.0, 0.0), (-120.0, 120.0)
+      ENDMODEL
+{@names ARM
+  BASE "base_link"
+  UPPER "upper_arm_link" JOINT "shoulder_pan_joint"
+  LOWER "forearm_link" JOINT "elbow_joint"
+}
+"""
+
+PLAY_ARM = """\
+      LOAD ARM FROM 'arm.lig'
+      MOTION M
+      STARTMOTION M
+        JOINT 1 POSITION 0.0, 0.0, 0.0
+          FRAME 5 POSITION 40.0, 0.0, 0.0
+        JOINT 2 POSITION 0.0, 0.0, 0.0
+          FRAME 5 POSITION 60.0, 0.0, 0.0
+      ENDMOTION
+      INITIALIZE SCENE 1
+      STARTSCENE LENGTH 6
+        ANIMATE ARM FROM 0 TO 5 USING M
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+
+def test_nodes_take_the_link_and_joint_names_of_the_source(tmp_path):
+    """A library's name table (a URDF robot's links and joints) names the bones and the nodes."""
+    from liganimate.cli import load_program
+
+    (tmp_path / "arm.lig").write_text(NAMED_ARM)
+    (tmp_path / "play.lig").write_text(PLAY_ARM)
+    program, _ = load_program(str(tmp_path / "play.lig"))
+    names = {}
+    for rig in X.RIGS:
+        path = str(tmp_path / f"{rig}.glb")
+        _export(program, path, rig)
+        doc, _ = load_gltf(path)
+        names[rig] = [n.name for n in doc.nodes if n.camera is None]
+        if rig == "skin":
+            (skin,) = doc.skins
+            extras = [doc.nodes[j].extras["liganimate"].get("source_joint") for j in skin.joints]
+            assert extras == [None, "shoulder_pan_joint", "elbow_joint"]
+    assert names["skin"] == ["ARM", "base_link", "upper_arm_link", "forearm_link", "ARM mesh"]
+    assert names["nodes"] == [
+        "ARM",
+        "ARM base_link",
+        "ARM shoulder_pan_joint",
+        "ARM upper_arm_link",
+        "ARM elbow_joint",
+        "ARM forearm_link",
+    ]

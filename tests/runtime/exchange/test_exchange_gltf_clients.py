@@ -26,8 +26,9 @@ from liganimate.runtime.exchange import _gltf
 FPS = 24.0
 # Figures the rig must carry: a mirrored, re-rooted, unevenly scaled model
 # shown part of the time beside a STEP scene (edges), the library humanoid
-# walking, a re-rooted figure, SCALE MODEL figures, Appendix A's figure.
-SKINNED = ["edges", "walking_humanoid", "rerooting", "big_and_small_robot", "appendix_a"]
+# walking, sliding and AXIS joints walked both ways (crane), a re-rooted figure, SCALE MODEL figures,
+# Appendix A's figure.
+SKINNED = ["edges", "walking_humanoid", "crane", "rerooting", "big_and_small_robot", "appendix_a"]
 
 
 def _export(program, path, rig, fps=FPS):
@@ -222,7 +223,7 @@ def _blender(x):
     return np.stack([x[..., 0], -x[..., 2], x[..., 1]], axis=-1)
 
 
-@pytest.mark.parametrize("name", ["walking_humanoid", "edges", "rerooting"])
+@pytest.mark.parametrize("name", ["walking_humanoid", "edges", "crane", "rerooting"])
 def test_blender_makes_an_armature_per_model_posed_as_drawn(tmp_path, name):
     program = program_named(tmp_path, name)
     figures = _figures(program)

@@ -127,7 +127,7 @@ def test_export_needs_a_known_extension(tmp_path):
     src = tmp_path / "a.lig"
     src.write_text("      X = 1\n")
     r = _cli("export", str(src), "-o", str(tmp_path / "a.obj"))
-    assert r.returncode == 1 and ".glb, .gltf or .bvh" in r.stderr
+    assert r.returncode == 1 and ".glb, .gltf, .bvh, .urdf, .csv or .json" in r.stderr
     assert sorted(os.listdir(tmp_path)) == ["a.lig"]
 
 

@@ -251,3 +251,29 @@ def test_bad_axis_or_slide_is_a_positioned_error(line, message):
         _run(CRANE + line + "\n")
     d = info.value.diagnostics[0]
     assert message in d.message and d.pos.line == 14
+
+
+def test_a_keyframe_beyond_a_slides_extremes_is_refused_at_the_animate():
+    from liganimate.lang.diagnostics import LigDiagnostics
+
+    program = CRANE + (
+        "MOTION GO\n"
+        "STARTMOTION GO\n"
+        "  JOINT 1\n"
+        "    FRAME 5 POSITION 2, 0, 0\n"
+        "    FRAME 10 POSITION 4, 0, 0\n"
+        "ENDMOTION\n"
+        "INITIALIZE SCENE 1\n"
+        "STARTSCENE LENGTH 10\n"
+        "  ANIMATE M FROM 0 TO 10 USING GO\n"
+        "ENDSCENE\n"
+        "SHOOTSCENES\n"
+    )
+    with pytest.raises(LigDiagnostics) as info:
+        _run(program)
+    d = info.value.diagnostics[0]
+    assert d.pos.line == 22  # the ANIMATE
+    assert "joint 1 slides within (0, 3) along X, but the motion puts it at 4 at frame 10" in d.message
+    # Within range it runs, and in-betweens that overshoot (none do here) would be clamped.
+    v, _ = _run(program.replace("POSITION 4, 0, 0", "POSITION 3, 0, 0"))
+    assert "M" in v

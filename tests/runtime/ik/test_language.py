@@ -59,10 +59,10 @@ def test_an_unknown_link_is_refused_and_an_ambiguous_one_warned():
     assert warn.startswith("2 links are named UPPER; the goal uses the one attached by joint 1")
 
 
-def solve(fig, goals, **options):
-    kw = dict(start=None, movable=None, translate=False, solver="dls", tolerance=None, iterations=None)
-    kw.update(options)
-    return RL.reach_block(fig, goals, 6, "LINEAR", **kw)
+def solve(fig, goals, start=None, **block):
+    kw = dict(movable=None, translate=False, solver="dls", tolerance=None, iterations=None)
+    kw.update(block)
+    return RL.reach_block(fig, goals, 6, "LINEAR", start=start, options=RL.block_options(**kw))
 
 
 def test_a_met_goal_gives_the_motion_and_no_warning():
@@ -106,3 +106,21 @@ def test_a_translation_beyond_the_geometry_limit_is_refused(monkeypatch):
     with pytest.raises(GoalError, match="not within the geometry limit") as info:
         solve(fig, [goal], translate=True)
     assert "1E12" in info.value.hint
+
+
+def test_a_block_s_options_travel_as_one_reach_options():
+    from liganimate.runtime.ik.reach import ReachOptions, reach, reach_options
+
+    o = RL.block_options(("chain", 2), 1, "ccd", 0.01, 40)
+    assert o == ReachOptions(movable=2, translate=True, solver="ccd", tolerance=0.01, max_iterations=40)
+    assert RL.block_options(("joints", [2, 1]), False, "dls", None, None).movable == (2, 1)
+    with pytest.raises(AttributeError):
+        o.solver = "dls"  # type: ignore[misc]
+    fig = model()
+    goal, _ = RL.language_goal(fig, "point", "LOWER", None, (0, -1, 0), (1.2, -0.9, 0), None, None)
+    by_value = reach(fig, [goal], 6.0, options=o)
+    by_fields = reach(fig, [goal], 6.0, movable=2, translate=True, solver="ccd", tolerance=0.01, max_iterations=40)
+    assert np.array_equal(by_value.solution.angles, by_fields.solution.angles)
+    assert reach_options(o, solver="dls") == ReachOptions(2, True, "dls", 0.01, 40)
+    with pytest.raises(GoalError, match="no REACH option iterations"):
+        reach(fig, [goal], 6.0, iterations=3)

@@ -144,3 +144,72 @@ def test_the_command_line_refuses_an_unknown_look(tmp_path):
     assert r.returncode == 1
     assert "liganimate: error: --look fancy is not a look; give one of modern, thesis" in r.stderr
     assert not list(tmp_path.glob("p_frames*"))
+
+
+# ------------------------------------------------------------ default framing
+SWING = """\
+      GRAPHICAL A, B
+      MODEL M
+      MOTION GO
+      A :- BOX AT ({x}, 3.0, -4.0), WIDTH 0.4, HEIGHT 0.8, DEPTH 0.4, LIGHTNESS 50.0
+      B :- BOX AT (1.0, 0.0, 0.0), WIDTH 1.0, HEIGHT 0.2, DEPTH 0.2, LIGHTNESS 70.0
+      M :- JOINT 1, A, ({x}, 3.0, -4.0), B, (0.0, 0.0, 0.0), (-180.0, 180.0), (-180.0, 180.0), (-180.0, 180.0)
+      STARTMOTION GO
+        JOINT 1 POSITION 0.0, 0.0, 0.0
+          FRAME {last} POSITION 0.0, 0.0, 170.0
+      ENDMOTION
+      INITIALIZE SCENE 1
+{view}      STARTSCENE LENGTH {length}
+        ANIMATE M FROM 0 TO {last} USING GO
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+
+def _frames(tmp_path, name, look, view="", length=1, x=6.0):
+    from liganimate.compiler import load_program
+    from liganimate.runtime.render.imagefiles import read_png
+
+    text = SWING.format(view=view, length=length, last=max(length - 1, 1), x=x)
+    program, _ = load_program(None, text=text, name=f"{name}.lig")
+    out = tmp_path / f"{name}_{look}"
+    program.render(str(out), size=SIZE, quiet=True, workers=1, look=look)
+    return [read_png(p) for p in sorted(out.rglob("*.png"))]
+
+
+def _drawn_box(image, background):
+    rows, cols = np.nonzero(image != background)
+    return rows.min(), rows.max(), cols.min(), cols.max()
+
+
+THESIS_VIEW = "        VIEW POINT = (0.0, 0.0, 10.0)\n        VIEW WIDTH = 10.0\n"
+
+
+def test_a_scene_without_view_frames_what_it_draws_in_the_modern_look(tmp_path):
+    (modern_image,) = _frames(tmp_path, "far", "modern")
+    r0, r1, c0, c1 = _drawn_box(modern_image, MODERN.background)
+    # The model fills the frame, with a margin, however far from the origin it is.
+    assert max(r1 - r0 > 0.5 * SIZE[1], c1 - c0 > 0.5 * SIZE[0])
+    assert r0 > 0 and c0 > 0 and r1 < SIZE[1] - 1 and c1 < SIZE[0] - 1
+    # The thesis look keeps the thesis' camera: (0, 0, 10) looking at the origin, 10 wide.
+    (thesis_image,) = _frames(tmp_path, "far", "thesis")
+    (explicit,) = _frames(tmp_path, "far_view", "thesis", THESIS_VIEW)
+    assert np.array_equal(thesis_image, explicit)
+    r0, r1, c0, c1 = _drawn_box(thesis_image, 255)
+    assert c1 - c0 < 0.25 * SIZE[0]
+
+
+def test_a_scene_that_sets_view_keeps_it_in_the_modern_look(tmp_path):
+    (image,) = _frames(tmp_path, "viewed", "modern", THESIS_VIEW)
+    r0, r1, c0, c1 = _drawn_box(image, MODERN.background)
+    assert c1 - c0 < 0.25 * SIZE[0]  # as small as the thesis' camera shows it
+
+
+def test_the_framing_holds_what_every_tick_draws(tmp_path):
+    images = _frames(tmp_path, "swing", "modern", length=60, x=-3.0)
+    assert len(images) == 60
+    boxes = np.array([_drawn_box(im, MODERN.background) for im in images])
+    # Every tick inside the frame; together they fill it.
+    assert (boxes[:, 0] > 0).all() and (boxes[:, 2] > 0).all()
+    assert (boxes[:, 1] < SIZE[1] - 1).all() and (boxes[:, 3] < SIZE[0] - 1).all()
+    assert boxes[:, 1].max() - boxes[:, 0].min() > 0.6 * SIZE[1]

@@ -12,7 +12,7 @@ from liganimate.cli import load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.runtime import exchange as X
 from liganimate.runtime.figure.pose import mesh_table, world_transforms, world_triangles
-from liganimate.runtime.studio import Generator, library_text, widened_extremes, write_library
+from liganimate.runtime.studio import Generator, Session, library_text, widened_extremes, write_library
 
 
 def _posed(fig, seed=31):
@@ -108,3 +108,49 @@ def test_a_library_that_would_not_compile_is_not_written(tmp_path, humanoid):
         write_library(str(lib), text)
     assert lib.read_text(encoding="utf-8") == "C the old library\n"
     assert os.listdir(tmp_path) == ["poses.lig"]  # no temporary file left behind
+
+
+def _warm_session(tmp_path, humanoid, monkeypatch):
+    from liganimate.runtime.studio import _session
+
+    compiled = []
+    real = _session.check_library
+    monkeypatch.setattr(_session, "check_library", lambda text, path: (compiled.append(text), real(text, path)))
+    s = Session(humanoid, "HUMANOID", "POSES", str(tmp_path / "poses.lig"), seed=4)
+    s.warm()
+    s._warming.join()
+    return s, compiled
+
+
+def test_save_after_the_warm_up_compiles_the_primitives_cut_short_and_writes_them_whole(
+    tmp_path, humanoid, monkeypatch
+):
+    s, compiled = _warm_session(tmp_path, humanoid, monkeypatch)
+    s.act({"action": "keep"})
+    s.act({"action": "next"})
+    s.act({"action": "take", "candidate": 2, "link": 3})
+    s.act({"action": "keep"})
+    s.act({"action": "save"})
+    g = s.generator
+    whole = library_text(humanoid, "HUMANOID", "POSES", g.kept, note=f"Seed {g.seed}, 2 pose(s) kept.")
+    assert (tmp_path / "poses.lig").read_text(encoding="utf-8") == whole
+    assert len(compiled) == 2  # the warm-up's whole library, then Save's
+    assert len(compiled[1]) < len(whole) / 20
+    assert whole.endswith(compiled[1][-2000:])  # the model and the motion are checked in full
+
+
+def test_save_after_the_warm_up_still_refuses_a_library_that_would_not_compile(tmp_path, humanoid, monkeypatch):
+    from liganimate.runtime.studio import _library, _session
+
+    s, _ = _warm_session(tmp_path, humanoid, monkeypatch)
+    real = _library.library
+
+    def broken(*args, **kwargs):
+        lib = real(*args, **kwargs)
+        return _library.Library(lib.head, lib.shapes, lib.skeleton, lib.body.replace("ENDMODEL", "ENDMODLE"))
+
+    monkeypatch.setattr(_session, "library", broken)
+    s.act({"action": "keep"})
+    with pytest.raises(LigDiagnostics):
+        s.act({"action": "save"})
+    assert not (tmp_path / "poses.lig").exists()

@@ -80,9 +80,10 @@ def browser():
         yield b
 
 
-def _open(browser, page, size="640x480"):
+def _open(browser, page, size="640x480", look="thesis"):
+    # The thesis look by default: the comparisons with `liganimate run --look thesis` need its flat shading.
     browser.driver.get("about:blank")  # a new document even when only the #fragment would differ
-    browser.driver.get(page.as_uri() + f"#size={size}")
+    browser.driver.get(page.as_uri() + f"#size={size}&look={look}")
     deadline = time.time() + 30
     while time.time() < deadline:
         if browser.driver.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"):
@@ -125,8 +126,25 @@ def test_the_canvas_shows_what_liganimate_run_draws(pages, browser, name, scene_
         assert same > 0.97, (name, image, same)
 
 
+def test_the_modern_look_lights_and_outlines_what_the_thesis_look_draws_flat(pages, browser):
+    page, _ = pages["five"]
+    _open(browser, page, look="thesis")
+    flat = _frame(browser, 0, 17)
+    _open(browser, page, look="modern")
+    modern = _frame(browser, 0, 17)
+    assert flat[5, 5] == 255 and abs(int(modern[5, 5]) - 244) <= 1  # the modern look's grey background
+    drawn_flat, drawn_modern = flat < 255, modern < 240
+    iou = (drawn_flat & drawn_modern).sum() / (drawn_flat | drawn_modern).sum()
+    assert iou > 0.8  # the same figures where they were (the outlines widen them a little)
+    # Outlines: pixels far darker than any shade the thesis look draws, along the figures' edges.
+    assert (modern < flat[drawn_flat].min() - 20).sum() > 300
+    # Lit faces and smoothed edges: many more levels than the flat look's few.
+    assert len(np.unique(modern)) > 3 * len(np.unique(flat))
+
+
 def test_moving_the_scrubber_changes_the_picture(pages, browser):
     from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
 
     _open(browser, pages["five"][0])
     before = browser.canvas()
@@ -142,9 +160,13 @@ def test_moving_the_scrubber_changes_the_picture(pages, browser):
     # Playing moves on by itself.
     browser.driver.execute_script("ligViewer.setFrame(0)")
     browser.driver.find_element("id", "play").click()
-    time.sleep(0.6)
+    # Waits for the event (a frame shown after 0), however slow the machine; the bound only stops a hang.
+    WebDriverWait(browser.driver, 60, poll_frequency=0.05).until(
+        lambda d: d.execute_script("return ligViewer.frame()") > 0
+    )
     browser.driver.find_element("id", "play").click()
-    assert browser.driver.execute_script("return ligViewer.frame()") > 0
+    stopped = browser.driver.execute_script("return ligViewer.frame()")
+    assert stopped > 0
 
 
 def test_orbit_and_back_to_the_scene_camera(pages, browser):
@@ -194,12 +216,17 @@ def test_hovering_a_segment_names_its_joint_angles_and_extremes(pages, browser):
 
 
 def test_the_page_makes_no_request_beyond_its_own_file(pages, tmp_path):
+    from selenium.webdriver.support.ui import WebDriverWait
+
     require_chromium()
     page = pages["five"][0]
     with Browser(log_network=True) as b:
         _open(b, page)
         b.driver.execute_script("ligViewer.setFrame(30); ligViewer.play(true);")
-        time.sleep(0.3)
+        # Several frames drawn while playing (whatever the machine's speed), then the network log.
+        WebDriverWait(b.driver, 60, poll_frequency=0.05).until(
+            lambda d: d.execute_script("return ligViewer.frame()") >= 33
+        )
         requests = b.requests()
     mine = {url.split("#")[0] for url, doc in requests if doc.split("#")[0] == page.as_uri()}
     assert mine == {page.as_uri()}, "the page's only request is for its own file"
