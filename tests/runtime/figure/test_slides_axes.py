@@ -307,3 +307,18 @@ def test_a_keyframe_beyond_a_slides_extremes_is_refused_at_the_animate():
     # Within range it runs, and in-betweens that overshoot (none do here) would be clamped.
     v, _ = _run(program.replace("POSITION 4, 0, 0", "POSITION 3, 0, 0"))
     assert "M" in v
+
+
+def test_a_slide_is_one_more_gene_of_the_studio():
+    """The studio's alternatives for a slide are displacements along its rail, coarsest first."""
+    from liganimate.runtime.studio import _genes as G
+
+    axes = G.joint_axes(_crane())
+    assert axes[0].slide and not axes[1].slide
+    first = G.alternatives(axes[0], np.array([0.5, 0.0, 0.0]), "flexion", True, 30.0)
+    assert first.axes == (0,)
+    assert list(first.values[:3, 0]) == [0.0, 3.0, 1.5] and list(first.level[:3]) == [0, 0, 1]
+    assert np.all((first.values >= 0.0) & (first.values <= 3.0))
+    later = G.alternatives(axes[0], np.array([0.5, 0.0, 0.0]), "flexion", False, 30.0)
+    assert len(later.values) and np.all(np.abs(later.values - 0.5) <= 0.5 + 1e-9)
+    assert G.alternatives(axes[0], np.array([0.5, 0.0, 0.0]), "twist", True, 30.0).values.size == 0
