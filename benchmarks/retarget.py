@@ -132,9 +132,9 @@ def length_rows(lengths: list, folder: str) -> list:
         row["render_first_frame"] = _child("module", "liganimate", args, folder)
         bvhio_code = f"import bvhio; bvhio.readAsBvh({bvh!r})"
         row["bvhio_read"] = _child("code", bvhio_code, [], folder)
-        row["within_limits"] = all(
-            row[k]["wall_s"] < 10 and row[k]["peak_mb"] < 400 for k in ("import", "check", "render_first_frame")
-        )
+        # Judged on CPU time: the wall clock of a shared machine measures the neighbours too.
+        steps = ("import", "check", "render_first_frame")
+        row["within_limits"] = all(row[k]["cpu_s"] < 10 and row[k]["peak_mb"] < 400 for k in steps)
         print(
             f"{n:>6} frames: import {row['import']['wall_s']:6.2f} s (cpu {row['import']['cpu_s']:.2f}) "
             f"{row['import']['peak_mb']:6.0f} MB | check {row['check']['wall_s']:6.2f} s "
