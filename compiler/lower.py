@@ -16,11 +16,11 @@ import re
 
 from liganimate import __version__
 from liganimate.lang import ast as A
-from liganimate.lang import bindings
+from liganimate.lang import bindings, keyframe_table
 from liganimate.lang import numbers as N
 from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
-from liganimate.lang.vocabulary import MODIFIERS
+from liganimate.lang.vocabulary import FUNCTIONS, MODIFIERS, Operator, operators_for
 from liganimate.runtime.ik.solvers import DEFAULT_SOLVER, SOLVER_KEYWORDS
 
 from . import types as T
@@ -81,6 +81,7 @@ class Lowerer(NodeVisitor):
         self.consume = False  # see lower()
         self.canvas = None
         self.tmp = 0
+        self.table_spans: list = []  # (start, end) offsets of keyframe-table rows, left out of the embedded source
         # > 0 inside code that runs many times (DO bodies, scene bodies,
         # primitives): there + - * results are range-checked inline, which
         # runs fastest; elsewhere by a call, which CPython compiles several
@@ -228,7 +229,16 @@ class Lowerer(NodeVisitor):
         self.emit("")
 
     def source_literal(self) -> str:
-        return repr(self.c.program.source)
+        source = self.c.program.source
+        if self.table_spans:
+            # A keyframe table's rows are data the module already carries; the source kept for
+            # diagnostics keeps their lines (so every line number holds) but not their numbers.
+            pieces, last = [], 0
+            for start, end in sorted(self.table_spans):
+                pieces += [source[last:start], "|" + "\n|" * source.count("\n", start, end)]
+                last = end
+            source = "".join(pieces) + source[last:]
+        return repr(source)
 
     # --------------------------------------------------------- primitives
     def primitive(self, pdef: A.PrimitiveDef, sig, scope) -> None:
@@ -360,7 +370,14 @@ class Lowerer(NodeVisitor):
                 kfs.append(f"({self.expr(k.frame)}, {self.position(k.position)}, {method}, {self.at(k)})")
             inner = "".join(x + ", " for x in kfs)
             self.emit(f"    ({self.joint_or_root(j.joint)}, {start}, ({inner}), {self.at(j)}),")
-        self.emit(f"), {self.at(s)})")
+        tables = ""
+        for t in s.tables:
+            # The rows travel as one string of numbers (lang/keyframe_table.py), read in bulk at run time.
+            columns = "".join(self.joint_or_root(c) + ", " for c in t.columns)
+            packed = keyframe_table.pack(t.rows)
+            tables += f"_host.TableArgs(({columns}), {packed!r}, {self.at(t)}), "
+            self.table_spans.append((t.rows_pos.start, t.rows_pos.start + len(t.rows)))
+        self.emit(f"), {self.at(s)}" + (f", ({tables}))" if tables else ")"))
 
     def s_ReachBlock(self, s, where):
         def opt(e):
@@ -457,7 +474,8 @@ class Lowerer(NodeVisitor):
             else:
                 t = self.type_of(item.value)
                 label = spelling(self.c.program.source, item.value.pos)
-                parts.append(f"({t!r}, {self.expr(item.value)}, {label!r})")
+                kind = None if t is None else str(t)  # the type's name, as program text
+                parts.append(f"({kind!r}, {self.expr(item.value)}, {label!r})")
         self.emit(f"rt.print_items(({''.join(p + ', ' for p in parts)}), {self.at(s)})")
 
     def s_View(self, s, where):
@@ -519,7 +537,7 @@ class Lowerer(NodeVisitor):
 
     def _binop(self, e, root: bool) -> str:
         t = self.type_of(e)
-        if e.op in _ARITH and t in _CHECKED:
+        if e.op in _ARITH and t in _CHECKED and self._operator(e).runtime is None:
             # A chain of + - * of one type is checked once, at its root: a
             # REAL that overflows stays infinite or NaN through + - *, and
             # INTEGER arithmetic inside an expression is exact (Python ints).
@@ -535,36 +553,36 @@ class Lowerer(NodeVisitor):
                 return f"_ck({text}, {kind!r}, {self.at(e)})"
             lo, hi = _BOUND[t]
             return f"(_n if {lo} <= (_n := {text}) <= {hi} else rt.overflow(_n, {kind!r}, {self.at(e)}))"
-        if e.op == "+" and self.type_of(e.left) == T.MOTION:
-            return self._motion_sum(e)
+        row = self._operator(e)
+        if row.group_right:
+            return self._right_grouped(e, row)
         left, right = self.expr(e.left), self.expr(e.right)
-        if e.op == "+" and t == T.GRAPHICAL:
-            # Superposition checks the triangle limit; an animated model is drawn in its pose.
-            return f"rt.superpose({left}, {right}, {self.at(e)})"
-        if e.op == "/":
-            return f"rt.div({left}, {right}, {self.at(e.op_pos)})"
-        if e.op == "MOD":
-            return f"rt.mod({left}, {right}, {self.at(e.op_pos)})"
-        if e.op == "*" and self.type_of(e.right) == T.MOTION:
-            return f"rt.repeat({left}, {right}, {self.at(e)})"
-        return f"({left} {e.op} {right})"
+        if row.runtime is None:
+            return f"({left} {e.op} {right})"
+        # The runtime call checks what Python's operator would not (the triangle limit
+        # of a superposition, a division by zero at the operator's position...).
+        return f"rt.{row.runtime}({left}, {right}, {self.at(e.op_pos if row.at_operator else e)})"
 
-    def _motion_sum(self, e) -> str:
+    def _operator(self, e) -> Operator:
+        """The row of the operator table the checker typed ``e`` by (the first that takes its operand types)."""
+        return operators_for(e.op, self.type_of(e.left), self.type_of(e.right))[0]
+
+    def _right_grouped(self, e, row: Operator) -> str:
         """``A + B + C`` grouped to the right, as the thesis' BNF
         (``<motion term> + <motion express>``) does; the parser groups it to the left.
 
-        + is associative, so this changes no pose; it keeps the listing of
+        The operator is associative, so this changes no pose; it keeps the listing of
         PRINT and describe() in the thesis' shape.  Operands are still
         evaluated left to right.
         """
         ops = []
-        while isinstance(e, A.BinOp) and e.op == "+" and self.type_of(e.left) == T.MOTION:
+        while isinstance(e, A.BinOp) and e.op == row.symbol and self._operator(e) is row:
             ops.append(e)
             e = e.left
         operands = [self.expr(e)] + [self.expr(op.right) for op in reversed(ops)]
         text = operands[-1]
         for operand, op in zip(reversed(operands[:-1]), ops):
-            text = f"rt.concat({operand}, {text}, {self.at(op)})"
+            text = f"rt.{row.runtime}({operand}, {text}, {self.at(op)})"
         return text
 
     def _chained(self, e, t) -> str:
@@ -577,7 +595,7 @@ class Lowerer(NodeVisitor):
 
     def e_Call(self, e):
         args = "".join(self.expr(a) + ", " for a in e.args)
-        return f"rt.f_{e.name}({args}at={self.at(e)})"
+        return f"rt.{FUNCTIONS[e.name].runtime}({args}at={self.at(e)})"
 
     def e_Modified(self, e):
         t = self.type_of(e.target)
@@ -585,7 +603,7 @@ class Lowerer(NodeVisitor):
         for m in e.modifiers:
             spec = MODIFIERS[m.kind]
             axis = f", {m.axis!r}" if spec.axis else ""
-            code = f"rt.{spec.runtime_name(t)}({code}, {self.expr(m.arg)}{axis}, {at})"
+            code = f"rt.{spec.methods[t]}({code}, {self.expr(m.arg)}{axis}, {at})"
         return code
 
     def e_PrimCall(self, e):
@@ -651,7 +669,8 @@ def _in_chain(e, t, lowerer) -> bool:
         return False
     if isinstance(e, A.Neg):
         return _in_chain(e.operand, t, lowerer)
-    return isinstance(e, A.BinOp) and e.op in _ARITH
+    # Only rows the table computes with Python's own operator chain; a runtime method checks itself.
+    return isinstance(e, A.BinOp) and e.op in _ARITH and lowerer._operator(e).runtime is None
 
 
 def _tuple_target(names) -> str:

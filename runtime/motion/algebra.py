@@ -20,7 +20,7 @@ from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
 from liganimate.runtime.motion import path as rp
 from liganimate.runtime.motion import track as tr
-from liganimate.runtime.motion.keyframe import Keyframe
+from liganimate.runtime.motion.keyframe import RAMP, Keyframe
 
 __all__ = [
     "DEFAULT_KEYFRAME_LIMIT",
@@ -122,6 +122,31 @@ def _leaf(joint: int | None, spec) -> tr.Leaf:
     return tr.Leaf(start, frames, positions, methods, ramps)
 
 
+def _array_leaf(joint: int | None, start, frames, values) -> tr.Leaf:
+    """A LINEAR leaf from arrays (a keyframe table's column), checked at once rather than key by key."""
+    who = "the root track" if joint is None else f"joint {joint}"
+    start = _vector(start, f"{who}: start position")
+    frames = np.asarray(frames, dtype=np.float64).reshape(-1)
+    positions = np.asarray(values, dtype=np.float64).reshape(len(frames), 3)
+    if not (np.isfinite(frames).all() and np.isfinite(positions).all()):
+        raise MotionError(f"{who}: a keyframe table holds a number that is not finite")
+    if len(frames) and (frames.min() < 0 or (np.diff(frames) < 0).any()):
+        raise MotionError(f"{who}: a keyframe table's frames must be 0 or more, in order")
+    tr.check_frames(frames, f"{who}: a keyframe list that")
+    everything = np.vstack([start[None, :], positions])
+    if joint is None:
+        far = float(np.max(np.abs(everything)))
+        if not far <= GEOMETRY_MAX:
+            raise MotionError(
+                f"the root track: a position {magnitude(far)} from the origin is beyond the geometry limit, "
+                f"{magnitude(GEOMETRY_MAX)}"
+            )
+    else:
+        tr.check_angles(everything, f"{who}: a position that")
+    linear = interpolation.get("LINEAR")
+    return tr.Leaf(start, frames, positions, (linear,) * len(frames), np.full(len(frames), RAMP))
+
+
 class Motion:
     """An immutable motion: a track per joint, built lazily by the motion algebra.
 
@@ -204,7 +229,9 @@ class Motion:
     # -- construction -----------------------------------------------------
 
     @classmethod
-    def from_tracks(cls, tracks: Mapping[int, tuple], name: str | None = None, root: tuple | None = None) -> Motion:
+    def from_tracks(
+        cls, tracks: Mapping[int, tuple], name: str | None = None, root: tuple | None = None, arrays=None
+    ) -> Motion:
         """Build a motion from explicit keyframes.
 
         Parameters
@@ -218,6 +245,11 @@ class Motion:
             The root track, built as a joint's: ``start`` (None for the
             origin) and keyframes whose positions are displacements of the
             model's main link in the model's own frame.
+        arrays : mapping of (int or None) to (start, frames, values), optional
+            Tracks given as arrays (a keyframe table's columns): ``start``
+            shape (3,), ``frames`` shape (K,), ``values`` shape (K, 3), every
+            keyframe LINEAR with the default ramp; None is the root track.
+            Checked all at once, so a table of 20,000 rows stays fast.
 
         Returns
         -------
@@ -234,6 +266,12 @@ class Motion:
             j = _joint_id(joint)
             leaves[j] = _leaf(j, spec)
         path = None if root is None else _leaf(None, root)
+        for joint, (start, frames, values) in (arrays or {}).items():
+            if joint is None:
+                path = _array_leaf(None, start, frames, values)
+            else:
+                j = _joint_id(joint)
+                leaves[j] = _array_leaf(j, start, frames, values)
         nkeys = sum(len(leaf.frames) for leaf in leaves.values()) + (len(path.frames) if path is not None else 0)
         return cls(leaves, ("keys", name, len(leaves), nkeys), root=path)
 
@@ -682,53 +720,69 @@ class Motion:
         -------
         str
         """
-        parts: list[str] = []
-        budget = [max_chars]
-
-        def put(s: str) -> bool:
-            parts.append(s)
-            budget[0] -= len(s)
-            return budget[0] > 0
-
-        def render(e: tuple, prec: int) -> bool:
-            # prec: 0 inside + or a list, 1 as a * operand, 2 before a <transform>.
-            kind = e[0]
-            if kind == "keys":
-                _, name, nj, nk = e
-                return put(name or f"keyframes[{nj} joints, {nk} keyframes]")
-            if kind == "empty":
-                return put("EMPTY")
-            if kind in ("+", "*"):
-                paren = prec > (0 if kind == "+" else 1)
-                if paren and not put("("):
-                    return False
-                if kind == "+":
-                    ok = render(e[1], 0) and put(" + ") and render(e[2], 0)
-                else:
-                    ok = put(f"{e[1]} * ") and render(e[2], 2)
-                return ok and (not paren or put(")"))
-            if kind in ("frames", "extremes"):
-                label = "FRAMES" if kind == "frames" else "EXTREMES"
-                return render(e[2], 2) and put(f" <SCALE {label} {e[1]:g}>")
-            if kind == "strip":
-                return put("STRIP(") and render(e[2], 0) and put("".join(f", {j}" for j in e[1]) + ")")
-            if kind == "sync":
-                if not put("SYNCHRONIZE("):
-                    return False
-                for i, sub in enumerate(e[1]):
-                    if (i and not put(", ")) or not render(sub, 0):
-                        return False
-                return put(")")
-            if kind == "unwrap":
-                return put("UNWRAP(") and render(e[1], 0) and put(")")
-            return put(f"<{kind}>")
-
-        if not render(self._expr, 0):
-            return "".join(parts)[:max_chars] + "..."
-        return "".join(parts)
+        text = _Describer(max_chars)
+        if not text.render(self._expr, 0):
+            return "".join(text.parts)[:max_chars] + "..."
+        return "".join(text.parts)
 
     def __repr__(self) -> str:
         return f"<Motion length={self._length:g} joints={list(self.joints)}: {self.describe(200)}>"
+
+
+class _Describer:
+    """Writes a motion's expression (``Motion._expr``) as text, stopping once ``budget`` characters are spent.
+
+    Each method returns False when the budget ran out, which stops the walk.
+    """
+
+    def __init__(self, budget: int):
+        self.parts: list[str] = []
+        self.budget = budget
+
+    def put(self, s: str) -> bool:
+        self.parts.append(s)
+        self.budget -= len(s)
+        return self.budget > 0
+
+    def render(self, e: tuple, prec: int) -> bool:
+        """``prec``: 0 inside + or a list, 1 as a * operand, 2 before a <transform>."""
+        kind = e[0]
+        if kind == "keys":
+            _, name, nj, nk = e
+            return self.put(name or f"keyframes[{nj} joints, {nk} keyframes]")
+        if kind == "empty":
+            return self.put("EMPTY")
+        if kind in ("+", "*"):
+            return self._operation(e, prec)
+        if kind in ("frames", "extremes"):
+            label = "FRAMES" if kind == "frames" else "EXTREMES"
+            return self.render(e[2], 2) and self.put(f" <SCALE {label} {e[1]:g}>")
+        if kind == "strip":
+            return self.put("STRIP(") and self.render(e[2], 0) and self.put("".join(f", {j}" for j in e[1]) + ")")
+        if kind == "sync":
+            return self._sync(e[1])
+        if kind == "unwrap":
+            return self.put("UNWRAP(") and self.render(e[1], 0) and self.put(")")
+        return self.put(f"<{kind}>")
+
+    def _operation(self, e: tuple, prec: int) -> bool:
+        kind = e[0]
+        paren = prec > (0 if kind == "+" else 1)
+        if paren and not self.put("("):
+            return False
+        if kind == "+":
+            ok = self.render(e[1], 0) and self.put(" + ") and self.render(e[2], 0)
+        else:
+            ok = self.put(f"{e[1]} * ") and self.render(e[2], 2)
+        return ok and (not paren or self.put(")"))
+
+    def _sync(self, operands: tuple) -> bool:
+        if not self.put("SYNCHRONIZE("):
+            return False
+        for i, sub in enumerate(operands):
+            if (i and not self.put(", ")) or not self.render(sub, 0):
+                return False
+        return self.put(")")
 
 
 def _finite(values: np.ndarray) -> None:

@@ -207,7 +207,10 @@ class Framebuffer:
     samples : ndarray, shape (aa H, aa W) or (aa H, aa W, 3), uint8
         The supersampled image so far (updated in place by :meth:`draw`).
     zbuf : ndarray, shape (aa H, aa W), int64
-        Depth keys (see :func:`rasterize_into`); ``EMPTY`` where nothing is drawn.
+        Depth keys; ``EMPTY`` (zero) where nothing is drawn.  A key is the
+        float64 ``1/z`` with its low 32 bits replaced by the triangle's
+        number: the larger key is the nearer surface, or at equal depth the
+        later triangle.
     count : int
         Triangles drawn so far; the next draw's triangles are numbered from here.
     aa : int
@@ -273,49 +276,6 @@ class Framebuffer:
         out = np.full(self.zbuf.shape, np.inf)
         out[drawn] = 1.0 / (self.zbuf[drawn] & _DEPTH_MASK).view(np.float64)
         return out
-
-
-def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first_index: int = 0) -> int:
-    """Draw triangles into an existing image and depth buffer.
-
-    Parameters
-    ----------
-    zbuf : ndarray, shape (H, W), int64, C-contiguous
-        Depth keys, updated in place.  Start from all ``EMPTY`` (zero).  A key is
-        the float64 ``1/z`` with its low 32 bits replaced by
-        ``first_index + i``: the larger key is the nearer surface, or at
-        equal depth the later triangle.  All draws into one buffer must
-        use the same camera.
-    img : ndarray, shape (H, W) or (H, W, 3), uint8, C-contiguous
-        The image, updated in place where a triangle wins the depth test.
-    triangles : array_like, shape (N, 3, 3)
-        World-space vertices.
-    shade : array_like, shape (N,) or (N, 3)
-        Grey levels, or colours when ``img`` is RGB, 0..255.
-    camera : Camera
-        The view; ``camera.size`` must be ``(W, H)``.
-    cull : array_like of bool, shape (N,), optional
-        See :func:`rasterize`.
-    first_index : int, optional
-        Number of triangle 0 for the tie rule; pass the previous call's
-        return value so later draws win ties.
-
-    Returns
-    -------
-    int
-        ``first_index + N``: the number to give the next draw.
-    """
-    W, H = camera.size
-    if img.shape[:2] != (H, W) or zbuf.shape != (H, W):
-        raise RenderError(
-            f"The camera's image size {W}x{H} does not match the {img.shape[1]}x{img.shape[0]} image being drawn into."
-        )
-    if not (img.flags.c_contiguous and zbuf.flags.c_contiguous and zbuf.dtype == np.int64 and img.dtype == np.uint8):
-        raise RenderError("The image and depth buffer must be C-contiguous uint8 and int64 arrays.")
-    tris, shade, cull = _check(triangles, shade, cull)
-    if (shade.ndim == 2) != (img.ndim == 3) or img.ndim not in (2, 3) or img.shape[2:] not in ((), (3,)):
-        raise RenderError("Colours need an RGB image, and grey levels a grey one.")
-    return _draw(zbuf, img, tris, shade, camera, cull, first_index)
 
 
 def _draw(zbuf, img, tris, shade, camera, cull, first_index):
@@ -528,6 +488,67 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     triangles, the cost of a frame is mostly the number of numpy calls.
     """
     W, H = camera.size
+    drawn = _camera_triangles(tris, cull, camera)
+    if drawn is None:
+        return None
+    cam, front, src = drawn
+    found = _trapezoids(_pixel_vertices(cam, camera), front, src, first_index, (W, H))
+    if found is None:
+        return None
+    table, first_row, nrows, total = found
+    table, nrows, bounds = _banded(table, first_row, nrows, total, band_rows, H)
+
+    # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
+    # spreads per-trapezoid values over them: it costs a few instructions
+    # per element where a gather (np.take, fancy indexing) costs 15-30.
+    t = table.repeat(nrows, axis=1)
+    cy = np.add(_aranges(total)[1][:total], t[12])
+    # Crossings of the long and the short edge (rows 0 and 1 of xab), then
+    # the first and one past the last pixel column (rows 0 and 1 of cols).
+    xab = np.subtract(cy, t[2:4])
+    xab *= t[4:6]
+    xab /= t[13:15]
+    xab += t[0:2]
+    cols = np.empty((2, total))
+    np.minimum(xab[0], xab[1], out=cols[0])
+    np.maximum(xab[0], xab[1], out=cols[1])
+    cols -= 0.5
+    np.ceil(cols, out=cols)
+    np.maximum(cols, 0, out=cols)
+    np.minimum(cols, W, out=cols)
+    length = cols[1] - cols[0]
+    count = length.astype(np.int64)
+    if np.maximum.reduce(count) <= 0:
+        return None
+
+    # 1/z at the first and last pixel centre, clamped to the triangle's range
+    # so that a sliver's ill-conditioned plane cannot produce a wild depth.
+    # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
+    wrow = cy * t[8]
+    wrow += t[7]
+    ws = cols + _CENTRES
+    ws *= t[6]
+    ws += wrow
+    np.fmax(ws, t[9], out=ws)
+    np.fmin(ws, t[10], out=ws)
+    step = ws[1] - ws[0]
+    length -= 1
+    step /= np.maximum(length, 1, out=length)  # (as floats: exact, and no int-to-float pass)
+    # Spans of no pixels stay: np.repeat skips them at no cost.
+    cy -= 0.5
+    cy *= W
+    cy += cols[0]
+    return cy.astype(np.int64), ws[0], step, t[11].astype(np.int64), count, bounds
+
+
+def _camera_triangles(tris, cull, camera: Camera):
+    """:func:`_spans`' first stage: the triangles drawn, in camera space and clipped at the near plane.
+
+    Returns ``(cam, front, src)``: ``cam[k, i, j]`` coordinate k of vertex
+    i of triangle j, whether each given triangle faces the camera, and the
+    given triangle each drawn one comes from (None: itself); or None when
+    nothing is left.
+    """
     # Component-major from here on, v[i, k] being coordinate k of vertex i
     # of every triangle: numpy's loops over a last axis of length 3 cost
     # more per element than the arithmetic.
@@ -559,10 +580,15 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     if cam.shape[2] and np.minimum.reduce(cam[2], axis=None) < camera.near:
         clipped, src = _clip_near(cam.transpose(2, 1, 0), src, camera.near)
         cam = np.ascontiguousarray(clipped.transpose(2, 1, 0))
-    m = cam.shape[2]
-    if m == 0:
+    if cam.shape[2] == 0:
         return None
+    return cam, front, src
 
+
+def _pixel_vertices(cam: np.ndarray, camera: Camera) -> np.ndarray:
+    """:func:`_spans`' second stage: x, y and 1/z of each vertex (3, 3, m), sorted by y within a triangle."""
+    W, H = camera.size
+    m = cam.shape[2]
     # Projection to pixels (as Camera.camera_to_pixels), then the vertices
     # of each triangle sorted by y: that fixes the orientation of every edge
     # (top end first), which is what makes shared edges bit-identical.
@@ -580,6 +606,18 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
             was = xyw[:, i].copy()
             np.copyto(xyw[:, i], xyw[:, j], where=swap)
             np.copyto(xyw[:, j], was, where=swap)
+    return xyw
+
+
+def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple):
+    """:func:`_spans`' third stage: the table of trapezoids (see the notes after :func:`_spans`).
+
+    Returns ``(table, first_row, nrows, total)``: the table (15, 2m), each
+    trapezoid's first row and number of rows, and their sum; or None when
+    no row is covered.
+    """
+    W, H = size
+    m = xyw.shape[2]
     x, y, w = xyw
     x0, y0, w0 = x[0], y[0], w[0]
 
@@ -645,9 +683,15 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     table[13, 1] = upper[13]
     table[6:11, 1] = upper[6:11]
     table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
-    table = table.reshape(15, 2 * m)
     first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
+    return table.reshape(15, 2 * m), first_row, nrows, total
 
+
+def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: int, band_rows, H: int):
+    """:func:`_spans`' fourth stage: trapezoids cut at band boundaries and ordered by band; row 12 set.
+
+    Returns ``(table, nrows, bounds)``.
+    """
     bounds = [0, total]
     if band_rows is not None and band_rows < H:
         # Cut trapezoids at band boundaries, and order the pieces by band.
@@ -672,47 +716,7 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     first_row += nrows
     np.add(first_row, 0.5, out=table[12])
 
-    # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
-    # spreads per-trapezoid values over them: it costs a few instructions
-    # per element where a gather (np.take, fancy indexing) costs 15-30.
-    t = table.repeat(nrows, axis=1)
-    cy = np.add(_aranges(total)[1][:total], t[12])
-    # Crossings of the long and the short edge (rows 0 and 1 of xab), then
-    # the first and one past the last pixel column (rows 0 and 1 of cols).
-    xab = np.subtract(cy, t[2:4])
-    xab *= t[4:6]
-    xab /= t[13:15]
-    xab += t[0:2]
-    cols = np.empty((2, total))
-    np.minimum(xab[0], xab[1], out=cols[0])
-    np.maximum(xab[0], xab[1], out=cols[1])
-    cols -= 0.5
-    np.ceil(cols, out=cols)
-    np.maximum(cols, 0, out=cols)
-    np.minimum(cols, W, out=cols)
-    length = cols[1] - cols[0]
-    count = length.astype(np.int64)
-    if np.maximum.reduce(count) <= 0:
-        return None
-
-    # 1/z at the first and last pixel centre, clamped to the triangle's range
-    # so that a sliver's ill-conditioned plane cannot produce a wild depth.
-    # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
-    wrow = cy * t[8]
-    wrow += t[7]
-    ws = cols + _CENTRES
-    ws *= t[6]
-    ws += wrow
-    np.fmax(ws, t[9], out=ws)
-    np.fmin(ws, t[10], out=ws)
-    step = ws[1] - ws[0]
-    length -= 1
-    step /= np.maximum(length, 1, out=length)  # (as floats: exact, and no int-to-float pass)
-    # Spans of no pixels stay: np.repeat skips them at no cost.
-    cy -= 0.5
-    cy *= W
-    cy += cols[0]
-    return cy.astype(np.int64), ws[0], step, t[11].astype(np.int64), count, bounds
+    return table, nrows, bounds
 
 
 # Rows of _spans' table: 0-1 x of the top of the long and the short edge,
