@@ -59,7 +59,7 @@
     }
     return {
       id: s.id, length: s.length, k: k, images: Math.max(1, Math.ceil(s.length / k)), cams: cams,
-      bounds: s.bounds, models: models, backgrounds: backgrounds, capacity: most * k
+      bounds: s.bounds, framing: s.framing, models: models, backgrounds: backgrounds, capacity: most * k
     };
   });
 
@@ -68,6 +68,10 @@
   var frame = { pos: new Float32Array(0), col: new Uint8Array(0), ranges: [], spans: [] };
 
   function sceneCamera(s, tick) {
+    // A scene without VIEW, in the modern look: framed as `liganimate run` frames it.
+    if (s.framing && renderer.look === 'modern') {
+      return { eye: s.framing.eye.slice(), target: s.framing.target.slice(), k: s.framing.k };
+    }
     var c = s.cams, i = Math.min(tick, c.length / 4 - 1) * 4;
     // A scene of no ticks has no camera: LIG's default VIEW.
     if (i < 0) return { eye: [0, 0, 10], target: [0, 0, 0], k: 1 };
@@ -150,8 +154,9 @@
       lines.push('the main link: no joint moves it (tick ' + mark.tick + ')');
     } else {
       var a = m.angles, b = (mark.row * m.J + j) * 3, e = m.joints[j].ext;
-      lines.push('joint ' + m.joints[j].id + ' at tick ' + mark.tick + ': X ' + fmt(a[b]) + '\u00b0  Y ' +
-        fmt(a[b + 1]) + '\u00b0  Z ' + fmt(a[b + 2]) + '\u00b0');
+      var unit = m.joints[j].slide ? '' : '\u00b0';  // a slide's values are a displacement
+      lines.push('joint ' + m.joints[j].id + (m.joints[j].slide ? ' (slide)' : '') + ' at tick ' + mark.tick +
+        ': X ' + fmt(a[b]) + unit + '  Y ' + fmt(a[b + 1]) + unit + '  Z ' + fmt(a[b + 2]) + unit);
       lines.push('extremes: X (' + e[0][0] + ', ' + e[0][1] + ')  Y (' + e[1][0] + ', ' + e[1][1] +
         ')  Z (' + e[2][0] + ', ' + e[2][1] + ')');
     }
