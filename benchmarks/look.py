@@ -16,7 +16,7 @@ look's CPU a frame on this scene.  The last line printed is one JSON object
 with the figures.
 
 Usage: ``python benchmarks/look.py [--quick] [--ticks N] [--rounds R]``
-(``--quick``: 240 ticks, 2 rounds, well under a minute).
+(``--quick``: 160 ticks, 2 rounds, under a minute).
 """
 
 from __future__ import annotations
@@ -130,11 +130,11 @@ def run(ticks: int, rounds: int) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="240 ticks, 2 rounds")
+    ap.add_argument("--quick", action="store_true", help="160 ticks, 2 rounds")
     ap.add_argument("--ticks", type=int, default=None)
     ap.add_argument("--rounds", type=int, default=None)
     args = ap.parse_args(argv)
-    ticks = args.ticks or (240 if args.quick else 1000)
+    ticks = args.ticks or (160 if args.quick else 1000)
     rounds = args.rounds or (2 if args.quick else 3)
     r = run(ticks, rounds)
     print(f"five humans, {ticks} ticks at {SIZE[0]}x{SIZE[1]}, one process, best of {rounds} rounds")

@@ -279,7 +279,8 @@ def _from_json(obj: dict) -> Library:
     sources = obj["sources"]
     sigs = {}
     for s in obj["signatures"]:
-        sigs[s["name"]] = Signature(s["name"], [Slot(k, p, g) for k, p, g in s["slots"]], {}, dict(s["param_types"]))
+        param_types = {k: T.Type(t) for k, t in s["param_types"].items()}
+        sigs[s["name"]] = Signature(s["name"], [Slot(k, p, g) for k, p, g in s["slots"]], {}, param_types)
     warnings = [
         Diagnostic(
             w["filename"],
@@ -297,7 +298,7 @@ def _from_json(obj: dict) -> Library:
         path=obj["path"],
         display=obj["display"],
         python=obj["python"],
-        types=dict(obj["types"]),
+        types={n: T.Type(t) for n, t in obj["types"].items()},
         signatures=sigs,
         descriptions=dict(obj["descriptions"]),
         warnings=warnings,

@@ -20,7 +20,7 @@ from liganimate.lang import bindings
 from liganimate.lang import numbers as N
 from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
-from liganimate.lang.vocabulary import MODIFIERS
+from liganimate.lang.vocabulary import FUNCTIONS, MODIFIERS, Operator, operators_for
 from liganimate.runtime.ik.solvers import DEFAULT_SOLVER, SOLVER_KEYWORDS
 
 from . import types as T
@@ -457,7 +457,8 @@ class Lowerer(NodeVisitor):
             else:
                 t = self.type_of(item.value)
                 label = spelling(self.c.program.source, item.value.pos)
-                parts.append(f"({t!r}, {self.expr(item.value)}, {label!r})")
+                kind = None if t is None else str(t)  # the type's name, as program text
+                parts.append(f"({kind!r}, {self.expr(item.value)}, {label!r})")
         self.emit(f"rt.print_items(({''.join(p + ', ' for p in parts)}), {self.at(s)})")
 
     def s_View(self, s, where):
@@ -535,36 +536,36 @@ class Lowerer(NodeVisitor):
                 return f"_ck({text}, {kind!r}, {self.at(e)})"
             lo, hi = _BOUND[t]
             return f"(_n if {lo} <= (_n := {text}) <= {hi} else rt.overflow(_n, {kind!r}, {self.at(e)}))"
-        if e.op == "+" and self.type_of(e.left) == T.MOTION:
-            return self._motion_sum(e)
+        row = self._operator(e)
+        if row.group_right:
+            return self._right_grouped(e, row)
         left, right = self.expr(e.left), self.expr(e.right)
-        if e.op == "+" and t == T.GRAPHICAL:
-            # Superposition checks the triangle limit; an animated model is drawn in its pose.
-            return f"rt.superpose({left}, {right}, {self.at(e)})"
-        if e.op == "/":
-            return f"rt.div({left}, {right}, {self.at(e.op_pos)})"
-        if e.op == "MOD":
-            return f"rt.mod({left}, {right}, {self.at(e.op_pos)})"
-        if e.op == "*" and self.type_of(e.right) == T.MOTION:
-            return f"rt.repeat({left}, {right}, {self.at(e)})"
-        return f"({left} {e.op} {right})"
+        if row.runtime is None:
+            return f"({left} {e.op} {right})"
+        # The runtime call checks what Python's operator would not (the triangle limit
+        # of a superposition, a division by zero at the operator's position...).
+        return f"rt.{row.runtime}({left}, {right}, {self.at(e.op_pos if row.at_operator else e)})"
 
-    def _motion_sum(self, e) -> str:
+    def _operator(self, e) -> Operator:
+        """The row of the operator table the checker typed ``e`` by (the first that takes its operand types)."""
+        return operators_for(e.op, self.type_of(e.left), self.type_of(e.right))[0]
+
+    def _right_grouped(self, e, row: Operator) -> str:
         """``A + B + C`` grouped to the right, as the thesis' BNF
         (``<motion term> + <motion express>``) does; the parser groups it to the left.
 
-        + is associative, so this changes no pose; it keeps the listing of
+        The operator is associative, so this changes no pose; it keeps the listing of
         PRINT and describe() in the thesis' shape.  Operands are still
         evaluated left to right.
         """
         ops = []
-        while isinstance(e, A.BinOp) and e.op == "+" and self.type_of(e.left) == T.MOTION:
+        while isinstance(e, A.BinOp) and e.op == row.symbol and self._operator(e) is row:
             ops.append(e)
             e = e.left
         operands = [self.expr(e)] + [self.expr(op.right) for op in reversed(ops)]
         text = operands[-1]
         for operand, op in zip(reversed(operands[:-1]), ops):
-            text = f"rt.concat({operand}, {text}, {self.at(op)})"
+            text = f"rt.{row.runtime}({operand}, {text}, {self.at(op)})"
         return text
 
     def _chained(self, e, t) -> str:
@@ -577,7 +578,7 @@ class Lowerer(NodeVisitor):
 
     def e_Call(self, e):
         args = "".join(self.expr(a) + ", " for a in e.args)
-        return f"rt.f_{e.name}({args}at={self.at(e)})"
+        return f"rt.{FUNCTIONS[e.name].runtime}({args}at={self.at(e)})"
 
     def e_Modified(self, e):
         t = self.type_of(e.target)
@@ -585,7 +586,7 @@ class Lowerer(NodeVisitor):
         for m in e.modifiers:
             spec = MODIFIERS[m.kind]
             axis = f", {m.axis!r}" if spec.axis else ""
-            code = f"rt.{spec.runtime_name(t)}({code}, {self.expr(m.arg)}{axis}, {at})"
+            code = f"rt.{spec.methods[t]}({code}, {self.expr(m.arg)}{axis}, {at})"
         return code
 
     def e_PrimCall(self, e):

@@ -1,4 +1,4 @@
-"""The static types of LIG ANIMATE values and the built-in functions."""
+"""The static types of LIG ANIMATE values (:class:`~liganimate.lang.vocabulary.Type`) and the built-in functions."""
 
 from __future__ import annotations
 
@@ -9,13 +9,14 @@ from liganimate.lang.vocabulary import (  # noqa: F401  (the type names are the 
     INTEGER,
     MODEL,
     MOTION,
+    NUMBER,
     PAIR,
     REAL,
     VECTOR,
+    Type,
 )
 
-DECLARABLE = (INTEGER, REAL, VECTOR, GRAPHICAL, MODEL, MOTION)
-NUMERIC = (INTEGER, REAL)
+NUMERIC = NUMBER
 
 #: How a type is named in messages.
 NOUN = {
@@ -30,17 +31,17 @@ NOUN = {
 }
 
 
-def is_numeric(t: str) -> bool:
+def is_numeric(t: Type | None) -> bool:
     """INTEGER or REAL."""
     return t in NUMERIC
 
 
-def numeric_join(a: str, b: str) -> str:
+def numeric_join(a: Type, b: Type) -> Type:
     """The type of arithmetic on two numbers: INTEGER only if both are."""
     return INTEGER if a == INTEGER and b == INTEGER else REAL
 
 
-def fits(declared: str, value: str) -> bool:
+def fits(declared: Type, value: Type) -> bool:
     """Can a value of type ``value`` be stored in a variable of type ``declared``?"""
     if declared == value:
         return True

@@ -262,7 +262,7 @@ class Name(Node):
 
 @dataclass(slots=True)
 class Decl(Node):
-    type: str
+    type: str  # a vocabulary.Type
     names: list  # of Name
 
 

@@ -69,6 +69,10 @@ def _inlined(callback):
 class Driver:
     """A Lark LALR parser's tables and callbacks, renumbered for :meth:`parse`.
 
+    :meth:`parse` cuts the text and runs the LALR loop in one loop: a
+    generator between them cost a fifth of the time. What a word or an
+    operator is in a state is the :class:`~.lexer.Scanner`'s decision.
+
     Parameters
     ----------
     lark : lark.Lark
@@ -102,7 +106,7 @@ class Driver:
         self.start = table.start_states["start"]
         self.end = table.end_states["start"]
         self.scanner = Scanner(lark.terminals, table.states)
-        self._chains: dict = {}  # see _chain
+        self._chains = _Chains(self)  # see _Chains
 
     @staticmethod
     def _rule(rule, callback):
@@ -124,33 +128,18 @@ class Driver:
     def parse(self, text: str, primitives: frozenset, tokens: list | None = None):
         """Parse ``text``; a NAME in ``primitives`` is a PRIM_NAME. Returns the start rule's value.
 
-        The only loop that cuts the text, and the LALR loop, in one: a
-        generator between them cost a fifth of the time. What a word or an
-        operator is in a state is the :class:`~.lexer.Scanner`'s decision.
-        ``tokens``, when given, receives every :class:`~.lexer.Tok` in
-        order, each with the type the parser's state gave it (the
-        formatter, lang/formatter.py, lays a program out by them).
+        ``tokens``, when given, receives every :class:`~.lexer.Tok` in order, each with the type the
+        parser's state gave it (the formatter, lang/formatter.py, lays a program out by them).
         """
-        actions = self.actions
-        rules = self.rules
-        chains = self._chains
-        scanner = self.scanner
-        keywords = scanner.tables.keywords
-        clause_states = scanner.clause_states
-        choice = scanner._choice
-        state = self.start
-        stack = [state]
+        actions, rules, chains, scanner, accept = self.actions, self.rules, self._chains, self.scanner, self.end
+        keywords, clause_states, choice = scanner.tables.keywords, scanner.clause_states, scanner._choice
+        word_type = self._keyword_type
         values: list = []
-        push_state = stack.append
-        push_value = values.append
-        scan = SCAN.match
-        count = text.count
-        pos = 0
-        line, line_start = 1, 0
-        tok = None
-        spellings: dict = {}
+        state, spellings = self.start, _Spellings()
+        stack = [state]
+        push_state, push_value, scan, count = stack.append, values.append, SCAN.match, text.count
+        pos, line, line_start, tok = 0, 1, 0, None
         ttype: str | None  # None only between a missed operator choice and _operator
-        accept = self.end
         end_tok: Token | None = None  # set once the text has ended
         while True:
             # ------------------------------------------------ next token
@@ -158,8 +147,7 @@ class Driver:
             if m is None:
                 scanner.unexpected_character(text, pos, line, state)
             k = m.lastindex
-            if not k:  # never: a match always ends in one of the groups; this narrows k for mypy
-                scanner.unexpected_character(text, pos, line, state)
+            assert k  # a match always ends in one of the groups; this narrows k for mypy
             start = m.start(k)
             if start != pos:
                 nl = count("\n", pos, start)
@@ -169,40 +157,23 @@ class Driver:
             end = m.end()
             value = text[start:end]
             if k == WORD:
-                word = value.upper()
-                if word in keywords:
-                    ttype = scanner.keyword(word, state, text, end)
-                    if ttype == "NAME" and word in primitives:
-                        ttype = "PRIM_NAME"
+                if (word := value.upper()) in keywords:
+                    ttype = word_type(word, state, text, end, primitives)
                 else:
                     ttype = "PRIM_NAME" if word in primitives else "NAME"
-                if ttype == "NAME" and state in clause_states:
-                    ttype = scanner.clause(text, end)
+                    if state in clause_states and ttype == "NAME":
+                        ttype = scanner.clause(text, end)
             elif k == NUMBER:
-                ttype = "NUMBER"
-                # The syntax tree keeps each number's spelling: share the
-                # spellings that repeat (a bounded table, for endless distinct ones).
-                seen = spellings.get(value)
-                if seen is not None:
-                    value = seen
-                elif len(spellings) < 4096:
-                    spellings[value] = value
+                ttype, value = "NUMBER", spellings[value]
             elif k == OPERATOR:
                 ttype = choice.get((state, value))
                 if ttype is None:
                     ttype, value, end = scanner._operator(value, start, state)
-            elif k == STRING:
-                ttype = "STRING"
-            elif k == DOLLAR:
-                ttype = "DOLLAR_NAME"
             else:
-                # The end of the text: $END goes through the same loop, which
-                # reduces what is left and returns at the start rule's end state.
-                ttype = "$END"
-                end_tok = (
-                    Token.new_borrow_pos("$END", "", tok.as_lark()) if tok is not None else Token("$END", "", 0, 1, 1)
-                )
-            if ttype != "$END":
+                ttype = _FIXED.get(k, "$END")  # $END is fed like a token: it reduces what is left
+            if ttype == "$END":
+                end_tok = _end_token(tok)
+            else:
                 column = start - line_start + 1
                 tok = _new_tuple(Tok, (ttype, value, start, line, column, column + end - start, end))
                 pos = end
@@ -220,22 +191,14 @@ class Driver:
                     break
                 size, origin, callback = rules[~code]
                 if callback is None:
-                    # A run of one-child ?rules (expr <- sum <- product ...):
-                    # where it ends depends only on these three, so take it in one step.
-                    key = (stack[-2], state, ttype)
-                    top = chains.get(key)
-                    if top is None:
-                        top = self._chain(key)
-                    stack[-1] = state = top
+                    # A run of one-child ?rules (expr <- sum <- product ...) taken in one step.
+                    stack[-1] = state = chains[stack[-2], state, ttype]
                     if state == accept:
                         return values[-1]
                     continue
-                if size:
-                    children = values[-size:]
-                    del values[-size:]
-                    del stack[-size:]
-                else:
-                    children = []
+                cut = len(values) - size  # not values[-size:]: size may be 0
+                children = values[cut:]
+                del values[cut:], stack[len(stack) - size :]
                 push_value(callback(children))
                 state = actions[stack[-1]][origin]
                 push_state(state)
@@ -243,20 +206,60 @@ class Driver:
                 if state == accept:
                     return values[-1]
 
+    def _keyword_type(self, word: str, state: int, text: str, end: int, primitives: frozenset) -> str:
+        """What a keyword is in this state: the keyword, or a NAME (perhaps a primitive's or a clause's)."""
+        ttype = self.scanner.keyword(word, state, text, end)
+        if ttype == "NAME" and word in primitives:
+            return "PRIM_NAME"
+        if ttype == "NAME" and state in self.scanner.clause_states:
+            return self.scanner.clause(text, end)
+        return ttype
+
     def _chain(self, key: tuple) -> int:
         """The state a run of one-child ?rule reductions ends in, from (state below, state, lookahead)."""
         below, top, ttype = key
         while True:
             code = self.actions[top].get(ttype)
             if code is None or code >= 0 or self.rules[~code][2] is not None:
-                break
+                return top
             top = self.actions[below][self.rules[~code][1]]
-        self._chains[key] = top
-        return top
 
     def _unexpected(self, token: Token, state) -> UnexpectedToken:
         expected = {s for s in self.actions[state] if s.isupper()}
         return UnexpectedToken(token, expected, state=state)
+
+
+#: The token types of the scanner's groups that need no decision.
+_FIXED = {STRING: "STRING", DOLLAR: "DOLLAR_NAME"}
+
+
+class _Chains(dict):
+    """(state below, state, lookahead) -> the state a run of one-child ?rule reductions ends in, found once."""
+
+    def __init__(self, driver: Driver):
+        super().__init__()
+        self.driver = driver
+
+    def __missing__(self, key: tuple) -> int:
+        top = self[key] = self.driver._chain(key)
+        return top
+
+
+class _Spellings(dict):
+    """Each number's spelling, shared where it repeats: the syntax tree keeps them all.
+
+    Bounded, for a text of endless distinct numbers: past the bound a new one is not kept.
+    """
+
+    def __missing__(self, value: str) -> str:
+        if len(self) < 4096:
+            self[value] = value
+        return value
+
+
+def _end_token(last: Tok | None) -> Token:
+    """The $END token, placed at the last token (or the start of an empty text)."""
+    return Token.new_borrow_pos("$END", "", last.as_lark()) if last is not None else Token("$END", "", 0, 1, 1)
 
 
 def _lookahead(tok: Tok | None, end_tok: Token | None) -> Token:

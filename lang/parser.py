@@ -377,24 +377,8 @@ def _bracket_hint(text: str, upto: int, after: int = -1):
 
 def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
     text = source.lexed
-    line, col = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
-    hint = None
     if isinstance(exc, UnexpectedCharacters):
-        at = exc.pos_in_stream
-        assert at is not None  # Optional on UnexpectedInput; UnexpectedCharacters always sets it
-        ch = text[at] if at < len(text) else ""
-        if ch == "$":
-            message = "names beginning with $ are reserved for liganimate"
-            hint = "rename it; only PRINT $model uses a $"
-        elif ch == "{":
-            message = "this { comment is never closed with }"
-            hint = "a comment runs from { to the next }; add the }"
-        elif ch == "'":
-            message = "this quoted word is never closed with ' on the same line"
-            hint = "a quoted word ends with ' before the end of its line"
-        else:
-            message = f"unexpected character {ch!r}"
-        return Diagnostic(source.filename, A.Pos(line, col, line, col + 1), message, hint, source=source.text)
+        return _character_diagnostic(exc, source)
     assert isinstance(exc, UnexpectedToken)
     tok = exc.token
     expected = set(exc.expected) if exc.expected else set()
@@ -409,7 +393,34 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
             return d
     if tok.type == "$END":
         return _end_of_file(tok, expected, text, source)
-    pos = _token_pos(tok)
+    return _token_diagnostic(tok, expected, text, source)
+
+
+def _character_diagnostic(exc: UnexpectedCharacters, source: Source) -> Diagnostic:
+    """A character no token starts with: a $ name, an unclosed comment or quoted word, or a stray symbol."""
+    text = source.lexed
+    line, col = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
+    at = exc.pos_in_stream
+    assert at is not None  # Optional on UnexpectedInput; UnexpectedCharacters always sets it
+    ch = text[at] if at < len(text) else ""
+    hint = None
+    if ch == "$":
+        message = "names beginning with $ are reserved for liganimate"
+        hint = "rename it; only PRINT $model uses a $"
+    elif ch == "{":
+        message = "this { comment is never closed with }"
+        hint = "a comment runs from { to the next }; add the }"
+    elif ch == "'":
+        message = "this quoted word is never closed with ' on the same line"
+        hint = "a quoted word ends with ' before the end of its line"
+    else:
+        message = f"unexpected character {ch!r}"
+    return Diagnostic(source.filename, A.Pos(line, col, line, col + 1), message, hint, source=source.text)
+
+
+def _token_diagnostic(tok, expected: set, text: str, source: Source) -> Diagnostic:
+    """A token the grammar does not take here (not the end of the file): what it is, and the likeliest fix."""
+    hint = None
     if tok.type == "DOLLAR_NAME":
         message = "names beginning with $ are reserved for liganimate"
         hint = "rename it; only PRINT $model uses a $"
@@ -423,16 +434,23 @@ def _syntax_diagnostic(exc: UnexpectedInput, source: Source) -> Diagnostic:
             d = _misspelt_statement(tok, text, source)
             if d is not None:
                 return d
-        closers = {e for e in expected if e.startswith("END")}
-        if hint is None and ((tok.type.startswith("END") and tok.type not in expected) or closers):
-            opened = _open_blocks(text, tok.start_pos)
-            if opened:
-                word, at = opened[-1]
-                oline, _ = _line_col(text, at)
-                hint = f"the {_shown(word)} opened at line {oline} is not closed; add {_CLOSER[word]}"
-        if hint is None and expected & {"RPAR", "RSQB"}:
-            hint = _bracket_hint(text, tok.start_pos)
-    return Diagnostic(source.filename, pos, message, hint, source=source.text)
+        if hint is None:
+            hint = _unclosed_hint(tok, expected, text)
+    return Diagnostic(source.filename, _token_pos(tok), message, hint, source=source.text)
+
+
+def _unclosed_hint(tok, expected: set, text: str) -> str | None:
+    """The block or bracket left open before ``tok``, when that explains the error."""
+    closers = {e for e in expected if e.startswith("END")}
+    if (tok.type.startswith("END") and tok.type not in expected) or closers:
+        opened = _open_blocks(text, tok.start_pos)
+        if opened:
+            word, at = opened[-1]
+            oline, _ = _line_col(text, at)
+            return f"the {_shown(word)} opened at line {oline} is not closed; add {_CLOSER[word]}"
+    if expected & {"RPAR", "RSQB"}:
+        return _bracket_hint(text, tok.start_pos)
+    return None
 
 
 #: The declarable types, as TYPE_KW spells them.
@@ -441,7 +459,7 @@ TYPE_NAMES = (REAL, INTEGER, VECTOR, GRAPHICAL, MODEL, MOTION)
 
 def _keyword_words(expected: set) -> set:
     """The keywords among the terminals ``expected``, as the user spells them."""
-    words = set()
+    words: set[str] = set()
     for e in expected:
         if e == "TYPE_KW":
             words |= set(TYPE_NAMES)

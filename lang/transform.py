@@ -12,7 +12,7 @@ from lark import Token, Transformer
 from . import ast as A
 from .lexer import Tok
 from .numbers import literal
-from .vocabulary import MODIFIERS
+from .vocabulary import MODIFIERS, Type
 
 #: What a terminal is in the children: our parser's Tok, or a Token from Lark's own loop.
 TOKENS = (Token, Tok)
@@ -129,7 +129,7 @@ class ToAst(Transformer):
     # --------------------------------------------------------- statements
     def declaration(self, children):
         kw = children[0]
-        return A.Decl(span(children), upper_name(kw.value), _nodes(children))
+        return A.Decl(span(children), Type(upper_name(kw.value)), _nodes(children))
 
     def decl_name(self, children):
         return _name(children[0])

@@ -347,7 +347,7 @@ class Runtime(Arithmetic):
 
     # ----------------------------------------------------------- modifiers
     # One method per modifier of lang/vocabulary.py and type it applies to,
-    # named by Modifier.runtime_name; a compiled <...> list calls them in order.
+    # named in its entry (Modifier.methods); a compiled <...> list calls them in order.
     def graphical_trans(self, g: Graphical, v, at) -> Graphical:
         """``g <TRANS v>``."""
         return self._transform(g, K.translation(v), at)

@@ -298,50 +298,14 @@ def _solid_orientation(polys) -> list:
     outward side is the one that gives a positive enclosed volume.
     """
     keyed = [[tuple(np.round(p, 9)) for p in pts] for pts, _ in polys]
-    uses: dict = {}  # undirected edge -> [(polygon, forward)]
-    bad = set()
-    for i, ks in enumerate(keyed):
-        if len(set(ks)) != len(ks):
-            bad.add(i)  # a repeated corner: not a proper face
-        for a, b in zip(ks, ks[1:] + ks[:1]):
-            if a == b:
-                continue
-            key, forward = ((a, b), True) if a < b else ((b, a), False)
-            uses.setdefault(key, []).append((i, forward))
+    uses, bad = _edge_uses(keyed)
     n = len(polys)
     side = [0] * n
     seen = [False] * n
     for first in range(n):
         if seen[first]:
             continue
-        # Walk one surface, choosing each polygon's winding relative to the first.
-        sign = {first: 1}
-        stack, ok = [first], first not in bad
-        seen[first] = True
-        while stack:
-            i = stack.pop()
-            ks = keyed[i]
-            for a, b in zip(ks, ks[1:] + ks[:1]):
-                if a == b:
-                    continue
-                users = uses[(a, b) if a < b else (b, a)]
-                if len(users) != 2:
-                    ok = False
-                    continue
-                (p, fp), (q, fq) = users
-                if p == q:
-                    ok = False
-                    continue
-                other, f_other, f_self = (q, fq, fp) if p == i else (p, fp, fq)
-                # Consistent winding walks a shared edge once each way.
-                want = sign[i] * (1 if f_self != f_other else -1)
-                if other in sign:
-                    ok = ok and sign[other] == want
-                else:
-                    sign[other] = want
-                    seen[other] = True
-                    ok = ok and other not in bad
-                    stack.append(other)
+        sign, ok = _walk_surface(first, keyed, uses, bad, seen)
         if not ok:
             continue
         vol = 0.0
@@ -355,6 +319,53 @@ def _solid_orientation(polys) -> list:
         for i, sgn in sign.items():
             side[i] = sgn * outward
     return side
+
+
+def _edges(ks: list):
+    """A polygon's edges as (corner, next corner), skipping zero-length ones."""
+    return ((a, b) for a, b in zip(ks, ks[1:] + ks[:1]) if a != b)
+
+
+def _edge_uses(keyed: list) -> tuple:
+    """Undirected edge -> [(polygon, walked forward)], and the polygons with a repeated corner."""
+    uses: dict = {}
+    bad = set()
+    for i, ks in enumerate(keyed):
+        if len(set(ks)) != len(ks):
+            bad.add(i)  # a repeated corner: not a proper face
+        for a, b in _edges(ks):
+            key, forward = ((a, b), True) if a < b else ((b, a), False)
+            uses.setdefault(key, []).append((i, forward))
+    return uses, bad
+
+
+def _walk_surface(first: int, keyed: list, uses: dict, bad: set, seen: list) -> tuple:
+    """Walk the surface of polygon ``first``: each polygon's winding relative to it, and whether it is closed."""
+    sign = {first: 1}
+    stack, ok = [first], first not in bad
+    seen[first] = True
+    while stack:
+        i = stack.pop()
+        for a, b in _edges(keyed[i]):
+            users = uses[(a, b) if a < b else (b, a)]
+            if len(users) != 2:
+                ok = False
+                continue
+            (p, fp), (q, fq) = users
+            if p == q:
+                ok = False
+                continue
+            other, f_other, f_self = (q, fq, fp) if p == i else (p, fp, fq)
+            # Consistent winding walks a shared edge once each way.
+            want = sign[i] * (1 if f_self != f_other else -1)
+            if other in sign:
+                ok = ok and sign[other] == want
+            else:
+                sign[other] = want
+                seen[other] = True
+                ok = ok and other not in bad
+                stack.append(other)
+    return sign, ok
 
 
 _FAR_HINT = "everything drawn must stay within 1E12 units of the origin along each axis"

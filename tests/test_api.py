@@ -73,9 +73,12 @@ def test_one_exception_type_for_everything_wrong_with_a_program_or_an_option(tmp
     assert sorted(os.listdir(tmp_path)) == []
     with pytest.raises(liganimate.LigProgramError) as info:
         liganimate.loads(SCENE).export(tmp_path / "a.obj")
+    from liganimate.runtime.exchange import EXPORT_FORMATS
+
+    suffixes = [s for f in EXPORT_FORMATS for s in f.suffixes]
     assert str(info.value) == (
         f"cannot tell the format of {tmp_path / 'a.obj'} from its extension.\n"
-        "  hint: write to a file ending in .glb, .gltf or .bvh"
+        f"  hint: write to a file ending in {', '.join(suffixes[:-1])} or {suffixes[-1]}"
     )
 
 

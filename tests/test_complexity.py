@@ -27,18 +27,7 @@ MAX_LENGTH = 80
 MAX_COMPLEXITY = 25
 
 #: (file, qualified function name) -> who splits it. Only ever remove entries.
-ALLOWED: dict[tuple[str, str], str] = {
-    ("lang/lalr.py", "Driver.parse"): "arch-check",
-    ("lang/parser.py", "_syntax_diagnostic"): "arch-check",
-    ("compiler/check.py", "Checker._loads"): "arch-check",
-    ("compiler/check.py", "Checker._s_ReachBlock"): "arch-check",
-    ("compiler/check.py", "Checker._e_BinOp"): "arch-check",
-    ("runtime/motion/algebra.py", "Motion.describe.render"): "arch-check",
-    ("runtime/values.py", "_solid_orientation"): "arch-check",
-    ("runtime/ik/solvers.py", "_dls_one"): "arch-options",
-    ("runtime/ik/solvers.py", "_ccd"): "arch-options",
-    ("runtime/render/raster.py", "_spans"): "arch-options",
-}
+ALLOWED: dict[tuple[str, str], str] = {}
 
 
 def _qualified_names(tree: ast.Module) -> dict[int, str]:

@@ -111,7 +111,7 @@ def _placed(expr: str, R: np.ndarray, t: np.ndarray) -> str:
     mods = [f"ROT {axis} {_num(a)}" for axis, a in (("X", roll), ("Y", pitch), ("Z", yaw)) if a != 0.0]
     if np.any(t != 0.0):
         mods.append(f"TRANS ({_num(t[0])}, {_num(t[1])}, {_num(t[2])})")
-    return f"({expr}) <{', '.join(mods)}>" if mods else f"({expr})"
+    return f"({expr}) <{', '.join(mods)}>" if mods else f"({expr})"  # parenthesised either way, for what follows
 
 
 _ALONG_Y_TO_Z = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # Rx(90): LIG's Y axis onto Z
@@ -282,8 +282,8 @@ def _segment_expr(visuals, R0: np.ndarray, meshes: _Meshes) -> str | None:
         t = R0 @ v.origin[:3, 3]
         expr = _placed(_shape(v, meshes), R, t)
         if v.rgba is not None:
-            r, g, b = (max(0.0, min(100.0, 100.0 * float(c))) for c in v.rgba[:3])
-            expr = f"({expr}) <COLOUR ({_num(r)}, {_num(g)}, {_num(b)})>"
+            r, g, b = (round(max(0.0, min(100.0, 100.0 * float(c))), 6) for c in v.rgba[:3])
+            expr = f"{expr} <COLOUR ({_num(r)}, {_num(g)}, {_num(b)})>"
         parts.append(expr)
     return " +\n          ".join(parts) if parts else None
 

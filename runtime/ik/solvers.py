@@ -39,6 +39,7 @@ entry there.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -741,26 +742,104 @@ def _attempts_of_one(prob: _Problem, x0, first, evaluate, curvature, tol, max_it
     return st
 
 
+def _evaluate_one(prob: _Problem, x: np.ndarray) -> tuple:
+    """``(r, J, dist, f)`` of one problem at ``x``: :func:`_dls_one`'s evaluation."""
+    r, J, dist = prob.one(x)
+    return r, J, dist, 0.5 * float(r @ r)
+
+
+def _curvature_one(J: np.ndarray) -> float:
+    """The largest squared column norm of one Jacobian (what :func:`_first_damping` scales by)."""
+    return float((J * J).sum(axis=0).max(initial=0.0))
+
+
+def _judged_step(now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: float, inactive, tol: float):
+    """Accept the step to ``xn`` or not, update the damping, and say how the attempt stands.
+
+    ``now`` is ``(x, r, J, dist, f)`` before the step and ``then`` the
+    evaluation ``(r, J, dist, f)`` at ``xn``.  Returns the state to go on
+    from (``xn``'s when accepted), the damping ``mu, nu``, and the status.
+    """
+    x, r, J, dist, f = now
+    rn, Jn, dn, fn = then
+    lin = r + J @ dx
+    predicted = f - 0.5 * float(lin @ lin)
+    gain = f - fn
+    accept = gain > 0 and predicted > 0
+    mu, nu = _damping(_pick, mu, nu, accept, gain / predicted if accept else 0.0)
+    if accept:
+        x, r, J, dist = xn, rn, Jn, dn
+    status = _step_status(
+        _pick,
+        _converged(dist, inactive, tol),
+        accept,
+        gain,
+        f,
+        math.sqrt(float(dx @ dx)),
+        math.sqrt(float(x @ x)),
+        _damping_spent(_pick, mu, curv),
+    )
+    return (x, r, J, dist, fn if accept else f), mu, nu, status
+
+
+def _held_step(x, r, J, lower, upper, mu: float, small: bool, diagonal: slice, V: int) -> np.ndarray:
+    """:func:`_dls_one`'s step from ``x``: damped, capped and projected into the bounds.
+
+    Variables at a limit that the descent direction, then the step, pushes
+    against are held.  Only a variable at a limit can be held, so while none
+    is (most iterations) there is nothing to check.
+    """
+    at_lower, at_upper = x <= lower, x >= upper
+    at_limit = bool(at_lower.any() or at_upper.any())
+    if at_limit:
+        g = J.T @ r
+        free = ~((at_lower & (g > 0)) | (at_upper & (g < 0)))
+    for _pass in range(3):
+        Jf = J * free if at_limit else J
+        if small:
+            A = Jf @ Jf.T
+            A.flat[diagonal] += mu
+            dx = Jf.T @ np.linalg.solve(A, -r)
+        else:
+            A = Jf.T @ Jf
+            A.flat[diagonal] += mu
+            dx = -np.linalg.solve(A, Jf.T @ r)
+        if not at_limit:
+            break
+        out = ((at_lower & (dx < 0)) | (at_upper & (dx > 0))) & free
+        if not out.any():
+            break
+        free &= ~out
+    big = float(np.abs(dx[:V]).max(initial=0.0))
+    if big > MAXSTEP:
+        dx = dx * (MAXSTEP / big)
+    # The projection (np.minimum/maximum: np.clip's wrapper costs more than the clipping).
+    xn = x + (np.where(free, dx, 0.0) if at_limit else dx)
+    return np.minimum(np.maximum(xn, lower), upper) - x
+
+
+def _next_attempt(st: _State, attempt: tuple) -> tuple[tuple, int]:
+    """Hand an attempt that ended unconverged to the attempts' :class:`_State`: the attempt to go on with, restarts left."""
+    st.put(0, **dict(zip(_ATTEMPT, attempt)))
+    st.end_attempts(_ONE)
+    return tuple(st.get(0, *_ATTEMPT)), int(st.attempts_left[0])
+
+
 def _dls_one(
     prob: _Problem, x: np.ndarray, tol: float, max_iter: int, restarts: int, seed: int, trace: bool
 ) -> SolveResult:
     """:func:`_dls` for a batch of one: the same step in 2-D arithmetic, the same rules and restarts.
 
     A single solve is a few dozen iterations on arrays of a handful of
-    entries, where every numpy call costs far more than its arithmetic:
-    run through :func:`_dls` and :class:`_State`, a batch of one spends most
-    of its time in per-element status arrays, index gathers and masked
-    writes (about 2.8 times as long per solve on the benchmark's chains).
-    So here the step -- hold, damped step, cap, projection, acceptance --
-    is computed with 2-D products on the one problem, and the rules
-    (:func:`_step_status`, :func:`_first_damping`, :func:`_damping`,
-    :func:`_damping_spent`, :func:`_progress`) run on Python scalars.  An
-    attempt that ends unconverged while restarts are in play is handed to a
-    :class:`_State` of one element, which restarts or resumes it as it does
-    for a batch (:meth:`_State.end_attempts`) and chooses the final attempt
-    (:meth:`_State.finish`).  A batch of one thus ends where the batched
-    loop ends it (same status and iterations, angles equal up to rounding:
-    the 2-D products round differently from the batched ``einsum``).
+    entries, where every numpy call costs far more than its arithmetic
+    (through :func:`_dls` and :class:`_State`, about 2.8 times as long per
+    solve on the benchmark's chains).  So the step (:func:`_held_step`,
+    :func:`_judged_step`) is computed with 2-D products on the one problem,
+    and the rules run on Python scalars.  An attempt that ends unconverged
+    while restarts are in play is handed to a :class:`_State` of one
+    element, which restarts or resumes it as for a batch and chooses the
+    final attempt.  A batch of one thus ends where the batched loop ends it
+    (same status and iterations, angles equal up to rounding).
 
     Parameters
     ----------
@@ -776,19 +855,11 @@ def _dls_one(
     SolveResult
         With a batch dimension of one, as :func:`solve` returns.
     """
-    model = prob.model
-    V, P = model.n_vars, model.n_params
+    V, P = prob.model.n_vars, prob.model.n_params
     lower, upper = prob.lower, prob.upper
     active = prob.stack.active[0]
     inactive = ~active
-
-    def evaluate(x):
-        r, J, dist = prob.one(x)
-        return r, J, dist, 0.5 * float(r @ r)
-
-    def curvature(J):
-        return float((J * J).sum(axis=0).max(initial=0.0))
-
+    evaluate, curvature = functools.partial(_evaluate_one, prob), _curvature_one
     x0 = x
     r, J, dist, f = first = evaluate(x)
     status = CONVERGED if _converged(dist, inactive, tol) else RUNNING
@@ -807,55 +878,10 @@ def _dls_one(
     diagonal = slice(None, None, min(r.size, P) + 1)  # of the flattened normal matrix
 
     while status == RUNNING:
-        # Hold variables at a limit the descent direction, then the step,
-        # pushes against.  Only a variable at a limit can be held, so while
-        # none is (most iterations) there is nothing to check.
-        at_lower, at_upper = x <= lower, x >= upper
-        at_limit = bool(at_lower.any() or at_upper.any())
-        if at_limit:
-            g = J.T @ r
-            free = ~((at_lower & (g > 0)) | (at_upper & (g < 0)))
-        for _pass in range(3):
-            Jf = J * free if at_limit else J
-            if small:
-                A = Jf @ Jf.T
-                A.flat[diagonal] += mu
-                dx = Jf.T @ np.linalg.solve(A, -r)
-            else:
-                A = Jf.T @ Jf
-                A.flat[diagonal] += mu
-                dx = -np.linalg.solve(A, Jf.T @ r)
-            if not at_limit:
-                break
-            out = ((at_lower & (dx < 0)) | (at_upper & (dx > 0))) & free
-            if not out.any():
-                break
-            free &= ~out
-        big = float(np.abs(dx[:V]).max(initial=0.0))
-        if big > MAXSTEP:
-            dx = dx * (MAXSTEP / big)
-        # The projection (np.minimum/maximum: np.clip's wrapper costs more than the clipping).
-        xn = x + (np.where(free, dx, 0.0) if at_limit else dx)
-        dx = np.minimum(np.maximum(xn, lower), upper) - x
+        dx = _held_step(x, r, J, lower, upper, mu, small, diagonal, V)
         xn = x + dx
-        rn, Jn, dn, fn = evaluate(xn)
-        lin = r + J @ dx
-        predicted = f - 0.5 * float(lin @ lin)
-        gain = f - fn
-        accept = gain > 0 and predicted > 0
-        f_old = f
-        mu, nu = _damping(_pick, mu, nu, accept, gain / predicted if accept else 0.0)
-        if accept:
-            x, r, J, dist, f = xn, rn, Jn, dn, fn
-        status = _step_status(
-            _pick,
-            _converged(dist, inactive, tol),
-            accept,
-            gain,
-            f_old,
-            math.sqrt(float(dx @ dx)),
-            math.sqrt(float(x @ x)),
-            _damping_spent(_pick, mu, curv),
+        (x, r, J, dist, f), mu, nu, status = _judged_step(
+            (x, r, J, dist, f), xn, dx, evaluate(xn), mu, nu, curv, inactive, tol
         )
         iterations += 1
         attempt_iter += 1
@@ -871,10 +897,8 @@ def _dls_one(
             if st is None:
                 st = _attempts_of_one(prob, x0, first, evaluate, curvature, tol, max_iter, restarts, seed)
             attempt = (x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu)
-            st.put(0, **dict(zip(_ATTEMPT, attempt)))
-            st.end_attempts(_ONE)
-            x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = st.get(0, *_ATTEMPT)
-            attempts_left = int(st.attempts_left[0])
+            attempt, attempts_left = _next_attempt(st, attempt)
+            x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = attempt
 
     if st is None:
         return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None], history)
@@ -1048,28 +1072,41 @@ def _ccd(prob: _Problem, st: _State) -> None:
             if mh.any():
                 vh[:, mh] = _rotate(vh[:, mh], w[:, None], s[:, None], cm[:, None])
         if model.translate:
-            # The residuals are linear in the translation: one Gauss-Newton
-            # step on it alone is its exact minimiser given the angles.
-            rt, Jt, _ = prob.evaluate(idx, stack, xs, jac=True)
-            Jt = Jt[..., V:]
-            H = np.swapaxes(Jt, 1, 2) @ Jt
-            g = np.einsum("bmp,bm->bp", Jt, rt)
-            # A whisker of damping keeps H invertible when the goals pin the
-            # translation in fewer than three directions (plane goals only).
-            H += (1e-12 * np.trace(H, axis1=1, axis2=2) + 1e-300)[:, None, None] * np.eye(3)
-            dt = -np.linalg.solve(H, g[..., None])[..., 0]
-            xs[:, V:] += dt
-        rn, _, dn = prob.evaluate(idx, stack, xs, jac=False)
-        fn = 0.5 * np.einsum("bm,bm->b", rn, rn)
-        gain = fs - fn
-        # Every coordinate move was exact and kept only if it helped, so the
-        # sweep can only lower f (up to rounding, which the check absorbs).
-        accept = gain >= 0
-        st.accept(idx, accept, xs, rn, dn, fn)
-        conv = _converged(st.dist[idx], st.inactive[idx], st.tol)
-        st.status[idx[conv]] = CONVERGED
-        st.status[idx[~conv & (~accept | (gain <= FTOL * fs))]] = STALLED
-        st.end_iteration(idx)
+            _ccd_translation(prob, idx, stack, xs)
+        _ccd_end_sweep(prob, st, idx, stack, xs, fs)
+
+
+def _ccd_translation(prob: _Problem, idx: np.ndarray, stack, xs: np.ndarray) -> None:
+    """Move the translation variables of ``xs`` (in place) to their best given the angles.
+
+    The residuals are linear in the translation: one Gauss-Newton step on
+    it alone is its exact minimiser.
+    """
+    V = prob.model.n_vars
+    rt, Jt, _ = prob.evaluate(idx, stack, xs, jac=True)
+    Jt = Jt[..., V:]
+    H = np.swapaxes(Jt, 1, 2) @ Jt
+    g = np.einsum("bmp,bm->bp", Jt, rt)
+    # A whisker of damping keeps H invertible when the goals pin the
+    # translation in fewer than three directions (plane goals only).
+    H += (1e-12 * np.trace(H, axis1=1, axis2=2) + 1e-300)[:, None, None] * np.eye(3)
+    dt = -np.linalg.solve(H, g[..., None])[..., 0]
+    xs[:, V:] += dt
+
+
+def _ccd_end_sweep(prob: _Problem, st: _State, idx: np.ndarray, stack, xs: np.ndarray, fs: np.ndarray) -> None:
+    """Keep a CCD sweep's result and say which solves converged or stalled."""
+    rn, _, dn = prob.evaluate(idx, stack, xs, jac=False)
+    fn = 0.5 * np.einsum("bm,bm->b", rn, rn)
+    gain = fs - fn
+    # Every coordinate move was exact and kept only if it helped, so the
+    # sweep can only lower f (up to rounding, which the check absorbs).
+    accept = gain >= 0
+    st.accept(idx, accept, xs, rn, dn, fn)
+    conv = _converged(st.dist[idx], st.inactive[idx], st.tol)
+    st.status[idx[conv]] = CONVERGED
+    st.status[idx[~conv & (~accept | (gain <= FTOL * fs))]] = STALLED
+    st.end_iteration(idx)
 
 
 def _sums(a: np.ndarray, b: np.ndarray, g: np.ndarray) -> np.ndarray:

@@ -682,53 +682,69 @@ class Motion:
         -------
         str
         """
-        parts: list[str] = []
-        budget = [max_chars]
-
-        def put(s: str) -> bool:
-            parts.append(s)
-            budget[0] -= len(s)
-            return budget[0] > 0
-
-        def render(e: tuple, prec: int) -> bool:
-            # prec: 0 inside + or a list, 1 as a * operand, 2 before a <transform>.
-            kind = e[0]
-            if kind == "keys":
-                _, name, nj, nk = e
-                return put(name or f"keyframes[{nj} joints, {nk} keyframes]")
-            if kind == "empty":
-                return put("EMPTY")
-            if kind in ("+", "*"):
-                paren = prec > (0 if kind == "+" else 1)
-                if paren and not put("("):
-                    return False
-                if kind == "+":
-                    ok = render(e[1], 0) and put(" + ") and render(e[2], 0)
-                else:
-                    ok = put(f"{e[1]} * ") and render(e[2], 2)
-                return ok and (not paren or put(")"))
-            if kind in ("frames", "extremes"):
-                label = "FRAMES" if kind == "frames" else "EXTREMES"
-                return render(e[2], 2) and put(f" <SCALE {label} {e[1]:g}>")
-            if kind == "strip":
-                return put("STRIP(") and render(e[2], 0) and put("".join(f", {j}" for j in e[1]) + ")")
-            if kind == "sync":
-                if not put("SYNCHRONIZE("):
-                    return False
-                for i, sub in enumerate(e[1]):
-                    if (i and not put(", ")) or not render(sub, 0):
-                        return False
-                return put(")")
-            if kind == "unwrap":
-                return put("UNWRAP(") and render(e[1], 0) and put(")")
-            return put(f"<{kind}>")
-
-        if not render(self._expr, 0):
-            return "".join(parts)[:max_chars] + "..."
-        return "".join(parts)
+        text = _Describer(max_chars)
+        if not text.render(self._expr, 0):
+            return "".join(text.parts)[:max_chars] + "..."
+        return "".join(text.parts)
 
     def __repr__(self) -> str:
         return f"<Motion length={self._length:g} joints={list(self.joints)}: {self.describe(200)}>"
+
+
+class _Describer:
+    """Writes a motion's expression (``Motion._expr``) as text, stopping once ``budget`` characters are spent.
+
+    Each method returns False when the budget ran out, which stops the walk.
+    """
+
+    def __init__(self, budget: int):
+        self.parts: list[str] = []
+        self.budget = budget
+
+    def put(self, s: str) -> bool:
+        self.parts.append(s)
+        self.budget -= len(s)
+        return self.budget > 0
+
+    def render(self, e: tuple, prec: int) -> bool:
+        """``prec``: 0 inside + or a list, 1 as a * operand, 2 before a <transform>."""
+        kind = e[0]
+        if kind == "keys":
+            _, name, nj, nk = e
+            return self.put(name or f"keyframes[{nj} joints, {nk} keyframes]")
+        if kind == "empty":
+            return self.put("EMPTY")
+        if kind in ("+", "*"):
+            return self._operation(e, prec)
+        if kind in ("frames", "extremes"):
+            label = "FRAMES" if kind == "frames" else "EXTREMES"
+            return self.render(e[2], 2) and self.put(f" <SCALE {label} {e[1]:g}>")
+        if kind == "strip":
+            return self.put("STRIP(") and self.render(e[2], 0) and self.put("".join(f", {j}" for j in e[1]) + ")")
+        if kind == "sync":
+            return self._sync(e[1])
+        if kind == "unwrap":
+            return self.put("UNWRAP(") and self.render(e[1], 0) and self.put(")")
+        return self.put(f"<{kind}>")
+
+    def _operation(self, e: tuple, prec: int) -> bool:
+        kind = e[0]
+        paren = prec > (0 if kind == "+" else 1)
+        if paren and not self.put("("):
+            return False
+        if kind == "+":
+            ok = self.render(e[1], 0) and self.put(" + ") and self.render(e[2], 0)
+        else:
+            ok = self.put(f"{e[1]} * ") and self.render(e[2], 2)
+        return ok and (not paren or self.put(")"))
+
+    def _sync(self, operands: tuple) -> bool:
+        if not self.put("SYNCHRONIZE("):
+            return False
+        for i, sub in enumerate(operands):
+            if (i and not self.put(", ")) or not self.render(sub, 0):
+                return False
+        return self.put(")")
 
 
 def _finite(values: np.ndarray) -> None:

@@ -528,6 +528,67 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     triangles, the cost of a frame is mostly the number of numpy calls.
     """
     W, H = camera.size
+    drawn = _camera_triangles(tris, cull, camera)
+    if drawn is None:
+        return None
+    cam, front, src = drawn
+    found = _trapezoids(_pixel_vertices(cam, camera), front, src, first_index, (W, H))
+    if found is None:
+        return None
+    table, first_row, nrows, total = found
+    table, nrows, bounds = _banded(table, first_row, nrows, total, band_rows, H)
+
+    # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
+    # spreads per-trapezoid values over them: it costs a few instructions
+    # per element where a gather (np.take, fancy indexing) costs 15-30.
+    t = table.repeat(nrows, axis=1)
+    cy = np.add(_aranges(total)[1][:total], t[12])
+    # Crossings of the long and the short edge (rows 0 and 1 of xab), then
+    # the first and one past the last pixel column (rows 0 and 1 of cols).
+    xab = np.subtract(cy, t[2:4])
+    xab *= t[4:6]
+    xab /= t[13:15]
+    xab += t[0:2]
+    cols = np.empty((2, total))
+    np.minimum(xab[0], xab[1], out=cols[0])
+    np.maximum(xab[0], xab[1], out=cols[1])
+    cols -= 0.5
+    np.ceil(cols, out=cols)
+    np.maximum(cols, 0, out=cols)
+    np.minimum(cols, W, out=cols)
+    length = cols[1] - cols[0]
+    count = length.astype(np.int64)
+    if np.maximum.reduce(count) <= 0:
+        return None
+
+    # 1/z at the first and last pixel centre, clamped to the triangle's range
+    # so that a sliver's ill-conditioned plane cannot produce a wild depth.
+    # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
+    wrow = cy * t[8]
+    wrow += t[7]
+    ws = cols + _CENTRES
+    ws *= t[6]
+    ws += wrow
+    np.fmax(ws, t[9], out=ws)
+    np.fmin(ws, t[10], out=ws)
+    step = ws[1] - ws[0]
+    length -= 1
+    step /= np.maximum(length, 1, out=length)  # (as floats: exact, and no int-to-float pass)
+    # Spans of no pixels stay: np.repeat skips them at no cost.
+    cy -= 0.5
+    cy *= W
+    cy += cols[0]
+    return cy.astype(np.int64), ws[0], step, t[11].astype(np.int64), count, bounds
+
+
+def _camera_triangles(tris, cull, camera: Camera):
+    """:func:`_spans`' first stage: the triangles drawn, in camera space and clipped at the near plane.
+
+    Returns ``(cam, front, src)``: ``cam[k, i, j]`` coordinate k of vertex
+    i of triangle j, whether each given triangle faces the camera, and the
+    given triangle each drawn one comes from (None: itself); or None when
+    nothing is left.
+    """
     # Component-major from here on, v[i, k] being coordinate k of vertex i
     # of every triangle: numpy's loops over a last axis of length 3 cost
     # more per element than the arithmetic.
@@ -559,10 +620,15 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     if cam.shape[2] and np.minimum.reduce(cam[2], axis=None) < camera.near:
         clipped, src = _clip_near(cam.transpose(2, 1, 0), src, camera.near)
         cam = np.ascontiguousarray(clipped.transpose(2, 1, 0))
-    m = cam.shape[2]
-    if m == 0:
+    if cam.shape[2] == 0:
         return None
+    return cam, front, src
 
+
+def _pixel_vertices(cam: np.ndarray, camera: Camera) -> np.ndarray:
+    """:func:`_spans`' second stage: x, y and 1/z of each vertex (3, 3, m), sorted by y within a triangle."""
+    W, H = camera.size
+    m = cam.shape[2]
     # Projection to pixels (as Camera.camera_to_pixels), then the vertices
     # of each triangle sorted by y: that fixes the orientation of every edge
     # (top end first), which is what makes shared edges bit-identical.
@@ -580,6 +646,18 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
             was = xyw[:, i].copy()
             np.copyto(xyw[:, i], xyw[:, j], where=swap)
             np.copyto(xyw[:, j], was, where=swap)
+    return xyw
+
+
+def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple):
+    """:func:`_spans`' third stage: the table of trapezoids (see the notes after :func:`_spans`).
+
+    Returns ``(table, first_row, nrows, total)``: the table (15, 2m), each
+    trapezoid's first row and number of rows, and their sum; or None when
+    no row is covered.
+    """
+    W, H = size
+    m = xyw.shape[2]
     x, y, w = xyw
     x0, y0, w0 = x[0], y[0], w[0]
 
@@ -645,9 +723,15 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     table[13, 1] = upper[13]
     table[6:11, 1] = upper[6:11]
     table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
-    table = table.reshape(15, 2 * m)
     first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
+    return table.reshape(15, 2 * m), first_row, nrows, total
 
+
+def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: int, band_rows, H: int):
+    """:func:`_spans`' fourth stage: trapezoids cut at band boundaries and ordered by band; row 12 set.
+
+    Returns ``(table, nrows, bounds)``.
+    """
     bounds = [0, total]
     if band_rows is not None and band_rows < H:
         # Cut trapezoids at band boundaries, and order the pieces by band.
@@ -672,47 +756,7 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     first_row += nrows
     np.add(first_row, 0.5, out=table[12])
 
-    # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
-    # spreads per-trapezoid values over them: it costs a few instructions
-    # per element where a gather (np.take, fancy indexing) costs 15-30.
-    t = table.repeat(nrows, axis=1)
-    cy = np.add(_aranges(total)[1][:total], t[12])
-    # Crossings of the long and the short edge (rows 0 and 1 of xab), then
-    # the first and one past the last pixel column (rows 0 and 1 of cols).
-    xab = np.subtract(cy, t[2:4])
-    xab *= t[4:6]
-    xab /= t[13:15]
-    xab += t[0:2]
-    cols = np.empty((2, total))
-    np.minimum(xab[0], xab[1], out=cols[0])
-    np.maximum(xab[0], xab[1], out=cols[1])
-    cols -= 0.5
-    np.ceil(cols, out=cols)
-    np.maximum(cols, 0, out=cols)
-    np.minimum(cols, W, out=cols)
-    length = cols[1] - cols[0]
-    count = length.astype(np.int64)
-    if np.maximum.reduce(count) <= 0:
-        return None
-
-    # 1/z at the first and last pixel centre, clamped to the triangle's range
-    # so that a sliver's ill-conditioned plane cannot produce a wild depth.
-    # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
-    wrow = cy * t[8]
-    wrow += t[7]
-    ws = cols + _CENTRES
-    ws *= t[6]
-    ws += wrow
-    np.fmax(ws, t[9], out=ws)
-    np.fmin(ws, t[10], out=ws)
-    step = ws[1] - ws[0]
-    length -= 1
-    step /= np.maximum(length, 1, out=length)  # (as floats: exact, and no int-to-float pass)
-    # Spans of no pixels stay: np.repeat skips them at no cost.
-    cy -= 0.5
-    cy *= W
-    cy += cols[0]
-    return cy.astype(np.int64), ws[0], step, t[11].astype(np.int64), count, bounds
+    return table, nrows, bounds
 
 
 # Rows of _spans' table: 0-1 x of the top of the long and the short edge,

@@ -66,7 +66,7 @@
     var p = v.pos, o = NV * 3, y = box.lo[1], s = box.r * 1.2;
     var x0 = box.c[0] - s, x1 = box.c[0] + s, z0 = box.c[2] - s, z1 = box.c[2] + s;
     var quad = [x0, y, z0, x0, y, z1, x1, y, z1, x0, y, z0, x1, y, z1, x1, y, z0];
-    for (var i = 0; i < 18; i++) { p[o + i] = quad[i]; v.col[o + i] = 215; }
+    for (var i = 0; i < 18; i++) { p[o + i] = quad[i]; v.col[o + i] = 200; }
   }
   function paint(v, matrices, block) {
     if (!mats) return;

@@ -1,7 +1,14 @@
 /* LIG GL: draws what the liganimate runtime computed, shaded like its rasterizer.
  *
  * Triangles come in segment coordinates with one colour each (the
- * rasterizer's flat shading: LIGHTNESS 0..100 -> 0..255, times COLOUR; no lighting);
+ * rasterizer's flat shading: LIGHTNESS 0..100 -> 0..255, times COLOUR).
+ * A Renderer draws in one of the two looks of `liganimate run --look`
+ * (docs/semantics-render.md, "Looks"): 'thesis', flat on white; or
+ * 'modern' (the default), each face lit by the same key light and ambient
+ * term as the rasterizer's modern look, outlines along silhouettes,
+ * creases (normals over 50 degrees apart) and changes of colour, the
+ * same grey background, and edges smoothed by the browser's multisampling
+ * (the contact shadow is the rasterizer's alone);
  * segment matrices come from the runtime, one 3x4 row-major block per
  * segment.  This file only multiplies vertices by those matrices: it never
  * turns joint angles into transforms.
@@ -99,8 +106,14 @@ var LigGL = (function () {
     return o;
   }
 
-  function Renderer(canvas) {
-    var gl = canvas.getContext('webgl', { antialias: false, preserveDrawingBuffer: true, alpha: false });
+  /* The modern look's parameters: those of runtime/render/look.py's Look. */
+  var MODERN = { light: [-0.3, 0.6, -0.75], ambient: 0.75, key: 0.4, crease: Math.cos(50 * Math.PI / 180),
+    ink: 0.25, background: 244 / 255 };
+
+  function Renderer(canvas, look) {
+    this.look = look === 'thesis' ? 'thesis' : 'modern';
+    var modern = this.look === 'modern';
+    var gl = canvas.getContext('webgl', { antialias: modern, preserveDrawingBuffer: true, alpha: false });
     if (!gl) throw new Error('this browser has no WebGL, which the viewer needs');
     this.gl = gl;
     this.canvas = canvas;
@@ -120,21 +133,104 @@ var LigGL = (function () {
     this.uM = gl.getUniformLocation(prog, 'mvp');
     this.pos = gl.createBuffer();
     this.col = gl.createBuffer();
+    this.linePos = gl.createBuffer();
+    this.lineCol = gl.createBuffer();
     this.capacity = 0;
+  }
+
+  /* Lit colours (modern look): each triangle's colour times ambient + key * max(0, n . L),
+   * n facing the eye, L the key light turned with the camera; at most white. */
+  function lit(pos, col, first, count, cam, out) {
+    var b = basis(cam), l = MODERN.light, ln = Math.sqrt(dot(l, l));
+    var L = [0, 1, 2].map(function (k) { return (b.right[k] * l[0] + b.up[k] * l[1] + b.fwd[k] * l[2]) / ln; });
+    var normals = new Float32Array(count);  // (count / 3 triangles) x 3
+    for (var v = first; v < first + count; v += 3) {
+      var i = v * 3;
+      var ax = pos[i + 3] - pos[i], ay = pos[i + 4] - pos[i + 1], az = pos[i + 5] - pos[i + 2];
+      var bx = pos[i + 6] - pos[i], by = pos[i + 7] - pos[i + 1], bz = pos[i + 8] - pos[i + 2];
+      var n = [ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx];
+      var len = Math.sqrt(dot(n, n)) || Infinity;
+      var toEye = [cam.eye[0] - pos[i], cam.eye[1] - pos[i + 1], cam.eye[2] - pos[i + 2]];
+      var s = (dot(n, toEye) < 0 ? -1 : 1) / len;
+      n = [n[0] * s, n[1] * s, n[2] * s];
+      var t = (v - first) / 3;
+      normals[3 * t] = n[0]; normals[3 * t + 1] = n[1]; normals[3 * t + 2] = n[2];
+      var f = MODERN.ambient + MODERN.key * Math.max(0, dot(n, L));
+      for (var c = 0; c < 9; c++) out[i + c] = Math.min(255, Math.floor(col[i + c] * f + 0.5));
+    }
+    return normals;
+  }
+
+  /* Outline segments (modern look): edges of a silhouette (one face towards the eye, one away),
+   * of the surface's border, of a crease, or between two colours. */
+  function outlines(pos, col, first, count, cam, normals, lines, lineCol) {
+    var edges = new Map();
+    function key(i) { return pos[i] + ',' + pos[i + 1] + ',' + pos[i + 2]; }
+    for (var v = first; v < first + count; v += 3) {
+      for (var e = 0; e < 3; e++) {
+        var a = (v + e) * 3, b = (v + (e + 1) % 3) * 3, ka = key(a), kb = key(b);
+        var k = ka < kb ? ka + '|' + kb : kb + '|' + ka;
+        var seen = edges.get(k);
+        if (seen === undefined) edges.set(k, [a, b, (v - first) / 3, -1]);
+        else if (seen[3] < 0) seen[3] = (v - first) / 3;
+        else seen[4] = true;  // three faces meet: draw it
+      }
+    }
+    function faces(t, i) {
+      var d = [cam.eye[0] - pos[i], cam.eye[1] - pos[i + 1], cam.eye[2] - pos[i + 2]];
+      var tri = first * 3 + t * 9;
+      var ax = pos[tri + 3] - pos[tri], ay = pos[tri + 4] - pos[tri + 1], az = pos[tri + 5] - pos[tri + 2];
+      var bx = pos[tri + 6] - pos[tri], by = pos[tri + 7] - pos[tri + 1], bz = pos[tri + 8] - pos[tri + 2];
+      return dot([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], d) > 0;
+    }
+    edges.forEach(function (e) {
+      var draw = e[3] < 0 || e[4];
+      if (!draw) {
+        var t1 = e[2], t2 = e[3], c1 = first * 3 + t1 * 9, c2 = first * 3 + t2 * 9;
+        var cos = normals[3 * t1] * normals[3 * t2] + normals[3 * t1 + 1] * normals[3 * t2 + 1] +
+          normals[3 * t1 + 2] * normals[3 * t2 + 2];
+        draw = faces(t1, e[0]) !== faces(t2, e[0]) || cos < MODERN.crease ||
+          col[c1] !== col[c2] || col[c1 + 1] !== col[c2 + 1] || col[c1 + 2] !== col[c2 + 2];
+      }
+      if (!draw) return;
+      for (var q = 0; q < 3; q++) { lines.push(pos[e[0] + q]); }
+      for (q = 0; q < 3; q++) { lines.push(pos[e[1] + q]); }
+      var ink = Math.round(255 * MODERN.background * MODERN.ink * 0.5);
+      for (q = 0; q < 6; q++) lineCol.push(ink);
+    });
   }
 
   /* Draw one picture.  frame = {pos: Float32Array, col: Uint8Array,
    * ranges: [{first, count, cam}]} with first/count in vertices. */
   Renderer.prototype.draw = function (frame, bounds) {
-    var gl = this.gl, c = this.canvas;
+    var gl = this.gl, c = this.canvas, modern = this.look === 'modern';
     gl.viewport(0, 0, c.width, c.height);
-    gl.clearColor(1, 1, 1, 1);
+    var bg = modern ? MODERN.background : 1;
+    gl.clearColor(bg, bg, bg, 1);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     gl.enable(gl.DEPTH_TEST);
     // Equal depths: the later triangle wins, as in the rasterizer.
     gl.depthFunc(gl.LEQUAL);
     gl.useProgram(this.prog);
     var n = frame.pos.length;
+    var lines = [], lineCol = [], lineRanges = [];
+    if (modern) {
+      var shaded = new Uint8Array(n);
+      for (var q = 0; q < frame.ranges.length; q++) {
+        var rg = frame.ranges[q];
+        if (!rg.count) continue;
+        var normals = lit(frame.pos, frame.col, rg.first, rg.count, rg.cam, shaded);
+        var l0 = lines.length / 3;
+        outlines(frame.pos, frame.col, rg.first, rg.count, rg.cam, normals, lines, lineCol);
+        lineRanges.push({ first: l0, count: lines.length / 3 - l0, cam: rg.cam });
+      }
+      frame = { pos: frame.pos, col: shaded, ranges: frame.ranges };
+      // Faces a little behind their outlines, so the lines win at equal depth.
+      gl.enable(gl.POLYGON_OFFSET_FILL);
+      gl.polygonOffset(1, 1);
+    } else {
+      gl.disable(gl.POLYGON_OFFSET_FILL);
+    }
     gl.bindBuffer(gl.ARRAY_BUFFER, this.pos);
     gl.bufferData(gl.ARRAY_BUFFER, frame.pos.subarray(0, n), gl.DYNAMIC_DRAW);
     gl.enableVertexAttribArray(this.aP);
@@ -148,6 +244,20 @@ var LigGL = (function () {
       if (!r.count) continue;
       gl.uniformMatrix4fv(this.uM, false, projection(r.cam, c.width, c.height, bounds).mvp);
       gl.drawArrays(gl.TRIANGLES, r.first, r.count);
+    }
+    if (lines.length) {
+      gl.bindBuffer(gl.ARRAY_BUFFER, this.linePos);
+      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(lines), gl.DYNAMIC_DRAW);
+      gl.vertexAttribPointer(this.aP, 3, gl.FLOAT, false, 0, 0);
+      gl.bindBuffer(gl.ARRAY_BUFFER, this.lineCol);
+      gl.bufferData(gl.ARRAY_BUFFER, new Uint8Array(lineCol), gl.DYNAMIC_DRAW);
+      gl.vertexAttribPointer(this.aC, 3, gl.UNSIGNED_BYTE, true, 0, 0);
+      for (var li = 0; li < lineRanges.length; li++) {
+        var lr = lineRanges[li];
+        if (!lr.count) continue;
+        gl.uniformMatrix4fv(this.uM, false, projection(lr.cam, c.width, c.height, bounds).mvp);
+        gl.drawArrays(gl.LINES, lr.first, lr.count);
+      }
     }
   };
 

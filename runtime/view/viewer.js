@@ -14,10 +14,17 @@
   var bytes = LigGL.decodeBase64(el('lig-blob').textContent);
   var V = function (ref) { return LigGL.view(bytes, ref); };
 
+  /* Options in the address: #size=640x480&scene=0&frame=12&look=thesis (the tests use them). */
+  var opts = {};
+  location.hash.replace(/^#/, '').split('&').forEach(function (kv) {
+    var p = kv.split('=');
+    if (p.length === 2) opts[p[0]] = p[1];
+  });
+
   var canvas = el('view');
   var renderer;
   try {
-    renderer = new LigGL.Renderer(canvas);
+    renderer = new LigGL.Renderer(canvas, opts.look === 'thesis' ? 'thesis' : 'modern');
   } catch (err) {
     el('info').textContent = 'Cannot draw: ' + err.message;
     return;
@@ -297,12 +304,6 @@
   });
   window.addEventListener('resize', function () { layout(); draw(); });
 
-  /* Options in the address: #size=640x480&scene=0&frame=12 (the tests use them). */
-  var opts = {};
-  location.hash.replace(/^#/, '').split('&').forEach(function (kv) {
-    var p = kv.split('=');
-    if (p.length === 2) opts[p[0]] = p[1];
-  });
   if (/^\d+x\d+$/.test(opts.size || '')) fixed = opts.size.split('x').map(Number);
   layout();
   setScene(+(opts.scene || 0));

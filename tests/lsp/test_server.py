@@ -72,9 +72,10 @@ def folder(tmp_path_factory) -> pathlib.Path:
 )
 async def client(lsp_client: LanguageClient, tmp_path_factory):
     record_versions(lsp_client)
-    await lsp_client.initialize_session(
+    result = await lsp_client.initialize_session(
         T.InitializeParams(capabilities=pytest_lsp.client_capabilities("visual-studio-code"))
     )
+    CAPABILITIES.append(result.capabilities)
     yield
     await lsp_client.shutdown_session()
 
@@ -91,6 +92,9 @@ def pos_of(text: str, needle: str, nth: int = 0, into: int = 0) -> T.Position:
     line = text.count("\n", 0, at)
     return T.Position(line=line, character=at - (text.rfind("\n", 0, at) + 1))
 
+
+#: What the server said it can do, at initialize.
+CAPABILITIES: list = []
 
 #: (uri, version) -> the diagnostics the server published for that version of the document.
 PUBLISHED: dict = {}
@@ -357,7 +361,16 @@ async def test_rename(client: LanguageClient, folder: pathlib.Path):
 
 
 async def test_lines_are_counted_as_the_editor_counts_them(client: LanguageClient, folder: pathlib.Path):
-    """A form feed (which LIG text may hold) does not end a line, for the editor or for LIG."""
+    """A form feed (which LIG text may hold) does not end a line, for the editor or for LIG.
+
+    The server asks for whole texts: pygls would apply an edit by lines cut at form feeds too.
+    """
+    sync = CAPABILITIES[0].text_document_sync
+    assert (sync.change if isinstance(sync, T.TextDocumentSyncOptions) else sync) == T.TextDocumentSyncKind.Full
+    features = CAPABILITIES[0]
+    assert features.hover_provider and features.definition_provider and features.references_provider
+    assert features.rename_provider and features.document_symbol_provider and features.folding_range_provider
+    assert features.completion_provider is not None
     text = "{ page one }\f{ page two }\n      X = 1\n      Y = X + BOX\n"
     uri = from_fs_path(str(folder / "paged.lig"))
     client.text_document_did_open(

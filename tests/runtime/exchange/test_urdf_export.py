@@ -191,3 +191,31 @@ def test_bvh_carries_slides_as_position_channels_and_axes_exactly(tmp_path):
             link = fig.links[joint.secondary]
             where = X_[t, joint.secondary, :3, :3] @ joint.loc2 + X_[t, joint.secondary, :3, 3]
             np.testing.assert_allclose(got[link.name], where, atol=1e-5)  # bvhio computes in float32
+
+
+def test_gltf_moves_slides_by_translation_channels_and_turns_axes_exactly(tmp_path):
+    """Every segment node of the glTF (the nodes rig, whose segment nodes carry the shape's
+    transform) is where the pose record puts the segment, at every tick."""
+    from exchange_support import load_gltf, pose_records, sample_channels, segment_nodes, world_transforms
+
+    src = tmp_path / "arm.lig"
+    src.write_text(ARM + SCENE.format(model="ARM", motion="M"))
+    out = tmp_path / "arm.glb"
+    done = subprocess.run(
+        [sys.executable, "-m", "liganimate", "export", str(src), "-o", str(out), "--rig", "nodes"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr
+    doc, blob = load_gltf(str(out))
+    program, _ = load_program(str(src))
+    records = pose_records(program, tmp_path)
+    (anim,) = doc.animations
+    assert any(ch.target.path == "translation" for ch in anim.channels)
+    segments = segment_nodes(doc)
+    for rec in records:
+        worlds = world_transforms(doc, 0, sample_channels(doc, blob, anim, rec["tick"] / 24.0))
+        for i, seg in enumerate(rec["segments"]):
+            expected = np.array(seg["matrix"]).reshape(4, 4)
+            np.testing.assert_allclose(worlds[segments[(1, "ARM", i)]], expected, rtol=0, atol=1e-5)

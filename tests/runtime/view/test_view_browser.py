@@ -80,9 +80,10 @@ def browser():
         yield b
 
 
-def _open(browser, page, size="640x480"):
+def _open(browser, page, size="640x480", look="thesis"):
+    # The thesis look by default: the comparisons with `liganimate run --look thesis` need its flat shading.
     browser.driver.get("about:blank")  # a new document even when only the #fragment would differ
-    browser.driver.get(page.as_uri() + f"#size={size}")
+    browser.driver.get(page.as_uri() + f"#size={size}&look={look}")
     deadline = time.time() + 30
     while time.time() < deadline:
         if browser.driver.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"):
@@ -123,6 +124,22 @@ def test_the_canvas_shows_what_liganimate_run_draws(pages, browser, name, scene_
         # Flat shading like the rasterizer: the same grey wherever both drew.
         same = (mine == theirs)[a & b].mean()
         assert same > 0.97, (name, image, same)
+
+
+def test_the_modern_look_lights_and_outlines_what_the_thesis_look_draws_flat(pages, browser):
+    page, _ = pages["five"]
+    _open(browser, page, look="thesis")
+    flat = _frame(browser, 0, 17)
+    _open(browser, page, look="modern")
+    modern = _frame(browser, 0, 17)
+    assert flat[5, 5] == 255 and abs(int(modern[5, 5]) - 244) <= 1  # the modern look's grey background
+    drawn_flat, drawn_modern = flat < 255, modern < 240
+    iou = (drawn_flat & drawn_modern).sum() / (drawn_flat | drawn_modern).sum()
+    assert iou > 0.8  # the same figures where they were (the outlines widen them a little)
+    # Outlines: pixels far darker than any shade the thesis look draws, along the figures' edges.
+    assert (modern < flat[drawn_flat].min() - 20).sum() > 300
+    # Lit faces and smoothed edges: many more levels than the flat look's few.
+    assert len(np.unique(modern)) > 3 * len(np.unique(flat))
 
 
 def test_moving_the_scrubber_changes_the_picture(pages, browser):
