@@ -209,7 +209,7 @@ class StatementChecker(NodeVisitor):
             out.error(s.options["MOVE CHAIN"][0], "MOVE JOINTS and MOVE CHAIN both choose the movable joints; keep one")
         if not s.goals:
             out.error(
-                s, f"REACH {s.name.name} has no GOAL", "add a line such as  GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10"
+                s, f"REACH {s.name.name} has no GOAL", "add a line such as GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10"
             )
         for g in s.goals:
             self._goal(g)
