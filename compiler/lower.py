@@ -520,7 +520,7 @@ class Lowerer(NodeVisitor):
 
     def _binop(self, e, root: bool) -> str:
         t = self.type_of(e)
-        if e.op in _ARITH and t in _CHECKED:
+        if e.op in _ARITH and t in _CHECKED and self._operator(e).runtime is None:
             # A chain of + - * of one type is checked once, at its root: a
             # REAL that overflows stays infinite or NaN through + - *, and
             # INTEGER arithmetic inside an expression is exact (Python ints).
@@ -652,7 +652,8 @@ def _in_chain(e, t, lowerer) -> bool:
         return False
     if isinstance(e, A.Neg):
         return _in_chain(e.operand, t, lowerer)
-    return isinstance(e, A.BinOp) and e.op in _ARITH
+    # Only rows the table computes with Python's own operator chain; a runtime method checks itself.
+    return isinstance(e, A.BinOp) and e.op in _ARITH and lowerer._operator(e).runtime is None
 
 
 def _tuple_target(names) -> str:

@@ -8,7 +8,7 @@ A literal outside these is a compile-time error at the literal
 (:func:`literal` marks it, the checker reports it). An operation whose result
 leaves them (INTEGER overflow, a REAL overflowing to infinity, a NaN) is a
 run-time error at that operation: the compiled program checks every
-arithmetic result with :func:`in_range` or an inline test equal to it, and
+arithmetic result with an inline range test (``lo <= x <= hi``, False for NaN), and
 the runtime's built-in functions and conversions use :func:`integer` and
 :func:`real`, which raise :class:`NumberError`.
 
@@ -155,13 +155,6 @@ def literal_problem(value) -> tuple[str, str] | None:
 # -------------------------------------------------------------- run-time checks
 
 
-def in_range(x) -> bool:
-    """Is ``x`` a number the language can hold (an INTEGER within range, a finite REAL)?"""
-    if isinstance(x, int):
-        return -INT_MAX <= x <= INT_MAX
-    return -REAL_MAX <= x <= REAL_MAX  # False for NaN and the infinities
-
-
 def describe(x) -> str:
     """A short text of a number for messages (huge integers abbreviated, ``%g`` for reals)."""
     if isinstance(x, bool):
@@ -250,8 +243,3 @@ def real(x, what: str = "the result") -> float:
     if not -REAL_MAX <= r <= REAL_MAX:
         raise overflow(r, what)
     return r
-
-
-def finite_reals(values, what: str) -> tuple:
-    """Several numbers as finite REALs (a vector's components...); NumberError naming ``what``."""
-    return tuple(real(v, what) for v in values)

@@ -12,7 +12,7 @@ from lark import Token, Transformer
 from . import ast as A
 from .lexer import Tok
 from .numbers import literal
-from .vocabulary import MODIFIERS, Type
+from .vocabulary import MODIFIERS, OPERATORS, Type
 
 #: What a terminal is in the children: our parser's Tok, or a Token from Lark's own loop.
 TOKENS = (Token, Tok)
@@ -430,26 +430,6 @@ class ToAst(Transformer):
     def sync_expr(self, children):
         return A.Sync(span(children), list(children[1:]))
 
-    def add(self, children):
-        left, right = children
-        return A.BinOp(span(children), "+", left, right)
-
-    def sub(self, children):
-        left, right = children
-        return A.BinOp(span(children), "-", left, right)
-
-    def mul(self, children):
-        left, right = children
-        return A.BinOp(span(children), "*", left, right)
-
-    def div(self, children):
-        left, op, right = children
-        return A.BinOp(span(children), "/", left, right, _tpos(op))
-
-    def mod(self, children):
-        left, op, right = children
-        return A.BinOp(span(children), "MOD", left, right, _tpos(op))
-
     def neg(self, children):
         minus, operand = children
         # The caret stays on the operand, as it always has; the text takes the sign.
@@ -532,3 +512,26 @@ def _modifier_rule(kind: str, axis: bool):
 # One method per modifier of lang/vocabulary.py: a new modifier needs no code here.
 for _spec in MODIFIERS.values():
     setattr(ToAst, "mod_" + _spec.kind, _modifier_rule(_spec.kind, _spec.axis))
+
+
+def _operator_rule(rule_name: str, symbol: str):
+    """The transformer method of ``left <op> right -> <rule_name>``.
+
+    An operator the grammar names as a terminal (``DIV_OP``, ``MOD``) is
+    kept as a child: its position is where a division by zero points.
+    """
+
+    def rule(self, children):
+        if len(children) == 3:
+            left, op, right = children
+            return A.BinOp(span(children), symbol, left, right, _tpos(op))
+        left, right = children
+        return A.BinOp(span(children), symbol, left, right)
+
+    rule.__name__ = rule_name
+    return rule
+
+
+# One method per operator of lang/vocabulary.py's table: a new operator needs no code here.
+for _op in OPERATORS:
+    setattr(ToAst, _op.rule, _operator_rule(_op.rule, _op.symbol))

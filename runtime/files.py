@@ -148,11 +148,6 @@ class AtomicWriter:
         except OSError as exc:
             raise write_error(exc, self.path) from None
 
-    @property
-    def temporary(self):
-        """The temporary file's path while it exists, else None."""
-        return self._tmp
-
     def write(self, data) -> None:
         """Append bytes (or any buffer) to the file."""
         if self._tmp is None:

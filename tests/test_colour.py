@@ -93,10 +93,21 @@ def test_draw_with_takes_lightness_or_colour_only():
 
 
 def test_color_is_the_same_word():
+    from liganimate.compiler import compile_text
+
     text = HEAD + "      RED :- RED <COLOR (100, 20, 10)>\n" + SCENE.format(what="RED")
-    load_program(None, text=text, name="color.lig")
+    same = text.replace("<COLOR (", "<COLOUR(")  # the same length, so every position is the same
+    assert same != text
+    python = compile_text(text, "color.lig").python
+    assert "rt.graphical_colour(" in python
+    # The modules differ only in the program text they quote.
+    assert python.replace(repr(text), "") == compile_text(same, "color.lig").python.replace(repr(same), "")
 
 
 def test_colour_is_still_a_name_elsewhere():
-    text = "      INTEGER COLOUR\n      COLOUR = 3\n      END\n"
-    load_program(None, text=text, name="name.lig")
+    from liganimate.compiler import compile_text
+
+    text = "      INTEGER COLOUR\n      COLOUR = 3\n      PRINT COLOUR + 1\n      END\n"
+    assert compile_text(text, "name.lig").checked.main.types["COLOUR"] == "INTEGER"
+    program, _ = load_program(None, text=text, name="name.lig")
+    assert program is not None

@@ -9,7 +9,7 @@ import pytest
 from paths import ROOT_DIR
 
 from liganimate.lang import vocabulary as V
-from liganimate.lang.transform import ToAst
+from liganimate.lang.parser import parse
 from liganimate.runtime.host import Runtime
 
 GRAMMAR = (pathlib.Path(ROOT_DIR) / "lang" / "lig.lark").read_text(encoding="utf-8")
@@ -23,7 +23,12 @@ def test_every_grammar_modifier_is_in_the_table_and_back():
 @pytest.mark.parametrize("kind", sorted(V.MODIFIERS))
 def test_every_modifier_has_a_transformer_rule_and_a_runtime_method_per_target(kind):
     spec = V.MODIFIERS[kind]
-    assert callable(getattr(ToAst, "mod_" + kind))
+    # The transformer rule (made from the table) builds this modifier from its grammar alternative.
+    arg = "(1, 2, 3)" if V.VECTOR in spec.accepts else "2"
+    words = f"{spec.label} X {arg}" if spec.axis else f"{spec.label} {arg}"
+    (stmt,) = parse(f"H = G <{words}>\n").body
+    (modifier,) = stmt.value.modifiers
+    assert (modifier.kind, modifier.axis) == (kind, "X" if spec.axis else None)
     assert spec.targets and set(spec.targets) <= set(V.TYPES)
     for target, method in spec.methods.items():
         assert callable(getattr(Runtime, method, None)), method
@@ -74,7 +79,10 @@ def test_every_grammar_operator_is_in_the_table_and_back():
 
 @pytest.mark.parametrize("row", V.OPERATORS, ids=lambda o: f"{o.left[0]}{o.symbol}{o.right[0]}")
 def test_every_operator_row_has_a_transformer_rule_and_its_runtime_method(row):
-    assert callable(getattr(ToAst, row.rule))
+    # The transformer rule (made from the table) builds this operator from its grammar production.
+    (stmt,) = parse(f"X = A {row.symbol} B\n").body
+    # A runtime error that points at the operator needs its position from the tree.
+    assert stmt.value.op == row.symbol and (stmt.value.op_pos.line > 0) == row.at_operator
     if row.runtime is not None:
         assert callable(getattr(Runtime, row.runtime, None)), row.runtime
     assert row.result is None or row.result in V.TYPES

@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
@@ -64,7 +65,17 @@ DEFAULT_TOLERANCE = 1e-5
 #: Default iteration limits per solver (sweeps for CCD), from the solvers' registry.
 DEFAULT_MAX_ITERATIONS = {name: spec.max_iterations for name, spec in SOLVERS.items()}
 
-_STATUS = {CONVERGED: "converged", STALLED: "stalled", LIMIT: "limit"}
+
+class SolveStatus(StrEnum):
+    """How a solve ended (``PoseSolution.status``); a StrEnum, so each is also its word."""
+
+    CONVERGED = "converged"  # every goal of non-zero weight is within the tolerance
+    STALLED = "stalled"  # no move lowers the weighted cost: the least-squares best pose
+    LIMIT = "limit"  # the iteration limit came first
+
+
+#: The solvers' status codes (runtime/ik/solvers.py) as the solution reports them.
+_STATUS = {CONVERGED: SolveStatus.CONVERGED, STALLED: SolveStatus.STALLED, LIMIT: SolveStatus.LIMIT}
 
 
 @dataclass(frozen=True)
@@ -140,9 +151,9 @@ class PoseSolution:
         goal's angle to its direction (degrees).
     converged : numpy.ndarray of bool, shape (B,)
         Every goal of non-zero weight is within the tolerance.
-    status : numpy.ndarray of str, shape (B,)
-        ``"converged"``, ``"stalled"`` (no move lowers the weighted cost: the
-        least-squares best pose, goals left unmet) or ``"limit"`` (the
+    status : numpy.ndarray of SolveStatus, shape (B,)
+        ``CONVERGED``, ``STALLED`` (no move lowers the weighted cost: the
+        least-squares best pose, goals left unmet) or ``LIMIT`` (the
         iteration limit came first).
     iterations : numpy.ndarray of int, shape (B,)
     tolerance : float
@@ -162,7 +173,7 @@ class PoseSolution:
     translation: np.ndarray
     residuals: np.ndarray
     converged: np.ndarray | bool
-    status: np.ndarray | str
+    status: np.ndarray | SolveStatus
     iterations: np.ndarray | int
     tolerance: float
     weights: np.ndarray
@@ -298,6 +309,83 @@ def start_pose(figure: Figure, start=None) -> np.ndarray:
     return K.clamp(figure, a)
 
 
+#: Rounds of the alternation between the angles and the slides (see :func:`_solve_with_slides`).
+SLIDE_ROUNDS = 12
+
+
+def _solve_with_slides(figure: Figure, goals: list, start, o: ReachOptions, trace: bool) -> PoseSolution:
+    """:func:`solve_pose` for a figure with slides: the angles and the slides in turn.
+
+    The solvers' variables are angles.  With the slides held, the goals are
+    met by the angles (:func:`_hold_slides`); with the angles held, every
+    link is an affine function of the slides' displacements, so the slides
+    that may move take the least-squares step of the weighted residuals,
+    within their extremes (an active set: a displacement the step would push
+    past an extreme is fixed there and the rest solved again).  The two
+    alternate until the goals are met, the slides stop moving, or
+    :data:`SLIDE_ROUNDS` rounds.  A batch of solves holds the slides.
+    """
+    held, start_held, values = _hold_slides(figure, start)
+    solution = solve_pose(held, goals, start=start_held, options=o, trace=trace)
+    mask = _movable_mask(figure, goals, o.movable) & (figure.extremes[..., 1] > figure.extremes[..., 0])
+    slide_rows = [int(k) for k in np.flatnonzero(figure.slides)]
+    free = [(k, a) for k in slide_rows for a in range(3) if mask[k, a]]
+    batched = np.ndim(solution.angles) == 3
+    for _ in range(SLIDE_ROUNDS if free and not batched else 0):
+        if bool(np.all(solution.met)):
+            break
+        step = _slide_step(figure, goals, solution, values, free, o.translate)
+        if not np.any(np.abs(step) > 1e-12):
+            break
+        for n, (k, a) in enumerate(free):
+            values[slide_rows.index(k), a] += step[n]
+        angles = np.array(solution.angles)
+        angles[figure.slides] = values
+        held, start_held, _ = _hold_slides(figure, angles)
+        solution = solve_pose(held, goals, start=start_held, options=o, trace=trace)
+    angles = np.array(solution.angles)
+    angles[..., figure.slides, :] = values
+    return dataclasses.replace(solution, angles=angles)
+
+
+def _slide_residuals(figure: Figure, goals: list, angles: np.ndarray, translation, translate: bool) -> np.ndarray:
+    """The weighted goal residuals of one pose (slides included, through a held figure)."""
+    held, start_held, _ = _hold_slides(figure, angles)
+    model = IKModel.cached(held, np.zeros((held.n_joints, 3), dtype=bool), translate)
+    stack = GoalStack(model, goals, 1)
+    R, p = model.forward(np.deg2rad(start_held)[None])
+    t = np.asarray(translation, dtype=np.float64)[None] if translate else None
+    return stack.evaluate(R, p, t)[0][0]
+
+
+def _slide_step(figure: Figure, goals: list, solution, values, free: list, translate: bool) -> np.ndarray:
+    """The bounded least-squares step of the free slide axes, the angles held."""
+    angles = np.array(solution.angles)
+    angles[figure.slides] = values
+    r0 = _slide_residuals(figure, goals, angles, solution.translation, translate)
+    J = np.empty((len(r0), len(free)))
+    for n, (k, a) in enumerate(free):
+        moved = angles.copy()
+        moved[k, a] += 1.0  # the residuals are affine in a displacement: one unit's difference is exact
+        J[:, n] = _slide_residuals(figure, goals, moved, solution.translation, translate) - r0
+    lo = np.array([figure.extremes[k, a, 0] - angles[k, a] for k, a in free])
+    hi = np.array([figure.extremes[k, a, 1] - angles[k, a] for k, a in free])
+    step = np.zeros(len(free))
+    active = np.zeros(len(free), dtype=bool)
+    for _ in range(len(free) + 1):
+        idle = ~active
+        if not idle.any():
+            break
+        rhs = -(r0 + J[:, active] @ step[active])
+        step[idle] = np.linalg.lstsq(J[:, idle], rhs, rcond=None)[0]
+        out = idle & ((step < lo) | (step > hi))
+        if not out.any():
+            break
+        step = np.clip(step, lo, hi)
+        active |= out
+    return np.clip(step, lo, hi)
+
+
 def _hold_slides(figure: Figure, start) -> tuple[Figure, np.ndarray, np.ndarray]:
     """REACH holds every slide at its start displacement.
 
@@ -430,11 +518,7 @@ def solve_pose(
     goals = list(goals)
     o = reach_options(options, **fields)
     if figure.slides.any():
-        held, start, values = _hold_slides(figure, start)
-        solution = solve_pose(held, goals, start=start, options=o, trace=trace)
-        angles = np.array(solution.angles)
-        angles[..., figure.slides, :] = values
-        return dataclasses.replace(solution, angles=angles)
+        return _solve_with_slides(figure, goals, start, o, trace)
     tol, max_iter = _options(figure, o.solver, o.tolerance, o.max_iterations)
     restarts, translate = o.restarts, o.translate
     if isinstance(restarts, bool) or not isinstance(restarts, (int, np.integer)) or restarts < 0:
@@ -493,7 +577,7 @@ def _pose_solution(figure, model, stack, result, start_deg, tol: float, translat
     # Wrapping free axes changes no link, so the solver's last distances are the pose's.
     residuals = stack.report(result.dist)
     converged = result.status == CONVERGED
-    status = np.array([_STATUS[s] for s in result.status])
+    status = np.array([_STATUS[s] for s in result.status], dtype=object)
     met = (result.dist <= tol) | ~stack.active
     if batched:
         return PoseSolution(
@@ -514,7 +598,7 @@ def _pose_solution(figure, model, stack, result, start_deg, tol: float, translat
         translation=t[0],
         residuals=residuals[0],
         converged=bool(converged[0]),
-        status=str(status[0]),
+        status=status[0],
         iterations=int(result.iterations[0]),
         tolerance=tol,
         weights=stack.weights[0],
@@ -557,7 +641,7 @@ def unmet_goals(figure: Figure, goals: Sequence, solution: PoseSolution) -> tupl
 
 def _limit_sentence(solution: PoseSolution, unmet: Sequence[UnmetGoal]) -> str | None:
     """The sentence that says the iteration limit stopped a solve leaving ``unmet`` goals, or None."""
-    if unmet and solution.status == "limit":
+    if unmet and solution.status == SolveStatus.LIMIT:
         return f"the solver stopped at its iteration limit ({solution.iterations}) before settling."
     return None
 

@@ -54,7 +54,7 @@ from liganimate.runtime.figure.pose import (
 from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
 from liganimate.runtime.render.framing import framing_view
-from liganimate.runtime.render.imagefiles import encode_png, write_png, write_png_bytes
+from liganimate.runtime.render.imagefiles import encode_png, write_png_bytes
 from liganimate.runtime.render.look import DEFAULT_LOOK, draw_modern, look_params
 from liganimate.runtime.render.options import RenderOptions, checked, executor_for
 from liganimate.runtime.render.outputs import OutputLock
@@ -637,11 +637,6 @@ def draw_images(size, draws_list, aa=1, png=True, raw=False, look=DEFAULT_LOOK) 
         image = draw(size, draws, aa, look)
         out.append((encode_png(image) if png else None, image if raw else None))
     return out
-
-
-def draw_image(path, size, draws, aa=1, look=DEFAULT_LOOK) -> None:
-    """Rasterize one image and write it atomically."""
-    write_png(path, draw(size, draws, aa, look))
 
 
 def draw(size, draws, aa=1, look=DEFAULT_LOOK) -> np.ndarray:

@@ -207,7 +207,10 @@ class Framebuffer:
     samples : ndarray, shape (aa H, aa W) or (aa H, aa W, 3), uint8
         The supersampled image so far (updated in place by :meth:`draw`).
     zbuf : ndarray, shape (aa H, aa W), int64
-        Depth keys (see :func:`rasterize_into`); ``EMPTY`` where nothing is drawn.
+        Depth keys; ``EMPTY`` (zero) where nothing is drawn.  A key is the
+        float64 ``1/z`` with its low 32 bits replaced by the triangle's
+        number: the larger key is the nearer surface, or at equal depth the
+        later triangle.
     count : int
         Triangles drawn so far; the next draw's triangles are numbered from here.
     aa : int
@@ -273,49 +276,6 @@ class Framebuffer:
         out = np.full(self.zbuf.shape, np.inf)
         out[drawn] = 1.0 / (self.zbuf[drawn] & _DEPTH_MASK).view(np.float64)
         return out
-
-
-def rasterize_into(zbuf, img, triangles, shade, camera: Camera, cull=None, first_index: int = 0) -> int:
-    """Draw triangles into an existing image and depth buffer.
-
-    Parameters
-    ----------
-    zbuf : ndarray, shape (H, W), int64, C-contiguous
-        Depth keys, updated in place.  Start from all ``EMPTY`` (zero).  A key is
-        the float64 ``1/z`` with its low 32 bits replaced by
-        ``first_index + i``: the larger key is the nearer surface, or at
-        equal depth the later triangle.  All draws into one buffer must
-        use the same camera.
-    img : ndarray, shape (H, W) or (H, W, 3), uint8, C-contiguous
-        The image, updated in place where a triangle wins the depth test.
-    triangles : array_like, shape (N, 3, 3)
-        World-space vertices.
-    shade : array_like, shape (N,) or (N, 3)
-        Grey levels, or colours when ``img`` is RGB, 0..255.
-    camera : Camera
-        The view; ``camera.size`` must be ``(W, H)``.
-    cull : array_like of bool, shape (N,), optional
-        See :func:`rasterize`.
-    first_index : int, optional
-        Number of triangle 0 for the tie rule; pass the previous call's
-        return value so later draws win ties.
-
-    Returns
-    -------
-    int
-        ``first_index + N``: the number to give the next draw.
-    """
-    W, H = camera.size
-    if img.shape[:2] != (H, W) or zbuf.shape != (H, W):
-        raise RenderError(
-            f"The camera's image size {W}x{H} does not match the {img.shape[1]}x{img.shape[0]} image being drawn into."
-        )
-    if not (img.flags.c_contiguous and zbuf.flags.c_contiguous and zbuf.dtype == np.int64 and img.dtype == np.uint8):
-        raise RenderError("The image and depth buffer must be C-contiguous uint8 and int64 arrays.")
-    tris, shade, cull = _check(triangles, shade, cull)
-    if (shade.ndim == 2) != (img.ndim == 3) or img.ndim not in (2, 3) or img.shape[2:] not in ((), (3,)):
-        raise RenderError("Colours need an RGB image, and grey levels a grey one.")
-    return _draw(zbuf, img, tris, shade, camera, cull, first_index)
 
 
 def _draw(zbuf, img, tris, shade, camera, cull, first_index):

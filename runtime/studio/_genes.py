@@ -66,6 +66,8 @@ class JointAxes:
         The extremes per axis.
     locked : ndarray of bool, shape (3,)
         Axes whose extremes are one value (``min == max``): they never move.
+    slide : bool
+        A prismatic joint (SLIDE): its gene is a displacement along its rail.
     """
 
     index: int
@@ -78,6 +80,7 @@ class JointAxes:
     lo: np.ndarray
     hi: np.ndarray
     locked: np.ndarray
+    slide: bool = False
 
 
 def _limb_axis(fig, k: int) -> np.ndarray:
@@ -114,7 +117,19 @@ def joint_axes(fig) -> list:
         ext = np.asarray(joint.extremes, dtype=np.float64)
         lo, hi = ext[:, 0].copy(), ext[:, 1].copy()
         out.append(
-            JointAxes(k, int(joint.id), int(joint.secondary), t, p, f, 1.0 if u[t] >= 0 else -1.0, lo, hi, lo == hi)
+            JointAxes(
+                k,
+                int(joint.id),
+                int(joint.secondary),
+                t,
+                p,
+                f,
+                1.0 if u[t] >= 0 else -1.0,
+                lo,
+                hi,
+                lo == hi,
+                joint.slide,
+            )
         )
     return out
 
@@ -240,6 +255,8 @@ def alternatives(
         Never the seed's own configuration.  Empty when the gene's axes
         for this mode are all locked, or nothing lies within reach.
     """
+    if ax.slide:
+        return _on_rail(ax, seed, mode, first, max_distance, need)
     if mode == "twist" or ax.locked[ax.pivot] or ax.locked[ax.flexion]:
         if mode == "twist":
             free = [ax.twist] if not ax.locked[ax.twist] else []
@@ -278,6 +295,39 @@ def _on_circle(ax: JointAxes, axis: int, seed: np.ndarray, first: bool, max_dist
     values = values[idx][:, None]
     order = _order(level[idx], np.ones(len(idx), dtype=bool), distance[idx], values)
     return Alternatives((axis,), values[order], level[idx][order])
+
+
+#: Levels of the rail's tessellation: level k halves the spacing of level k - 1.
+_RAIL_LEVELS = 6
+
+
+def _on_rail(ax: JointAxes, seed: np.ndarray, mode: str, first: bool, max_distance: float, need: int) -> Alternatives:
+    """A slide's gene: displacements along its first free axis (the flexion mode) or its second (twist).
+
+    Level 0 is the rail's two ends, each further level the midpoints of the
+    last; later generations stay within ``max_distance / 180`` of the rail's
+    length from the seed, as a turn stays within ``max_distance`` degrees.
+    """
+    free = [a for a in range(3) if not ax.locked[a]]
+    pick = 0 if mode != "twist" else 1
+    if len(free) <= pick:
+        return Alternatives((), np.zeros((0, 0)), np.zeros(0, dtype=np.int64))
+    axis = free[pick]
+    lo, hi = float(ax.lo[axis]), float(ax.hi[axis])
+    steps = 2**_RAIL_LEVELS
+    fractions = np.arange(steps + 1) / steps
+    level = np.array([0 if i in (0, steps) else _RAIL_LEVELS - (i & -i).bit_length() + 1 for i in range(steps + 1)])
+    order = np.argsort(level, kind="stable")
+    values, level = np.round(lo + (hi - lo) * fractions[order], _DECIMALS), level[order]
+    s = float(seed[axis])
+    distance = np.abs(values - s)
+    ok = distance > _EPS * max(1.0, hi - lo)
+    if not first:
+        ok &= distance <= max_distance / 180.0 * (hi - lo) + _EPS
+    idx = _coarsest(ok, level, need)
+    vals = values[idx][:, None]
+    ranked = _order(level[idx], np.ones(len(idx), dtype=bool), distance[idx], vals)
+    return Alternatives((axis,), vals[ranked], level[idx][ranked])
 
 
 def _on_sphere(ax: JointAxes, seed: np.ndarray, first: bool, max_distance: float, need: int) -> Alternatives:

@@ -105,7 +105,13 @@ def _model_entry(take, blob: Blob, extent: list) -> dict:
         parent = fig.parent_joint_of(i)
         joint_of_link.append(-1 if parent is None else fig.joint_index(parent.id))
     for j in fig.joints:
-        joints.append({"id": int(j.id), "ext": np.asarray(j.extremes, dtype=np.float64).round(9).tolist()})
+        joints.append(
+            {
+                "id": int(j.id),
+                "ext": np.asarray(j.extremes, dtype=np.float64).round(9).tolist(),
+                "slide": bool(j.slide),  # its values are a displacement, not degrees
+            }
+        )
     return {
         "name": take.name,
         "links": [link.name if link.name is not None else "<anonymous>" for link in fig.links],

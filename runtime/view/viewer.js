@@ -150,8 +150,9 @@
       lines.push('the main link: no joint moves it (tick ' + mark.tick + ')');
     } else {
       var a = m.angles, b = (mark.row * m.J + j) * 3, e = m.joints[j].ext;
-      lines.push('joint ' + m.joints[j].id + ' at tick ' + mark.tick + ': X ' + fmt(a[b]) + '\u00b0  Y ' +
-        fmt(a[b + 1]) + '\u00b0  Z ' + fmt(a[b + 2]) + '\u00b0');
+      var unit = m.joints[j].slide ? '' : '\u00b0';  // a slide's values are a displacement
+      lines.push('joint ' + m.joints[j].id + (m.joints[j].slide ? ' (slide)' : '') + ' at tick ' + mark.tick +
+        ': X ' + fmt(a[b]) + unit + '  Y ' + fmt(a[b + 1]) + unit + '  Z ' + fmt(a[b + 2]) + unit);
       lines.push('extremes: X (' + e[0][0] + ', ' + e[0][1] + ')  Y (' + e[1][0] + ', ' + e[1][1] +
         ')  Z (' + e[2][0] + ', ' + e[2][1] + ')');
     }

@@ -384,8 +384,12 @@ def test_end_inside_an_open_scene_names_the_scene():
 
 
 def test_a_variable_called_like_a_closing_word_is_still_a_variable():
-    parse(MOTION + "ENDMOTION = 1\n")
-    parse(MOTION + "ENDJOINT[1, 2] = FRAME 3 POSITION 0\n")
+    from liganimate.lang import ast as A
+
+    *_, assign = parse(MOTION + "ENDMOTION = 1\n").body
+    assert isinstance(assign, A.Assign) and assign.target.name == "ENDMOTION"
+    *_, key = parse(MOTION + "ENDJOINT[1, 2] = FRAME 3 POSITION 0\n").body
+    assert isinstance(key, A.KeyframeAssign) and key.target.name == "ENDJOINT"
 
 
 def test_a_closing_word_assigned_after_an_expression_is_refused_as_a_name():

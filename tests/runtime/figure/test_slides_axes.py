@@ -169,6 +169,36 @@ def test_ik_forward_axes_and_one_pose_kinematics_honour_axes(seed):
         np.testing.assert_allclose(a, b[0], rtol=0, atol=1e-12)
 
 
+def _crane():
+    return Figure(
+        (Link("BASE", None), Link("CAR", None), Link("ARM", None)),
+        (
+            Joint(1, 0, 1, (0, 0, 0), (0, 0, 0), [(0, 3)], slide=True),
+            Joint(2, 1, 2, (0, 0, 0), (0, -1, 0), [(-170, 170)], axes=frame_from_axis((0, 0, 1))),
+        ),
+    )
+
+
+def test_reach_slides_the_carriage_when_the_arm_alone_cannot_reach():
+    """A slider plus a wrist reaches further: the target is 2.3 from the carriage's start."""
+    fig = _crane()
+    target = np.array([2.5, 0.6, 0.0])
+    sol = solve_pose(fig, [PointGoal(2, target, point=(0, 0, 0))], start=np.array([[0.5, 0, 0], [0, 0, 0]]))
+    assert sol.converged
+    assert 0.0 <= sol.angles[0, 0] <= 3.0 and sol.angles[0, 1] == sol.angles[0, 2] == 0.0
+    X = K.pose_transforms(fig, sol.angles[None])[0]
+    np.testing.assert_allclose(X[2, :3, 3], target, atol=1e-4)
+
+
+def test_reach_stops_a_slide_at_the_end_of_its_rail():
+    fig = _crane()
+    sol = solve_pose(fig, [PointGoal(2, (5.0, 0.0, 0.0), point=(0, 0, 0))], start=np.zeros((2, 3)))
+    assert not sol.converged
+    assert sol.angles[0, 0] == 3.0  # the end of the rail, and the arm stretched towards the target
+    X = K.pose_transforms(fig, sol.angles[None])[0]
+    assert X[2, 0, 3] == pytest.approx(4.0, abs=1e-3)
+
+
 def test_reach_turns_joints_with_axes_and_holds_slides_at_their_start():
     fig = Figure(
         (Link("BASE", None), Link("CAR", None), Link("ARM", None)),
@@ -277,3 +307,18 @@ def test_a_keyframe_beyond_a_slides_extremes_is_refused_at_the_animate():
     # Within range it runs, and in-betweens that overshoot (none do here) would be clamped.
     v, _ = _run(program.replace("POSITION 4, 0, 0", "POSITION 3, 0, 0"))
     assert "M" in v
+
+
+def test_a_slide_is_one_more_gene_of_the_studio():
+    """The studio's alternatives for a slide are displacements along its rail, coarsest first."""
+    from liganimate.runtime.studio import _genes as G
+
+    axes = G.joint_axes(_crane())
+    assert axes[0].slide and not axes[1].slide
+    first = G.alternatives(axes[0], np.array([0.5, 0.0, 0.0]), "flexion", True, 30.0)
+    assert first.axes == (0,)
+    assert list(first.values[:3, 0]) == [0.0, 3.0, 1.5] and list(first.level[:3]) == [0, 0, 1]
+    assert np.all((first.values >= 0.0) & (first.values <= 3.0))
+    later = G.alternatives(axes[0], np.array([0.5, 0.0, 0.0]), "flexion", False, 30.0)
+    assert len(later.values) and np.all(np.abs(later.values - 0.5) <= 0.5 + 1e-9)
+    assert G.alternatives(axes[0], np.array([0.5, 0.0, 0.0]), "twist", True, 30.0).values.size == 0

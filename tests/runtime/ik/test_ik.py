@@ -13,6 +13,7 @@ import pytest
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure.tree import Figure, Joint, Link
+from liganimate.runtime.ik import reach as reach_module
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal
 from liganimate.runtime.ik.model import IKModel
 from liganimate.runtime.ik.reach import solve_pose
@@ -151,6 +152,7 @@ def test_each_solver_reaches_a_reachable_goal(solver):
     target = tip(fig, [[10, 20, 30], [-40, 10, 5], [30, -20, 40], [5, 5, -60]], 4, (0, 1, 0))
     sol = solve_pose(fig, [PointGoal("L4", target, point=(0, 1, 0))], solver=solver, tolerance=1e-6)
     assert sol.status == "converged" and sol.converged
+    assert sol.status is reach_module.SolveStatus.CONVERGED  # an enum member, not a bare string
     assert sol.residuals[0] <= 1e-6
     np.testing.assert_allclose(tip(fig, sol.angles, 4, (0, 1, 0)), target, atol=1e-6)
 

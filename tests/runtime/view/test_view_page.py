@@ -233,3 +233,12 @@ def test_load_errors_read_like_the_command_line(tmp_path):
         liganimate.load(42)
     with pytest.raises(TypeError):
         liganimate.loads(b"      X = 1\n")
+
+
+def test_a_robots_slide_is_marked_so_the_page_shows_its_displacement_without_degrees(tmp_path):
+    out = tmp_path / "arm.html"
+    assert _view(os.path.join(ROOT, "examples", "robot_arm.lig"), "-o", str(out)).returncode == 0
+    manifest, _ = _parts(out.read_text(encoding="utf-8"))
+    (model,) = manifest["scenes"][0]["models"]
+    assert [j["slide"] for j in model["joints"]] == [True, False, False, False]
+    assert model["joints"][0]["ext"][0] == [-1.0, 1.0]
