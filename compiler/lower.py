@@ -16,7 +16,7 @@ import re
 
 from liganimate import __version__
 from liganimate.lang import ast as A
-from liganimate.lang import bindings
+from liganimate.lang import bindings, keyframe_table
 from liganimate.lang import numbers as N
 from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
@@ -81,6 +81,7 @@ class Lowerer(NodeVisitor):
         self.consume = False  # see lower()
         self.canvas = None
         self.tmp = 0
+        self.table_spans: list = []  # (start, end) offsets of keyframe-table rows, left out of the embedded source
         # > 0 inside code that runs many times (DO bodies, scene bodies,
         # primitives): there + - * results are range-checked inline, which
         # runs fastest; elsewhere by a call, which CPython compiles several
@@ -228,7 +229,16 @@ class Lowerer(NodeVisitor):
         self.emit("")
 
     def source_literal(self) -> str:
-        return repr(self.c.program.source)
+        source = self.c.program.source
+        if self.table_spans:
+            # A keyframe table's rows are data the module already carries; the source kept for
+            # diagnostics keeps their lines (so every line number holds) but not their numbers.
+            pieces, last = [], 0
+            for start, end in sorted(self.table_spans):
+                pieces += [source[last:start], "|" + "\n|" * source.count("\n", start, end)]
+                last = end
+            source = "".join(pieces) + source[last:]
+        return repr(source)
 
     # --------------------------------------------------------- primitives
     def primitive(self, pdef: A.PrimitiveDef, sig, scope) -> None:
@@ -360,7 +370,14 @@ class Lowerer(NodeVisitor):
                 kfs.append(f"({self.expr(k.frame)}, {self.position(k.position)}, {method}, {self.at(k)})")
             inner = "".join(x + ", " for x in kfs)
             self.emit(f"    ({self.joint_or_root(j.joint)}, {start}, ({inner}), {self.at(j)}),")
-        self.emit(f"), {self.at(s)})")
+        tables = ""
+        for t in s.tables:
+            # The rows travel as one string of numbers (lang/keyframe_table.py), read in bulk at run time.
+            columns = "".join(self.joint_or_root(c) + ", " for c in t.columns)
+            packed = keyframe_table.pack(t.rows)
+            tables += f"_host.TableArgs(({columns}), {packed!r}, {self.at(t)}), "
+            self.table_spans.append((t.rows_pos.start, t.rows_pos.start + len(t.rows)))
+        self.emit(f"), {self.at(s)}" + (f", ({tables}))" if tables else ")"))
 
     def s_ReachBlock(self, s, where):
         def opt(e):

@@ -10,7 +10,7 @@ by the rules of :mod:`.scopes`.
 from __future__ import annotations
 
 from liganimate.lang import ast as A
-from liganimate.lang import bindings, messages, numbers
+from liganimate.lang import bindings, keyframe_table, messages, numbers
 from liganimate.lang.diagnostics import did_you_mean
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import DRAW_WITH
@@ -89,15 +89,16 @@ class StatementChecker(NodeVisitor):
         for j in s.joints:
             args = j.args
             self.t.joint_args(args, j, in_block=True)
-            if args and const(args[0]) is not None and isinstance(args[0].value, int):
-                if args[0].value in ids:
+            ident = const(args[0]) if args else None
+            if isinstance(ident, int):
+                if ident in ids:
                     self.st.out.error(
                         args[0],
-                        f"joint {args[0].value} appears twice in model {s.name.name}",
-                        f"the first is at line {ids[args[0].value].line}; joint identifiers must be unique",
+                        f"joint {ident} appears twice in model {s.name.name}",
+                        f"the first is at line {ids[ident].line}; joint identifiers must be unique",
                     )
                 else:
-                    ids[args[0].value] = args[0].pos
+                    ids[ident] = args[0].pos
 
     def _s_FigureStmt(self, s, context):
         self.t.want_var(s.model, T.MODEL)
@@ -145,7 +146,7 @@ class StatementChecker(NodeVisitor):
         S.define_as(self.st, s.name, T.MOTION, "{name} is {noun}, not a MOTION")
         seen: dict = {}
         for j in s.joints:
-            self._track_joint(s, j, seen)
+            self._track_joint(s, j.joint, seen)
             if j.start is not None:
                 self._position(j.start, j)
             last = None
@@ -155,27 +156,35 @@ class StatementChecker(NodeVisitor):
                 if c is not None and last is not None and c < last:
                     self.st.out.error(k.frame, messages.keyframes_out_of_order(c, last))
                 last = c if c is not None else last
+        for t in s.tables:
+            for column in t.columns:
+                self._track_joint(s, column, seen)
+            try:
+                t.data = keyframe_table.read_rows(t.rows, t.rows_pos, len(t.columns))
+            except keyframe_table.TableProblem as problem:
+                self.st.out.error(problem.pos, problem.message, problem.hint)
 
-    def _track_joint(self, s, j, seen: dict) -> None:
-        """The JOINT (or ROOT) a track of a STARTMOTION block drives, each at most once."""
-        if isinstance(j.joint, A.RootTrack):
+    def _track_joint(self, s, joint, seen: dict) -> None:
+        """The JOINT (or ROOT) a track of a STARTMOTION block drives (an entry or a table's column), each once."""
+        if isinstance(joint, A.RootTrack):
             if "ROOT" in seen:
                 self.st.out.error(
-                    j.joint,
+                    joint,
                     f"ROOT appears twice in motion {s.name.name}",
                     f"the first is at line {seen['ROOT'].line}; a motion has one root track",
                 )
-            seen["ROOT"] = j.joint.pos
+            seen["ROOT"] = joint.pos
         else:
-            self.t.want(j.joint, T.INTEGER, "a joint identifier")
-        if isinstance(j.joint, A.Num) and const(j.joint) is not None:
-            if j.joint.value in seen:
+            self.t.want(joint, T.INTEGER, "a joint identifier")
+        ident = const(joint)
+        if isinstance(ident, int):
+            if ident in seen:
                 self.st.out.error(
-                    j.joint,
-                    f"joint {j.joint.value} appears twice in motion {s.name.name}",
-                    f"the first is at line {seen[j.joint.value].line}; put all its keyframes under one JOINT",
+                    joint,
+                    f"joint {ident} appears twice in motion {s.name.name}",
+                    f"the first is at line {seen[ident].line}; put all its keyframes under one JOINT",
                 )
-            seen[j.joint.value] = j.joint.pos
+            seen[ident] = joint.pos
 
     # ------------------------------------------------------------- REACH
     def _s_ReachBlock(self, s, context):
@@ -200,7 +209,7 @@ class StatementChecker(NodeVisitor):
             out.error(s.options["MOVE CHAIN"][0], "MOVE JOINTS and MOVE CHAIN both choose the movable joints; keep one")
         if not s.goals:
             out.error(
-                s, f"REACH {s.name.name} has no GOAL", "add a line such as  GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10"
+                s, f"REACH {s.name.name} has no GOAL", "add a line such as GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10"
             )
         for g in s.goals:
             self._goal(g)

@@ -349,9 +349,24 @@ class MotionJoint(Node):
 
 
 @dataclass(slots=True)
+class MotionTable(Node):
+    """``TABLE 1, 2, ROOT`` and its ``| frame x y z ...`` rows: keyframes of several tracks at once.
+
+    ``rows`` is the TABLE_ROWS token's text and ``rows_pos`` where it starts;
+    the checker reads the numbers (lang/keyframe_table.py) into ``data``.
+    """
+
+    columns: list  # of expressions and RootTrack
+    rows: str
+    rows_pos: Pos
+    data: object = None
+
+
+@dataclass(slots=True)
 class MotionBlock(Node):
     name: Name
     joints: list  # of MotionJoint
+    tables: list = field(default_factory=list)  # of MotionTable
 
 
 @dataclass(slots=True)

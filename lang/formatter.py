@@ -49,7 +49,7 @@ CONTINUATION = "    "
 LISTING_MARGIN = " " * 6
 
 # Token types whose spelling is kept as written; every other word is a keyword.
-_AS_WRITTEN = frozenset({"NAME", "CLAUSE_NAME", "PRIM_NAME", "NUMBER", "STRING", "DOLLAR_NAME"})
+_AS_WRITTEN = frozenset({"NAME", "CLAUSE_NAME", "PRIM_NAME", "NUMBER", "STRING", "DOLLAR_NAME", "TABLE_ROWS"})
 # After one of these a + or - is binary; anywhere else it is a sign.
 _OPERAND_ENDS = frozenset({"NUMBER", "NAME", "RPAR", "RSQB", "MORETHAN", "PRIM_NAME", "DOLLAR_NAME", "STRING"})
 _NO_SPACE_AFTER = frozenset({"LPAR", "LSQB", "LESSTHAN"})
@@ -252,6 +252,8 @@ class _Blocks:
             "STARTSCENE": self._startscene,
             "JOINT": self._joint,
             "ROOT": self._root,
+            "TABLE": self._root,
+            "TABLE_ROWS": self._rows,
             "FRAME": self._frame,
             "NAME": self._name,
             "PRIM_NAME": self._name,
@@ -303,7 +305,7 @@ class _Blocks:
         return None if self._type(i - 1) in ("THEN", "ELSE") else len(self.stack)
 
     def _close(self, kind: str):
-        if kind == "MOTION" and self._top() == "JOINT":
+        if kind == "MOTION" and self._top() in ("JOINT", "TABLE"):
             self.stack.pop()
         if self._top() == kind:
             self.stack.pop()
@@ -332,14 +334,20 @@ class _Blocks:
         return self._root(i)
 
     def _root(self, i: int):
-        """A motion's JOINT or ROOT entry: its keyframes are indented under it."""
-        if self._top() not in ("MOTION", "JOINT"):
+        """A motion's JOINT, ROOT or TABLE entry: its keyframes (a table's rows) are indented under it."""
+        if self._top() == "TABLE" and self._type(i - 1) in ("TABLE", "COMMA"):
+            return None  # ROOT among a table's columns
+        if self._top() not in ("MOTION", "JOINT", "TABLE"):
             return None
-        if self._top() == "JOINT":
+        if self._top() in ("JOINT", "TABLE"):
             self.stack.pop()
         depth = len(self.stack)
-        self.stack.append(["JOINT", None])
+        self.stack.append(["TABLE" if self._type(i) == "TABLE" else "JOINT", None])
         return depth
+
+    def _rows(self, i: int):
+        """A keyframe table's rows (one token, written as it is): on lines of their own, under the TABLE."""
+        return len(self.stack)
 
     def _frame(self, i: int):
         return len(self.stack) if self._top() == "JOINT" else None

@@ -26,7 +26,7 @@ from lark.lexer import Token
 from lark.parse_tree_builder import ChildFilterLALR_NoPlaceholders, ExpandSingleChild
 from lark.parsers.lalr_analysis import Shift
 
-from .lexer import DOLLAR, NUMBER, OPERATOR, SCAN, STRING, WORD, Scanner, Tok
+from .lexer import DOLLAR, NUMBER, OPERATOR, ROWS, SCAN, STRING, WORD, Scanner, Tok
 
 
 class _Inlined(tuple):
@@ -128,8 +128,7 @@ class Driver:
     def parse(self, text: str, primitives: frozenset, tokens: list | None = None):
         """Parse ``text``; a NAME in ``primitives`` is a PRIM_NAME. Returns the start rule's value.
 
-        ``tokens``, when given, receives every :class:`~.lexer.Tok` in order, each with the type the
-        parser's state gave it (the formatter, lang/formatter.py, lays a program out by them).
+        ``tokens``, if given, receives every :class:`~.lexer.Tok`, typed as the parser took it (lang/formatter.py).
         """
         actions, rules, chains, scanner, accept = self.actions, self.rules, self._chains, self.scanner, self.end
         keywords, clause_states, choice = scanner.tables.keywords, scanner.clause_states, scanner._choice
@@ -177,6 +176,7 @@ class Driver:
                 column = start - line_start + 1
                 tok = _new_tuple(Tok, (ttype, value, start, line, column, column + end - start, end))
                 pos = end
+                line, line_start = _past_rows(text, start, end, line, line_start) if k == ROWS else (line, line_start)
                 if tokens is not None:
                     tokens.append(tok)
             # ------------------------------------------------ feed it
@@ -230,7 +230,13 @@ class Driver:
 
 
 #: The token types of the scanner's groups that need no decision.
-_FIXED = {STRING: "STRING", DOLLAR: "DOLLAR_NAME"}
+def _past_rows(text: str, start: int, end: int, line: int, line_start: int) -> tuple:
+    """``(line, line_start)`` after a keyframe table's rows, the only token that spans lines."""
+    nl = text.count("\n", start, end)
+    return (line + nl, text.rfind("\n", start, end) + 1) if nl else (line, line_start)
+
+
+_FIXED = {STRING: "STRING", DOLLAR: "DOLLAR_NAME", ROWS: "TABLE_ROWS"}
 
 
 class _Chains(dict):

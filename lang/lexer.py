@@ -43,11 +43,13 @@ SCAN = re.compile(
     + r"|(?P<s>'[^'\n]*')"
     + r"|(?P<d>\$[A-Za-z0-9_]*)"
     + r"|(?P<o>::=|:-|:=|<=|>=|<>|/=|[=<>/;,\[\]+\-*()])"
+    # A keyframe table's rows: a run of lines that start with "|", one token (TABLE_ROWS).
+    + r"|(?P<t>\|[^\n]*+(?:\n[ \t\r\f]*+\|[^\n]*+)*+)"
     + r"|(?P<end>\Z))"
 )
 _NEWLINE = "\n"
 #: SCAN's groups, by number (Match.lastindex).
-WORD, NUMBER, STRING, DOLLAR, OPERATOR, END = range(1, 7)
+WORD, NUMBER, STRING, DOLLAR, OPERATOR, ROWS, END = range(1, 8)
 
 # Operator spellings, longest first, and the terminals each may be (in Lark's order).
 _OPERATORS = {
@@ -89,7 +91,16 @@ class GrammarTables:
         self.contextual: set = set()  # words whose terminal depends on the text after them
         for t in terminals:
             pattern = t.pattern
-            if t.name in ("NAME", "CLAUSE_NAME", "DOLLAR_NAME", "NUMBER", "STRING", "WS", "BRACE_COMMENT"):
+            if t.name in (
+                "NAME",
+                "CLAUSE_NAME",
+                "DOLLAR_NAME",
+                "NUMBER",
+                "STRING",
+                "WS",
+                "BRACE_COMMENT",
+                "TABLE_ROWS",
+            ):
                 continue
             if type(pattern).__name__ == "PatternStr" and pattern.value[:1].isalpha():
                 self.plain[pattern.value.upper()] = t.name
@@ -158,7 +169,7 @@ class Tok(tuple):
     start_pos = property(itemgetter(2))
     line = property(itemgetter(3))
     column = property(itemgetter(4))
-    end_line = property(itemgetter(3))  # a token never spans lines
+    end_line = property(itemgetter(3))  # a token never spans lines (but TABLE_ROWS; see lalr.Driver.parse)
     end_column = property(itemgetter(5))
     end_pos = property(itemgetter(6))
 

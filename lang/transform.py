@@ -275,7 +275,21 @@ class ToAst(Transformer):
         return A.JointStmt(span(children), args, slide, axis)
 
     def motion_block(self, children):
-        return A.MotionBlock(span(children), _name(children[1]), _nodes(children[2:]))
+        items = _nodes(children[2:])
+        joints = [c for c in items if not isinstance(c, A.MotionTable)]
+        tables = [c for c in items if isinstance(c, A.MotionTable)]
+        return A.MotionBlock(span(children), _name(children[1]), joints, tables)
+
+    def motion_table(self, children):
+        rows = children[-1]
+        columns = [c for c in children[1:-1] if not isinstance(c, TOKENS)]
+        return A.MotionTable(span(children), columns, rows.value, _tpos(rows))
+
+    def table_column(self, children):
+        c = children[0]
+        if isinstance(c, TOKENS) and c.type == "ROOT":
+            return A.RootTrack(_tpos(c))
+        return c
 
     def motion_joint(self, children):
         joint = children[1]
@@ -452,7 +466,11 @@ class ToAst(Transformer):
         # The caret ends at the last modifier, as it always has; the text at ">".
         pos = span([target, mods]).widened(target.pos.start, _offsets(gt)[1])
         if isinstance(target, A.Modified):
-            return A.Modified(pos, target.target, target.modifiers + mods)
+            # The parser hands the chain so far to nothing else: extend it in
+            # place, so that a chain of n lists costs n steps, not n*n copies.
+            target.modifiers.extend(mods)
+            target.pos = pos
+            return target
         return A.Modified(pos, target, mods)
 
     def number(self, children):

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from liganimate.lang import messages
+from liganimate.lang import keyframe_table, messages
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
@@ -60,6 +60,20 @@ class Posed:
     def with_figure(self, figure: F.Figure) -> Posed:
         """The same pose on a changed figure (placement, main link...)."""
         return Posed(figure, self.motion, self.frame, self.statement)
+
+
+@dataclass(frozen=True, slots=True)
+class TableArgs:
+    """A keyframe table of a STARTMOTION block, as the compiled module passes it to :meth:`Runtime.motion_block`.
+
+    ``columns`` are the joint identifiers (None for ROOT), ``numbers`` the
+    rows' numbers, blank-separated, deflated and in base 64 (``keyframe_table.pack``;
+    checked by the compiler), ``at`` the table's position index.
+    """
+
+    columns: tuple
+    numbers: str
+    at: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -552,7 +566,7 @@ class Runtime(Arithmetic):
             self.warn(at if w.goal is None else goals[w.goal].at, _sentence(w.sentence), w.hint)
         return block.motion, Vec(*block.translation)
 
-    def motion_block(self, joints, at):
+    def motion_block(self, joints, at, tables=()):
         spec = {}
         for joint, start, kfs, jat in joints:
             if joint in spec:
@@ -573,7 +587,24 @@ class Runtime(Arithmetic):
                 [Keyframe(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
         root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
-        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root))
+        arrays = self._table_tracks(tables, spec, root is not None)
+        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays))
+
+    def _table_tracks(self, tables, spec: dict, has_root: bool) -> dict:
+        """Each table column as ``(start, frames, values)``: its first row is the start, the others keyframes."""
+        arrays: dict = {}
+        for t in tables:
+            width = 1 + 3 * len(t.columns)
+            data = keyframe_table.unpack(t.numbers)
+            if data is None or data.size == 0 or data.size % width:
+                self.fail(t.at, "this keyframe table's rows do not have one frame and three numbers per column")
+            data = data.reshape(-1, width)
+            for n, joint in enumerate(t.columns):
+                if joint in spec or joint in arrays or (joint is None and has_root):
+                    self.fail(t.at, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
+                cols = data[:, 1 + 3 * n : 4 + 3 * n]
+                arrays[joint] = (cols[0], data[1:, 0], cols[1:])
+        return arrays
 
     def concat(self, a, b, at):
         return self._guard(at, M.concat, self._motion(a, at), self._motion(b, at))

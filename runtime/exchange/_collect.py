@@ -82,6 +82,9 @@ class SceneTake:
     backgrounds : list of (object, ndarray of int)
         Each background object (a Graphical or a Figure drawn still) with
         the ticks at which it is in the background.
+    viewed : bool
+        Whether a VIEW statement ran before or during the scene (else the
+        modern look frames it: docs/semantics-render.md, "Default framing").
     """
 
     id: int
@@ -90,6 +93,7 @@ class SceneTake:
     cameras: list = field(default_factory=list)
     models: list = field(default_factory=list)
     backgrounds: list = field(default_factory=list)
+    viewed: bool = False
 
 
 class _Drawn:
@@ -112,6 +116,7 @@ class _SceneRecord:
         self.length = 0
         self.sameframe = 1
         self.cameras: list = []
+        self.viewed = False
         self.drawn: dict = {}
         self.background: dict = {}  # id -> [object, ticks]
 
@@ -145,6 +150,7 @@ class SceneCollector:
         tick = state.tick
         rec.length, rec.sameframe = state.length, state.sameframe
         rec.cameras.append((tuple(float(x) for x in state.view_point), float(state.view_width)))
+        rec.viewed = rec.viewed or bool(getattr(state, "viewed", True))
         for item in state.background:
             entry = rec.background.setdefault(id(item), [item, []])
             entry[1].append(tick)
@@ -216,7 +222,7 @@ def collect(program, warnings: list | None = None) -> list:
 
 
 def _take(rec: _SceneRecord) -> SceneTake:
-    take = SceneTake(rec.id, rec.length, rec.sameframe, rec.cameras)
+    take = SceneTake(rec.id, rec.length, rec.sameframe, rec.cameras, viewed=rec.viewed)
     for d in rec.drawn.values():
         take.models.append(_model_take(d))
     take.backgrounds = [(obj, np.asarray(ticks, dtype=np.int64)) for obj, ticks in rec.background.values()]

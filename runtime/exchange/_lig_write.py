@@ -253,29 +253,50 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
 
     ``path`` (F, 3), if given, is the ROOT track: its start position, then a
     keyframe at every frame if it moves.  ``ids`` are the joints' identifiers
-    (default 1, 2, ...).
+    (default 1, 2, ...).  With a keyframe at every frame (``keep`` None) the
+    moving tracks go into one keyframe table (``TABLE``, docs/language.md
+    4.8), a row a frame; with ``keep``, each joint lists its own keyframes.
     """
     F, J = angles.shape[:2]
     parts = [f"      STARTMOTION {name}\n".encode("ascii")]
     moving = (angles != angles[:1]).any(axis=(0, 2)) if F > 1 else np.zeros(J, dtype=bool)
     if F > 1 and not moving.any():
         moving[0] = True  # keep the motion's length: one joint carries every frame
+    ids = list(range(1, J + 1)) if ids is None else list(ids)
+    root_moves = path is not None and F > 1 and bool((path != path[:1]).any())
+    table = keep is None and F > 1
     frames = np.arange(1, F, dtype=np.float64)
     for j in range(J):
-        if not rotating[j] and not moving[j]:
+        if not rotating[j] and not moving[j] or (table and moving[j]):
             continue
-        jid = j + 1 if ids is None else ids[j]
-        start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {jid} POSITION", suffix="\n")
+        start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {ids[j]} POSITION", suffix="\n")
         parts.append(start)
         if moving[j]:
-            rows = np.arange(1, F) if keep is None else keep[j][keep[j] > 0]
+            rows = keep[j][keep[j] > 0]
             parts.append(_keyframe_rows(frames[rows - 1], angles[rows, j]))
-    if path is not None:
+    if path is not None and not (table and root_moves):
         parts.append(format_rows(path[:1], DECIMALS, sep=",", prefix="        ROOT POSITION", suffix="\n"))
-        if F > 1 and (path != path[:1]).any():
+        if root_moves:
             parts.append(_keyframe_rows(frames, path[1:]))
+    if table:
+        columns = [angles[:, j] for j in range(J) if moving[j]] + ([path] if root_moves else [])
+        names = [str(ids[j]) for j in range(J) if moving[j]] + (["ROOT"] if root_moves else [])
+        parts.append(_table_text(names, np.arange(F, dtype=np.float64), columns))
     parts.append(b"      ENDMOTION\n")
     return b"".join(parts)
+
+
+def _table_text(names: list, frames: np.ndarray, columns: list) -> bytes:
+    """``TABLE 1, 2, ROOT`` and one ``| frame x y z ...`` row per frame (lang/keyframe_table.py)."""
+    head = [f"        TABLE {', '.join(names[:12])}"]
+    for k in range(12, len(names), 12):
+        head[-1] += ","
+        head.append("              " + ", ".join(names[k : k + 12]))
+    legend = "frame, then x y z of " + ", ".join(n if n == "ROOT" else f"JOINT {n}" for n in names)
+    head.append(f"{{ {legend} }}")
+    table = np.column_stack([frames] + columns)
+    rows = format_rows(table, [0] + [DECIMALS] * (table.shape[1] - 1), prefix="          |", suffix="\n")
+    return ("\n".join(head) + "\n").encode("ascii") + rows
 
 
 def motion_library(
@@ -324,6 +345,9 @@ def read_root_path(path: str) -> np.ndarray:
     """
     with open(path, encoding="utf-8") as fh:
         lines = fh.read().split("\n")
+    table = _table_root(lines)
+    if table is not None:
+        return table
     at = next((i for i, line in enumerate(lines) if line.strip().startswith("ROOT POSITION")), None)
     if at is None:
         raise ValueError(f"{path} has no ROOT track")
@@ -335,6 +359,24 @@ def read_root_path(path: str) -> np.ndarray:
         frame, rest = line.split("POSITION", 1)
         rows.append([float(frame.split()[1])] + [float(v) for v in rest.split(",")])
     return np.array(rows, dtype=np.float64)[:, 1:]
+
+
+def _table_root(lines: list):
+    """The ROOT column of a keyframe table written by :func:`_table_text`, or None."""
+    at = next((i for i, line in enumerate(lines) if line.strip().startswith("TABLE ")), None)
+    if at is None:
+        return None
+    names: list = []
+    i = at
+    while i < len(lines) and not lines[i].lstrip().startswith(("{", "|")):
+        names += [w.strip() for w in lines[i].strip().removeprefix("TABLE").split(",") if w.strip()]
+        i += 1
+    if "ROOT" not in names:
+        return None
+    rows = [line.split("|", 1)[1] for line in lines[i:] if line.lstrip().startswith("|")]
+    data = np.array([r.split() for r in rows], dtype=np.float64)
+    k = 1 + 3 * names.index("ROOT")
+    return data[:, k : k + 3]
 
 
 def _wrapped(d: np.ndarray) -> np.ndarray:

@@ -20,7 +20,7 @@ from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
 from liganimate.runtime.motion import path as rp
 from liganimate.runtime.motion import track as tr
-from liganimate.runtime.motion.keyframe import Keyframe
+from liganimate.runtime.motion.keyframe import RAMP, Keyframe
 
 __all__ = [
     "DEFAULT_KEYFRAME_LIMIT",
@@ -122,6 +122,31 @@ def _leaf(joint: int | None, spec) -> tr.Leaf:
     return tr.Leaf(start, frames, positions, methods, ramps)
 
 
+def _array_leaf(joint: int | None, start, frames, values) -> tr.Leaf:
+    """A LINEAR leaf from arrays (a keyframe table's column), checked at once rather than key by key."""
+    who = "the root track" if joint is None else f"joint {joint}"
+    start = _vector(start, f"{who}: start position")
+    frames = np.asarray(frames, dtype=np.float64).reshape(-1)
+    positions = np.asarray(values, dtype=np.float64).reshape(len(frames), 3)
+    if not (np.isfinite(frames).all() and np.isfinite(positions).all()):
+        raise MotionError(f"{who}: a keyframe table holds a number that is not finite")
+    if len(frames) and (frames.min() < 0 or (np.diff(frames) < 0).any()):
+        raise MotionError(f"{who}: a keyframe table's frames must be 0 or more, in order")
+    tr.check_frames(frames, f"{who}: a keyframe list that")
+    everything = np.vstack([start[None, :], positions])
+    if joint is None:
+        far = float(np.max(np.abs(everything)))
+        if not far <= GEOMETRY_MAX:
+            raise MotionError(
+                f"the root track: a position {magnitude(far)} from the origin is beyond the geometry limit, "
+                f"{magnitude(GEOMETRY_MAX)}"
+            )
+    else:
+        tr.check_angles(everything, f"{who}: a position that")
+    linear = interpolation.get("LINEAR")
+    return tr.Leaf(start, frames, positions, (linear,) * len(frames), np.full(len(frames), RAMP))
+
+
 class Motion:
     """An immutable motion: a track per joint, built lazily by the motion algebra.
 
@@ -204,7 +229,9 @@ class Motion:
     # -- construction -----------------------------------------------------
 
     @classmethod
-    def from_tracks(cls, tracks: Mapping[int, tuple], name: str | None = None, root: tuple | None = None) -> Motion:
+    def from_tracks(
+        cls, tracks: Mapping[int, tuple], name: str | None = None, root: tuple | None = None, arrays=None
+    ) -> Motion:
         """Build a motion from explicit keyframes.
 
         Parameters
@@ -218,6 +245,11 @@ class Motion:
             The root track, built as a joint's: ``start`` (None for the
             origin) and keyframes whose positions are displacements of the
             model's main link in the model's own frame.
+        arrays : mapping of (int or None) to (start, frames, values), optional
+            Tracks given as arrays (a keyframe table's columns): ``start``
+            shape (3,), ``frames`` shape (K,), ``values`` shape (K, 3), every
+            keyframe LINEAR with the default ramp; None is the root track.
+            Checked all at once, so a table of 20,000 rows stays fast.
 
         Returns
         -------
@@ -234,6 +266,12 @@ class Motion:
             j = _joint_id(joint)
             leaves[j] = _leaf(j, spec)
         path = None if root is None else _leaf(None, root)
+        for joint, (start, frames, values) in (arrays or {}).items():
+            if joint is None:
+                path = _array_leaf(None, start, frames, values)
+            else:
+                j = _joint_id(joint)
+                leaves[j] = _array_leaf(j, start, frames, values)
         nkeys = sum(len(leaf.frames) for leaf in leaves.values()) + (len(path.frames) if path is not None else 0)
         return cls(leaves, ("keys", name, len(leaves), nkeys), root=path)
 
@@ -258,6 +296,20 @@ class Motion:
     def joints(self) -> tuple[int, ...]:
         """Driven joint ids, sorted."""
         return tuple(self._tracks)
+
+    @property
+    def cycle(self) -> tuple[int, float] | None:
+        """``(n, period)`` when this motion is ``n * a`` (REPEAT) with n >= 2 and a of positive length, else None.
+
+        Copies 1 .. n-2 of such a motion are the same track graph (the first
+        and the last copy differ: they meet a neighbour on one side only), so
+        a frame in a middle copy poses the figure exactly as the frame one
+        period earlier does, as long as the frames subtract exactly.
+        """
+        e = self._expr
+        if e[0] != "*" or e[1] < 2 or self._length <= 0:
+            return None
+        return int(e[1]), self._length / e[1]
 
     @property
     def root(self) -> tr.Track | None:

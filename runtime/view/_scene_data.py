@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from liganimate.runtime.figure.pose import mesh_table, static_triangles, world_transforms
+from liganimate.runtime.render.framing import framing_view
 from liganimate.runtime.values import Graphical, rgb_levels
 
 __all__ = ["Blob", "scene_manifest"]
@@ -161,6 +162,9 @@ def scene_manifest(scenes, blob: Blob) -> list:
         One JSON-ready entry per scene: ``id``, ``length``, ``sameframe``,
         ``cameras`` (per tick: eye x, y, z and VIEW WIDTH, float32),
         ``bounds`` (centre x, y, z and radius of everything drawn),
+        ``framing`` (for a scene that sets no VIEW: the modern look's
+        camera, ``eye``, ``target`` and ``k``, the view width over the
+        distance, framing everything drawn in a 4:3 picture; else None),
         ``models`` and ``backgrounds``.
     """
     out = []
@@ -171,6 +175,12 @@ def scene_manifest(scenes, blob: Blob) -> list:
         backgrounds = [b for b in (_background_entry(o, t, blob, extent) for o, t in take.backgrounds) if b]
         pts = np.concatenate(extent)
         lo, hi = pts.min(axis=0), pts.max(axis=0)
+        framing = None
+        if not take.viewed and len(pts) > 1:
+            drawn = pts[1:]  # without the origin that seeds the extent
+            eye, width, target = framing_view((drawn.min(axis=0), drawn.max(axis=0)), (640, 480))
+            distance = float(np.linalg.norm(np.subtract(eye, target)))
+            framing = {"eye": list(eye), "target": list(target), "k": width / distance}
         centre = (lo + hi) / 2
         radius = float(np.linalg.norm(hi - lo) / 2) or 1.0
         out.append(
@@ -180,6 +190,7 @@ def scene_manifest(scenes, blob: Blob) -> list:
                 "sameframe": int(take.sameframe),
                 "cameras": blob.add(cams, np.float32),
                 "bounds": [float(c) for c in centre] + [radius],
+                "framing": framing,
                 "models": models,
                 "backgrounds": backgrounds,
             }

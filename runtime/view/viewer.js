@@ -59,7 +59,7 @@
     }
     return {
       id: s.id, length: s.length, k: k, images: Math.max(1, Math.ceil(s.length / k)), cams: cams,
-      bounds: s.bounds, models: models, backgrounds: backgrounds, capacity: most * k
+      bounds: s.bounds, framing: s.framing, models: models, backgrounds: backgrounds, capacity: most * k
     };
   });
 
@@ -68,6 +68,10 @@
   var frame = { pos: new Float32Array(0), col: new Uint8Array(0), ranges: [], spans: [] };
 
   function sceneCamera(s, tick) {
+    // A scene without VIEW, in the modern look: framed as `liganimate run` frames it.
+    if (s.framing && renderer.look === 'modern') {
+      return { eye: s.framing.eye.slice(), target: s.framing.target.slice(), k: s.framing.k };
+    }
     var c = s.cams, i = Math.min(tick, c.length / 4 - 1) * 4;
     // A scene of no ticks has no camera: LIG's default VIEW.
     if (i < 0) return { eye: [0, 0, 10], target: [0, 0, 0], k: 1 };

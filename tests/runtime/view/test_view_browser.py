@@ -49,6 +49,17 @@ TWO_SCENES = """\
 """
 
 
+# The README's walk: no VIEW, so the modern look frames it.
+NO_VIEW = """\
+LOAD HUMANOID, WALK FROM 'humanoid'
+INITIALIZE SCENE 1
+STARTSCENE LENGTH 48
+ANIMATE HUMANOID FROM 0 TO 47 USING WALK REPEAT
+ENDSCENE
+SHOOTSCENES
+"""
+
+
 @pytest.fixture(scope="module")
 def pages(tmp_path_factory):
     """Viewer pages and `liganimate run` frames of three programs (five figures shortened to 60 ticks)."""
@@ -56,8 +67,9 @@ def pages(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("view")
     five = Path(FIVE).read_text(encoding="utf-8").replace("STARTSCENE LENGTH 1000", "STARTSCENE LENGTH 60")
     five = re.sub(r"FROM 0 TO 999 ", "FROM 0 TO 59 ", five)
-    sources = {"appendix": APPENDIX, "five": tmp / "five.lig", "two": tmp / "two.lig"}
+    sources = {"appendix": APPENDIX, "five": tmp / "five.lig", "two": tmp / "two.lig", "walk": tmp / "walk.lig"}
     (tmp / "five.lig").write_text(five, encoding="utf-8")
+    (tmp / "walk.lig").write_text(NO_VIEW, encoding="utf-8")
     (tmp / "two.lig").write_text(TWO_SCENES, encoding="utf-8")
     out = {}
     for name, src in sources.items():
@@ -140,6 +152,19 @@ def test_the_modern_look_lights_and_outlines_what_the_thesis_look_draws_flat(pag
     assert (modern < flat[drawn_flat].min() - 20).sum() > 300
     # Lit faces and smoothed edges: many more levels than the flat look's few.
     assert len(np.unique(modern)) > 3 * len(np.unique(flat))
+
+
+def test_a_scene_without_view_is_framed_in_the_modern_look(pages, browser):
+    page, _ = pages["walk"]
+    _open(browser, page, look="thesis")
+    small = _frame(browser, 0, 0)
+    _open(browser, page, look="modern")
+    framed = _frame(browser, 0, 0)
+    rows_small = np.nonzero((small < 250).any(axis=1))[0]
+    rows_framed = np.nonzero((framed < 230).any(axis=1))[0]
+    # The thesis' camera shows the 1.8-unit figure in a view 10 units wide; the framing fills the picture's height.
+    assert rows_small.max() - rows_small.min() < 0.35 * small.shape[0]
+    assert rows_framed.max() - rows_framed.min() > 1.4 * (rows_small.max() - rows_small.min())
 
 
 def test_moving_the_scrubber_changes_the_picture(pages, browser):
