@@ -71,7 +71,7 @@ def _signatures(program: A.Program, report: Report) -> tuple:
             report.error(
                 p.name,
                 f"PRIMITIVE {p.name.name} has no invocation pattern",
-                f"add a line such as  {p.name.name} ::= '{p.name.name}' 'SIZE' S ;",
+                f"add a line such as {p.name.name} ::= '{p.name.name}' 'SIZE' S;",
             )
             continue
         sig, problems = signature_from_pattern(p.name.name, p.pattern)

@@ -30,12 +30,17 @@ def expr_type(types: dict, e) -> str | None:
 
 
 def const(e):
-    """The value of a literal (or a negated one), or None; a literal out of range is reported elsewhere."""
-    if isinstance(e, A.Neg):
-        c = const(e.operand) if isinstance(e.operand, A.Num) else None
-        return -c if c is not None else None
+    """The value of a constant expression (a literal, negated any number of times), or None.
+
+    Every check that looks at a constant goes through here and uses the value
+    it returns, never the node's own fields: ``-1`` is a ``Neg`` node, not a
+    literal.  A literal out of range is reported elsewhere (None here).
+    """
+    sign = 1
+    while isinstance(e, A.Neg):  # a loop, not recursion: the minus signs may be many
+        sign, e = -sign, e.operand
     if isinstance(e, A.Num) and not isinstance(e.value, numbers.BadLiteral):
-        return e.value
+        return e.value if sign > 0 else -e.value
     return None
 
 
@@ -290,7 +295,7 @@ class ExpressionTyper(NodeVisitor):
         t = self.expr(ext)
         if t is not None and t != T.PAIR:
             self.st.out.error(ext, f"joint extremes are pairs (min, max), not {T.NOUN[t]}")
-        elif isinstance(ext, A.Tuple) and all(isinstance(i, (A.Num, A.Neg)) for i in ext.items):
+        elif isinstance(ext, A.Tuple) and len(ext.items) == 2:
             lo, hi = (const(i) for i in ext.items)
             if lo is not None and hi is not None and lo > hi:
                 self.st.out.error(

@@ -89,15 +89,16 @@ class StatementChecker(NodeVisitor):
         for j in s.joints:
             args = j.args
             self.t.joint_args(args, j, in_block=True)
-            if args and const(args[0]) is not None and isinstance(args[0].value, int):
-                if args[0].value in ids:
+            ident = const(args[0]) if args else None
+            if isinstance(ident, int):
+                if ident in ids:
                     self.st.out.error(
                         args[0],
-                        f"joint {args[0].value} appears twice in model {s.name.name}",
-                        f"the first is at line {ids[args[0].value].line}; joint identifiers must be unique",
+                        f"joint {ident} appears twice in model {s.name.name}",
+                        f"the first is at line {ids[ident].line}; joint identifiers must be unique",
                     )
                 else:
-                    ids[args[0].value] = args[0].pos
+                    ids[ident] = args[0].pos
 
     def _s_FigureStmt(self, s, context):
         self.t.want_var(s.model, T.MODEL)
@@ -175,14 +176,15 @@ class StatementChecker(NodeVisitor):
             seen["ROOT"] = joint.pos
         else:
             self.t.want(joint, T.INTEGER, "a joint identifier")
-        if isinstance(joint, A.Num) and const(joint) is not None:
-            if joint.value in seen:
+        ident = const(joint)
+        if isinstance(ident, int):
+            if ident in seen:
                 self.st.out.error(
                     joint,
-                    f"joint {joint.value} appears twice in motion {s.name.name}",
-                    f"the first is at line {seen[joint.value].line}; put all its keyframes under one JOINT",
+                    f"joint {ident} appears twice in motion {s.name.name}",
+                    f"the first is at line {seen[ident].line}; put all its keyframes under one JOINT",
                 )
-            seen[joint.value] = joint.pos
+            seen[ident] = joint.pos
 
     # ------------------------------------------------------------- REACH
     def _s_ReachBlock(self, s, context):
@@ -207,7 +209,7 @@ class StatementChecker(NodeVisitor):
             out.error(s.options["MOVE CHAIN"][0], "MOVE JOINTS and MOVE CHAIN both choose the movable joints; keep one")
         if not s.goals:
             out.error(
-                s, f"REACH {s.name.name} has no GOAL", "add a line such as  GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10"
+                s, f"REACH {s.name.name} has no GOAL", "add a line such as GOAL HAND TO (0.5, 1.0, 0.0) WEIGHT 10"
             )
         for g in s.goals:
             self._goal(g)

@@ -122,6 +122,7 @@ _FRIENDLY = {
 }
 
 _EXPRESSION_STARTS = {"NAME", "NUMBER", "LPAR"}
+_SYMBOLS = frozenset({",", ";", "(", ")", "[", "]", "<", ">", "=", "+", "-", "*", "/", ":", "::="})
 _STATEMENT_STARTS = {"TYPE_KW", "DO", "IF", "STARTMODEL", "STARTMOTION", "ANIMATE", "PRINT"}
 
 
@@ -150,7 +151,9 @@ def _describe_expected(expected: set) -> str:
         parts.append("an expression")
         expected = expected - _EXPRESSION_STARTS - {"MINUS", "PLUS", "PRIM_NAME"}
     for e in sorted(expected):
-        parts.append(_terminal_text(e))
+        text = _terminal_text(e)
+        # A symbol is quoted, as the unexpected token is: "expected ',' or ')'", never "expected , or )".
+        parts.append(repr(text) if text in _SYMBOLS else text)
     if not parts:
         return "something else"
     if len(parts) > 6:

@@ -11,15 +11,45 @@ from __future__ import annotations
 
 from . import ast as A
 from .diagnostics import error
-from .visitor import BLOCKS, too_deep
+from .visitor import BLOCKS, children, too_deep
 
 #: Deeper syntax trees are refused with a diagnostic (no RecursionError may escape).
 MAX_DEPTH = 100
 
 
+class _ModifierLevel:
+    """The first ``count`` modifiers of a modifier chain, as one level of nesting.
+
+    ``A <M1> <M2> <M3>`` is one ``Modified`` node, but its lowering nests one
+    call per modifier (``m3(m2(m1(A)))``), so a long chain is as deep as a
+    deeply nested expression: the depth check walks it as such levels.
+    """
+
+    __slots__ = ("node", "count", "pos")
+
+    def __init__(self, node: A.Modified, count: int) -> None:
+        self.node, self.count = node, count
+        self.pos = node.modifiers[count - 1].pos
+
+
+def _levels(node) -> list:
+    """The nodes one level below ``node`` as the compiled program nests them (modifier chains unrolled)."""
+    if type(node) is A.Modified and len(node.modifiers) > 1:
+        node = _ModifierLevel(node, len(node.modifiers))
+    if type(node) is _ModifierLevel:
+        chain, k = node.node, node.count
+        below = chain.target if k == 1 else _ModifierLevel(chain, k - 1)
+        return [below, chain.modifiers[k - 1]]
+    return children(node)
+
+
 def check_depth(roots: list, source) -> None:
-    """Refuse trees deeper than MAX_DEPTH, iteratively, pointing at the deepest place."""
-    node = too_deep(roots, MAX_DEPTH)
+    """Refuse trees deeper than MAX_DEPTH, iteratively, pointing at the deepest place.
+
+    A chain of modifiers counts one level per modifier, as it nests in the
+    compiled program.
+    """
+    node = too_deep(roots, MAX_DEPTH, inner=_levels)
     if node is not None:
         raise error(
             source.filename,

@@ -15,6 +15,7 @@ runtime's ``fail(at, message, hint)``.
 from __future__ import annotations
 
 import math
+import os
 
 from liganimate.lang import numbers as N
 from liganimate.runtime.values import Vec
@@ -88,9 +89,23 @@ class Arithmetic:
         return a % b
 
     def do_range(self, start, stop, step, at):
-        """The values of a DO loop's variable, produced one at a time (never a list)."""
+        """The values of a DO loop's variable, produced one at a time (never a list).
+
+        A loop of more than :func:`max_loop_trips` passes is refused at its
+        DO statement before its first pass (issue 24: ``DO 10 R = 0.0, 1E18,
+        1E-300`` ran forever).
+        """
         if step == 0:
             self.fail(at, "a DO loop's step cannot be 0")
+        trips = _trips(start, stop, step)
+        limit = max_loop_trips()
+        if trips > limit:
+            shown = f"{trips:.3g}" if trips != math.inf else "endlessly many"
+            self.fail(
+                at,
+                f"this DO loop would make {shown} passes, over the budget of {limit} passes for one loop",
+                f"take a larger step or a shorter range, or raise the budget with {LOOP_TRIPS_ENV}",
+            )
         if isinstance(start, int) and isinstance(stop, int) and isinstance(step, int):
             return range(start, stop + (1 if step > 0 else -1), step)
         return _real_steps(start, stop, step)
@@ -189,6 +204,28 @@ def overflow_error(value, kind) -> N.NumberError:
     if kind[0] == "R" and isinstance(value, int):
         value = math.inf  # a REAL-typed expression holding a huge whole number
     return N.overflow(value, _RESULT.get(kind[-1], "the value of this expression"))
+
+
+#: The environment variable that sets the most passes one DO loop may make.
+LOOP_TRIPS_ENV = "LIGANIMATE_MAX_LOOP_PASSES"
+#: The default budget of passes of one DO loop (a billion passes of Python would take hours).
+DEFAULT_LOOP_TRIPS = 100_000_000
+
+
+def max_loop_trips() -> int:
+    """The most passes one DO loop may make: ``$LIGANIMATE_MAX_LOOP_PASSES`` if it is a whole number, else 10^8."""
+    text = os.environ.get(LOOP_TRIPS_ENV, "").strip()
+    return int(text) if text.isdigit() else DEFAULT_LOOP_TRIPS
+
+
+def _trips(start, stop, step) -> float:
+    """The number of passes of a DO loop, computed before the first (``inf`` when it cannot be counted)."""
+    if isinstance(start, int) and isinstance(stop, int) and isinstance(step, int):
+        return max(0, (stop - start) // step + 1)
+    q = (stop - start + step) / step + 1e-9  # as _real_steps counts them
+    if not q > 0:  # also NaN: no pass, as _real_steps makes
+        return 0
+    return math.floor(q) if q != math.inf else math.inf
 
 
 def _real_steps(start, stop, step):

@@ -140,10 +140,10 @@ def _size(value: Any) -> tuple[int, int]:
             w, h = (int(v) for v in value)
             if (w, h) != tuple(value):
                 raise ValueError
-        if not (0 < w <= 16384 and 0 < h <= 16384):
-            raise ValueError
     except (TypeError, ValueError):
         raise ValueError(f"{value!r} is not a size like 640x480") from None
+    if not (0 < w <= 16384 and 0 < h <= 16384):
+        raise ValueError(f"{value!r} is out of range: width and height are 1 to 16384 pixels each")
     return w, h
 
 

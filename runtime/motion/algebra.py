@@ -298,6 +298,20 @@ class Motion:
         return tuple(self._tracks)
 
     @property
+    def cycle(self) -> tuple[int, float] | None:
+        """``(n, period)`` when this motion is ``n * a`` (REPEAT) with n >= 2 and a of positive length, else None.
+
+        Copies 1 .. n-2 of such a motion are the same track graph (the first
+        and the last copy differ: they meet a neighbour on one side only), so
+        a frame in a middle copy poses the figure exactly as the frame one
+        period earlier does, as long as the frames subtract exactly.
+        """
+        e = self._expr
+        if e[0] != "*" or e[1] < 2 or self._length <= 0:
+            return None
+        return int(e[1]), self._length / e[1]
+
+    @property
     def root(self) -> tr.Track | None:
         """The root path, or None for a motion that does not move the figure."""
         return self._root

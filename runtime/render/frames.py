@@ -33,6 +33,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import json
+import math
 import os
 import signal
 import sys
@@ -74,6 +75,47 @@ _ANGLE_FRAMES = 4096
 # Seconds close() waits for the images being drawn before it kills the workers.
 _CLOSE_WAIT = 30.0
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+# Frames and periods that are multiples of 2**-_DYADIC below 2**_EXACT_BELOW subtract exactly.
+_DYADIC = 20
+_EXACT_BELOW = 31
+
+
+def _dyadic(x: float) -> bool:
+    return abs(x) < 2.0**_EXACT_BELOW and math.ldexp(x, _DYADIC) == round(math.ldexp(x, _DYADIC))
+
+
+def wrapped_frame(frame: float, n: int, period: float) -> float:
+    """The frame of copy 1 of ``n * a`` that poses a figure exactly as ``frame`` does.
+
+    Parameters
+    ----------
+    frame : float
+        A frame of the repeated motion.
+    n, period : int, float
+        Its :attr:`Motion.cycle`.
+
+    Returns
+    -------
+    float
+        ``frame - (k - 1) * period`` when ``frame`` lies strictly inside a
+        middle copy ``k`` (1 <= k <= n - 2) and every frame involved is
+        exact in binary (a multiple of 2**-20 below 2**31, so the track
+        graph's own subtractions give the same local time bit for bit);
+        else ``frame`` itself.  Junction frames, the first and the last copy
+        (each meets a neighbour on one side only) are never wrapped.
+    """
+    if n < 4 or not (_dyadic(frame) and _dyadic(period) and _dyadic(n * period)) or period * n >= 2.0**_EXACT_BELOW:
+        return frame
+    k = math.floor(frame / period)
+    while k * period > frame:
+        k -= 1
+    while (k + 1) * period <= frame:
+        k += 1
+    if k < 2 or k > n - 2 or k * period == frame:
+        return frame
+    return frame - (k - 1) * period
 
 
 class Renderer:
@@ -135,6 +177,7 @@ class Renderer:
         self.futures: list = []  # (future, [(scene id, image number)]), in order
         self._chunk: list = []
         self._angles: dict = {}
+        self.angle_frames = 0  # frames whose joint angles were evaluated (see _joint_angles)
         self.scene_id = None
         self.scene_total = 0
         self.progress = progress if progress is not None else (not options.quiet and sys.stderr.isatty())
@@ -288,11 +331,15 @@ class Renderer:
         self.pending = []
 
     def _joint_angles(self, fig, motion, frames: list) -> np.ndarray:
-        """Clamped joint angles (T, J, 3) at ``frames``, each frame evaluated once per render.
+        """Clamped joint angles (T, J, 3) at ``frames``: a pose table per (model's joints, motion).
 
-        A REPEATed motion comes back to the same frames every period, so
-        angles are remembered per (model's joints, motion, frame); a frame's
-        angles do not depend on which other frames are evaluated with it.
+        Angles are remembered per frame (a frame's angles do not depend on
+        which other frames are evaluated with it).  A REPEATed motion
+        (``n * a``, :attr:`Motion.cycle`) plays its middle copies through the
+        same track graph, so a frame in any of them is looked up under its
+        wrapped frame (:func:`wrapped_frame`): each frame of a period is
+        evaluated once per render, however many periods a scene plays.
+        ``angle_frames`` counts the frames evaluated.
         """
         key = (id(fig.joints), id(motion))
         entry = self._angles.get(key)
@@ -301,14 +348,17 @@ class Renderer:
                 self._angles.clear()
             entry = self._angles[key] = (fig.joints, motion, {})
         memo: dict = entry[2]
-        missing = [f for f in dict.fromkeys(frames) if f not in memo]
+        cycle = motion.cycle
+        keys = frames if cycle is None else [wrapped_frame(f, *cycle) for f in frames]
+        missing = [f for f in dict.fromkeys(keys) if f not in memo]
         if missing:
             if len(memo) + len(missing) > _ANGLE_FRAMES:
                 memo.clear()
-                missing = list(dict.fromkeys(frames))
+                missing = list(dict.fromkeys(keys))
+            self.angle_frames += len(missing)
             for f, row in zip(missing, joint_angles(fig, motion, np.array(missing, dtype=np.float64))):
                 memo[f] = row
-        return np.stack([memo[f] for f in frames])
+        return np.stack([memo[f] for f in keys])
 
     def _write_pose(self, scene, tick, image, name, fig, angles, X) -> None:
         joints = {str(j): [_r(a) for a in angles[k]] for k, j in enumerate(fig.joint_ids)}

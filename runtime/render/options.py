@@ -52,6 +52,59 @@ __all__ = [
 # The largest image side: bounds the memory of one framebuffer up front.
 MAX_SIDE = 16384
 
+#: Bytes one sample (a pixel, or one of its aa x aa parts) costs while an image
+#: is drawn: its colour (3), its depth key (8) and the looks' per-sample
+#: temporaries (depths, outlines, shadow), rounded up.
+BYTES_PER_SAMPLE = 24
+#: The environment variable that sets the memory budget of one image, in MiB.
+MEMORY_ENV = "LIGANIMATE_IMAGE_MEMORY_MB"
+#: The default budget of one image being drawn: 8 GiB (16384 x 16384 pixels without anti-aliasing fit).
+DEFAULT_IMAGE_MEMORY_MB = 8192
+
+
+def image_memory_budget() -> int:
+    """The memory one image may take while drawn, in bytes: ``$LIGANIMATE_IMAGE_MEMORY_MB`` or 8 GiB.
+
+    Raises
+    ------
+    RenderError
+        When the variable is set but is not a whole number of MiB from 1.
+    """
+    text = os.environ.get(MEMORY_ENV)
+    if text is None or not text.strip():
+        return DEFAULT_IMAGE_MEMORY_MB << 20
+    if not text.strip().isdigit() or int(text) < 1:
+        raise RenderError(f"{MEMORY_ENV}={text!r} is not a number of MiB; give a whole number such as 16384")
+    return int(text) << 20
+
+
+def check_image_memory(size: tuple[int, int], aa: int, names: Mapping[str, str]) -> None:
+    """Refuse, before anything is drawn, an image whose ``W x H x aa^2`` samples exceed the memory budget.
+
+    Parameters
+    ----------
+    size : (int, int)
+        Checked width and height.
+    aa : int
+        Checked anti-aliasing factor.
+    names : mapping
+        How the caller spells the options (:data:`CLI_NAMES` or :data:`KEYWORD_NAMES`).
+
+    Raises
+    ------
+    RenderError
+        One sentence naming the estimate, the limit and how to raise it.
+    """
+    need = size[0] * size[1] * aa * aa * BYTES_PER_SAMPLE
+    budget = image_memory_budget()
+    if need > budget:
+        mib = -(-need // (1 << 20))
+        raise RenderError(
+            f"{size[0]}x{size[1]} pixels with {names['aa'].rstrip('=')} {aa} ({aa * aa} samples a pixel) "
+            f"would take about {mib} MiB to draw, over the budget of {budget >> 20} MiB for one image; "
+            f"lower the size or the anti-aliasing, or raise the budget with {MEMORY_ENV}={mib}"
+        )
+
 
 @dataclass(frozen=True)
 class RenderOptions:
@@ -243,6 +296,7 @@ def checked(options: RenderOptions, names: Mapping[str, str] = KEYWORD_NAMES, ma
         preset=check_preset(options.preset, names["preset"]),
         workers=_workers(options.workers, names["workers"]),
     )
+    check_image_memory(result.size, result.aa, names)
     if result.scheduler is not None and not result.scheduler.strip():
         raise RenderError(
             f"{names['scheduler'].rstrip('=')} is empty; give the address of a Dask scheduler, like tcp://host:8786"

@@ -34,14 +34,16 @@ def _print_diagnostics(diags, stream=None) -> None:
 
 
 def _size(text: str):
+    from liganimate.runtime.render.options import MAX_SIDE
+
     try:
         width, height = text.lower().split("x")
         w, h = int(width), int(height)
-        if w <= 0 or h <= 0 or w > 16384 or h > 16384:
-            raise ValueError
-        return w, h
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a size like 640x480") from None
+    if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
+        raise argparse.ArgumentTypeError(f"{text!r} is out of range: width and height are 1 to {MAX_SIDE} pixels each")
+    return w, h
 
 
 def lig_name(text: str) -> str:

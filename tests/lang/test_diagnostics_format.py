@@ -138,7 +138,7 @@ def test_end_of_file_via_the_cli(tmp_path):
     status, err = check_cli(tmp_path, "X = (1 + 2\n")
     assert status == 1
     assert err.splitlines() == [
-        "t.lig:1:11: error: the file ends too early; expected , or )",
+        "t.lig:1:11: error: the file ends too early; expected ',' or ')'",
         "    X = (1 + 2",
         "              ^",
         "  hint: the ( opened at 1:5 is never closed",
@@ -450,4 +450,4 @@ def test_a_syntax_error_via_the_cli_names_no_internal_terminal(tmp_path):
     # Inside a PRIMITIVE its name may start a pattern (P ::= ...), an anonymous terminal.
     status, err = check_cli(tmp_path, "PRIMITIVE P\n  P X\nEND\n")
     assert status == 1
-    assert err.splitlines()[0] == "t.lig:2:5: error: unexpected name X; expected ::="
+    assert err.splitlines()[0] == "t.lig:2:5: error: unexpected name X; expected '::='"

@@ -103,7 +103,7 @@ def test_grammar_programs_keep_their_meaning(rng):
 @pytest.mark.parametrize("generator", [fuzzgen.splice_program, fuzzgen.number_program, fuzzgen.wild_program])
 def test_spliced_and_extreme_programs_keep_their_meaning(generator, fuzz_path):
     formatted = 0
-    for seed in range(40):
+    for seed in range(80):
         text = generator(random.Random(seed))
         try:
             source = prepare(text, fuzz_path)

@@ -46,7 +46,8 @@ def test_every_suffix_chooses_one_format():
             assert X.export_format("a" + s.upper()) is f
     with pytest.raises(ValueError, match="cannot tell the format of film.obj") as caught:
         X.export_format("film.obj")
-    assert caught.value.hint == "write to a file ending in .glb, .gltf or .bvh"
+    assert caught.value.hint == f"write to a file ending in {', '.join(suffixes[:-1])} or {suffixes[-1]}"
+    assert {".glb", ".gltf", ".bvh"} <= set(suffixes)
 
 
 def test_options_are_converted_once_for_text_and_values():
@@ -69,6 +70,8 @@ def test_options_are_converted_once_for_text_and_values():
         X.export_options(glb, {"fps": -1})
     with pytest.raises(ValueError, match=r"--size: \(3\.5, 2\) is not a size like 640x480"):
         X.export_options(glb, {"size": (3.5, 2)})
+    with pytest.raises(ValueError, match="'20000x20' is out of range: width and height are 1 to 16384 pixels each"):
+        X.export_options(glb, {"size": "20000x20"})
     with pytest.raises(ValueError, match="--size does not apply to bvh files"):
         X.export_options(X.export_format("a.bvh"), {"size": (320, 200)})
     with pytest.raises(ValueError, match="no export option 'speed'"):

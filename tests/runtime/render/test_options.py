@@ -107,3 +107,41 @@ def test_the_lock_guards_every_file_the_options_name(tmp_path):
             Renderer(O.RenderOptions(out=str(tmp_path / "g"), gif=str(tmp_path / "a.gif"), quiet=True))
     finally:
         held.close()
+
+
+# ---------------------------------------------------------------- the memory budget (issue 24)
+
+
+def test_an_image_over_the_memory_budget_is_refused_before_anything_is_drawn(tmp_path, monkeypatch):
+    monkeypatch.delenv(O.MEMORY_ENV, raising=False)
+    options = O.RenderOptions(out=str(tmp_path / "out"), size=(16384, 16384), aa=8)
+    with pytest.raises(RenderError) as info:
+        O.checked(options, O.CLI_NAMES)
+    message = str(info.value)
+    assert "16384x16384 pixels with --aa 8 (64 samples a pixel)" in message
+    assert "over the budget of 8192 MiB for one image" in message
+    assert f"{O.MEMORY_ENV}=393216" in message
+    assert not (tmp_path / "out").exists()
+    # The largest side without anti-aliasing fits the default budget.
+    O.checked(dataclasses.replace(options, aa=1), O.CLI_NAMES)
+
+
+def test_the_memory_budget_is_raised_and_lowered_by_its_environment_variable(tmp_path, monkeypatch):
+    options = O.RenderOptions(out=str(tmp_path / "out"), size=(640, 480), aa=2)
+    monkeypatch.setenv(O.MEMORY_ENV, "1")  # 1 MiB: 640 x 480 x 4 samples do not fit
+    with pytest.raises(RenderError, match=r"with aa 2 .* over the budget of 1 MiB"):
+        O.checked(options)
+    monkeypatch.setenv(O.MEMORY_ENV, "100")
+    O.checked(options)
+    monkeypatch.setenv(O.MEMORY_ENV, "lots")
+    with pytest.raises(RenderError, match=f"{O.MEMORY_ENV}='lots' is not a number of MiB"):
+        O.checked(options)
+
+
+def test_a_size_beyond_the_limit_states_the_limit(tmp_path):
+    src = program(tmp_path, 2)
+    r = run("run", str(src), "-o", "out", "--size", "20000x20000", cwd=tmp_path)
+    assert r.returncode == 2
+    assert "'20000x20000' is out of range: width and height are 1 to 16384 pixels each" in r.stderr
+    r = run("run", str(src), "-o", "out", "--size", "big", cwd=tmp_path)
+    assert "'big' is not a size like 640x480" in r.stderr
