@@ -15,6 +15,8 @@ The run is derandomized (the same cases every time) and takes about 15 s.
 
 from __future__ import annotations
 
+import os
+
 from hypothesis import HealthCheck, event, given, settings
 from mutations import SOURCES, example, fuzz, mutated, mutations
 
@@ -27,7 +29,9 @@ def test_the_examples_are_there_and_pass_unmutated():
     names = [name for name, _ in SOURCES]
     assert {"appendix_a.lig", "clock.lig"} <= set(names)
     for name, text in SOURCES:
-        fuzz.compile_and_check(text, name)
+        # The example's own path, so that a LOAD of a library beside it
+        # (robot_arm.lig's 'robots/gantry.lig') resolves as `liganimate check` resolves it.
+        fuzz.compile_and_check(text, os.path.join(fuzz.EXAMPLES, name))
 
 
 def test_mutations_change_the_text():
