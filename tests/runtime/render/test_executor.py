@@ -70,9 +70,11 @@ def test_bad_aa_is_refused_before_compiling(tmp_path, value):
         text=True,
         cwd=tmp_path,
     )
-    assert r.returncode == 1
-    assert r.stderr == (
-        f"liganimate: error: --aa {value} is not an anti-aliasing factor; give a whole number from 1 (none) to 8\n"
+    # A value no run could take is a usage error: exit 2, the usage line, then the sentence.
+    assert r.returncode == 2
+    assert r.stderr.startswith("usage: liganimate run ")
+    assert r.stderr.endswith(
+        f"liganimate run: error: --aa {value} is not an anti-aliasing factor; give a whole number from 1 (none) to 8\n"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == [src.name]
 
@@ -178,5 +180,5 @@ def test_scheduler_without_dask_says_how_to_install_it(tmp_path):
             env["LIGANIMATE_SCHEDULER"] = "tcp://127.0.0.1:1"
         r = run_env(tmp_path, *args, env=env)
         assert r.returncode == 1, r.stderr
-        assert r.stderr == "liganimate: error: Dask is not installed: pip install 'liganimate[dask]'\n"
+        assert r.stderr == "liganimate: error: dask is not installed: pip install 'liganimate[dask]'\n"
         assert not (tmp_path / "out").exists()

@@ -31,7 +31,7 @@ def tree(folder) -> list:
 
 
 BAD_OPTIONS = [
-    (["--gif", "{tmp}"], "--gif {tmp} is a folder, not a file"),
+    (["--gif", "sub.gif"], "--gif sub.gif is a folder, not a file"),
     (["--gif", "missing/x.gif"], "--gif missing/x.gif cannot be written: the folder missing does not exist"),
     (["--mp4", "missing/x.mp4"], "--mp4 missing/x.mp4 cannot be written: the folder missing does not exist"),
     (["--poses", "missing/p.jsonl"], "--poses missing/p.jsonl cannot be written: the folder missing does not exist"),
@@ -40,23 +40,47 @@ BAD_OPTIONS = [
     (["-o", "bad.lig"], "-o bad.lig is a file, not a folder"),
     (["-o", "bad.lig/frames"], "-o bad.lig/frames cannot be created: {tmp}/bad.lig is a file, not a folder"),
     (["--gif", "a.gif", "--poses", "a.gif"], "--poses and --gif both name a.gif; give each its own file"),
-    (["-o", "f", "--gif", "f"], "--gif f is the frames folder (-o f); give another file name"),
-    (["--gif", "/dev/null"], "--gif /dev/null exists and is not a regular file"),
-] + [
+    (["-o", "f.gif", "--gif", "f.gif"], "--gif f.gif is the frames folder (-o f.gif); give another file name"),
+    (["--gif", "fifo.gif"], "--gif fifo.gif exists and is not a regular file"),
+]
+
+# A value no run could take is a usage error: exit 2, the usage line, then the sentence.
+BAD_VALUES = [
     ([f"--fps={v}"], f"--fps {v} is not a usable frame rate; give a number of frames per second from 0.01 to 1000")
     for v in ["0", "-2", "nan", "inf", "-inf", "abc", "1e-9", "1e9"]
+] + [
+    (["--gif", "{tmp}"], "the file of --gif must end in .gif (it is a GIF), not '{tmp}'"),
+    (["--gif", "out.png"], "the file of --gif must end in .gif (it is a GIF), not 'out.png'"),
 ]
+
+
+def _bad_run_folder(tmp_path):
+    """A program with an error on line 1, and the files the bad options name."""
+    (tmp_path / "bad.lig").write_text("X = (1 +\n")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub.gif").mkdir()
+    os.mkfifo(tmp_path / "fifo.gif")
 
 
 @pytest.mark.parametrize("args, message", BAD_OPTIONS, ids=[" ".join(a) for a, _ in BAD_OPTIONS])
 def test_bad_output_options_are_refused_before_compiling(tmp_path, args, message):
     # The program has an error on line 1: the option is refused first, so it was never compiled.
-    (tmp_path / "bad.lig").write_text("X = (1 +\n")
-    (tmp_path / "sub").mkdir()
+    _bad_run_folder(tmp_path)
     before = tree(tmp_path)
     r = run("run", "bad.lig", *[a.format(tmp=tmp_path) for a in args], cwd=tmp_path)
     assert r.returncode == 1, r.stderr
     assert r.stderr == f"liganimate: error: {message.format(tmp=tmp_path)}\n"
+    assert tree(tmp_path) == before
+
+
+@pytest.mark.parametrize("args, message", BAD_VALUES, ids=[" ".join(a) for a, _ in BAD_VALUES])
+def test_bad_option_values_are_usage_errors(tmp_path, args, message):
+    _bad_run_folder(tmp_path)
+    before = tree(tmp_path)
+    r = run("run", "bad.lig", *[a.format(tmp=tmp_path) for a in args], cwd=tmp_path)
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith("usage: liganimate run ")
+    assert r.stderr.endswith(f"liganimate run: error: {message.format(tmp=tmp_path)}\n")
     assert tree(tmp_path) == before
 
 

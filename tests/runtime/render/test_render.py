@@ -171,7 +171,7 @@ def test_mp4_without_ffmpeg_is_refused_before_anything_is_written(tmp_path):
         src, "--mp4", "a.mp4", "--gif", "a.gif", "--poses", "p.jsonl", cwd=tmp_path, env=no_ffmpeg_env(tmp_path)
     )
     assert r.returncode == 1
-    assert "liganimate: error: MP4 output needs the ffmpeg program, and none was found." in r.stderr
+    assert "liganimate: error: MP4 output needs the ffmpeg program, and none was found\n" in r.stderr
     assert "hint: pip install imageio-ffmpeg" in r.stderr
     assert "Traceback" not in r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == [src.name]  # no frames, no GIF, no pose record, no temp

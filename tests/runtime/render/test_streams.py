@@ -138,9 +138,11 @@ def test_the_same_program_gives_the_same_mp4_bytes(tmp_path):
 def test_bad_crf_or_preset_is_refused_before_compiling(tmp_path, args, message):
     src = program(tmp_path, 4)
     r = run("run", str(src), "--mp4", "a.mp4", *args, cwd=tmp_path)
-    assert r.returncode == 1
-    assert r.stderr.startswith(f"liganimate: error: {message}")
-    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+    # A value no encoder could take is a usage error: exit 2, the usage line, then the sentence.
+    assert r.returncode == 2
+    assert r.stderr.startswith("usage: liganimate run ")
+    last = r.stderr.splitlines()[-1]
+    assert last.startswith(f"liganimate run: error: {message}") and "Traceback" not in r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == [src.name]
 
 
