@@ -36,7 +36,7 @@ KEYWORDS = (
     "PRIMITIVE", "PRINT", "REPEAT", "ROOT", "ROT", "SAMEFRAME", "SCALE", "SCENE", "SHOOTSCENE", "SHOOTSCENES",
     "SLIDE",
     "SOLVER", "STARTMODEL", "STARTMOTION", "STARTREACH", "STARTSCENE", "STRIP", "SYNCHRONISE", "SYNCHRONIZE",
-    "TO", "TOLERANCE", "TRANS", "TRANSLATE", "USING", "VIEW", "WEIGHT", "WIDTH", "WITH", "X", "Y", "Z",
+    "TABLE", "TO", "TOLERANCE", "TRANS", "TRANSLATE", "USING", "VIEW", "WEIGHT", "WIDTH", "WITH", "X", "Y", "Z",
 )  # fmt: skip
 #: The word operator.
 WORD_OPERATORS = ("MOD",)
@@ -89,7 +89,8 @@ class LigLexer(RegexLexer):
             (words(CONSTANTS, prefix=_WORD_START, suffix=_WORD_END), Name.Constant),
             (r"[A-Za-z][A-Za-z0-9_]*", Name),
             (r"::=|:-|:=|<=|>=|<>|/=|[=<>/+\-*]", Operator),
-            (r"[;,\[\]()]", Punctuation),
+            # The bar that starts each row of a keyframe table (TABLE ... then | rows).
+            (r"[;,\[\]()|]", Punctuation),
         ],
     }
 
