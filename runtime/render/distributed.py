@@ -283,9 +283,20 @@ def _probe(address: str, timeout: float) -> None:
             f"{address!r} is not a Dask scheduler address; give one like tcp://host:8786", _HINT
         ) from None
     try:
-        socket.create_connection((host, port), timeout=timeout).close()
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            # A Dask server writes its handshake as soon as it accepts; an
+            # endpoint that accepts and stays silent would keep Dask's client
+            # waiting without end, so its first answer is awaited here, bounded.
+            sock.settimeout(timeout)
+            first = sock.recv(1)
+    except TimeoutError:
+        raise RenderError(
+            f"the Dask scheduler at {address} accepted the connection but did not answer in {timeout:g} s", _HINT
+        ) from None
     except OSError as exc:
         raise RenderError(f"cannot reach the Dask scheduler at {address}: {_why(exc)}", _HINT) from None
+    if not first:
+        raise RenderError(f"cannot reach the Dask scheduler at {address}: the connection closed", _HINT)
 
 
 def _why(exc: BaseException) -> str:

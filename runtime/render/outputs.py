@@ -128,6 +128,15 @@ def check_outputs(options: RenderOptions, names: Mapping[str, str], make_poses_f
         seen[real] = opt
 
 
+def _why_not_writable(folder: str) -> str:
+    """Why ``folder`` refuses writes: a read-only file system (EROFS) or a permission, said as such."""
+    try:
+        read_only = bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
+    except (OSError, AttributeError):  # no statvfs (Windows): the permission is all there is to say
+        read_only = False
+    return "the file system is read-only (EROFS)" if read_only else "permission denied"
+
+
 def _check_folder(path: str, opt: str) -> None:
     if not path:
         raise RenderError(f"{opt} is empty; give a folder for the frames")
@@ -143,7 +152,7 @@ def _check_folder(path: str, opt: str) -> None:
     elif not os.path.isdir(probe):
         raise RenderError(f"{opt} {path} cannot be created: {probe} is a file, not a folder")
     if not os.access(probe, os.W_OK | os.X_OK):
-        raise RenderError(f"{opt} {path} cannot be written: permission denied for {probe}")
+        raise RenderError(f"{opt} {path} cannot be written: {_why_not_writable(probe)} for {probe}")
 
 
 def _check_file(path: str, opt: str, out_dir) -> None:
@@ -162,7 +171,7 @@ def _check_file(path: str, opt: str, out_dir) -> None:
         what = "is not a folder" if os.path.lexists(folder) else "does not exist"
         raise RenderError(f"{opt} {path} cannot be written: the folder {shown} {what}")
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise RenderError(f"{opt} {path} cannot be written: permission denied for the folder {shown}")
+        raise RenderError(f"{opt} {path} cannot be written: {_why_not_writable(folder)} for the folder {shown}")
 
 
 def lock_path_of(target: str, folder: bool) -> str:

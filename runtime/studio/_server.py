@@ -223,14 +223,13 @@ class _Handler(BaseHTTPRequestHandler):
         if ctype != "application/json":
             self.close_connection = True
             return self._error(415, "send the action as application/json")
-        length = self.headers.get("Content-Length")
-        if self.headers.get("Transfer-Encoding") or length is None:
+        lengths = self.headers.get_all("Content-Length") or []
+        if self.headers.get("Transfer-Encoding") or not lengths:
             self.close_connection = True
             return self._error(411, "say the body's length with Content-Length")
-        try:
-            n = int(length)
-        except ValueError:
-            n = -1
+        # Strict: one Content-Length of ASCII digits only (int() would take "+2", "0_2" or " 2").
+        text = lengths[0].strip(" \t")
+        n = int(text) if len(lengths) == 1 and text.isascii() and text.isdigit() else -1
         if n < 0:
             self.close_connection = True
             return self._error(400, "Content-Length is not a length")
@@ -240,7 +239,7 @@ class _Handler(BaseHTTPRequestHandler):
         raw = self.rfile.read(n)
         try:
             body = json.loads(raw.decode("utf-8"))
-        except (UnicodeDecodeError, ValueError):
+        except (UnicodeDecodeError, ValueError, RecursionError):  # 60,000 "[" nest past Python's stack
             return self._error(400, "the body is not JSON")
         try:
             state = self.server.session.act(body)

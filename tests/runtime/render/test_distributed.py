@@ -184,6 +184,18 @@ def test_an_unreachable_scheduler_is_one_sentence_and_nothing_is_written(tmp_pat
     assert not (tmp_path / "out").exists()
 
 
+def test_a_scheduler_that_accepts_and_stays_silent_is_refused_within_the_connect_timeout():
+    # Issue 24: an endpoint that accepts and never answers kept the run waiting without end.
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen(4)
+        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+        with pytest.raises(RenderError) as err:
+            DaskExecutor(address, connect_timeout=0.5)
+    assert err.value.message == (f"the Dask scheduler at {address} accepted the connection but did not answer in 0.5 s")
+    assert err.value.hint
+
+
 @pytest.mark.parametrize("address", ["foo://somewhere:8786", "tcp://host:port", "no.such.host.invalid:8786"])
 def test_a_bad_scheduler_address_is_a_render_error(address):
     with pytest.raises(RenderError) as err:

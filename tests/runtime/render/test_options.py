@@ -145,3 +145,23 @@ def test_a_size_beyond_the_limit_states_the_limit(tmp_path):
     assert "'20000x20000' is out of range: width and height are 1 to 16384 pixels each" in r.stderr
     r = run("run", str(src), "-o", "out", "--size", "big", cwd=tmp_path)
     assert "'big' is not a size like 640x480" in r.stderr
+
+
+def test_a_read_only_file_system_is_reported_as_such_not_as_a_permission(tmp_path, monkeypatch):
+    from liganimate.runtime.render import outputs
+
+    real_statvfs = os.statvfs
+
+    class ReadOnly:
+        def __init__(self, path):
+            self.f_flag = real_statvfs(path).f_flag | os.ST_RDONLY
+
+    monkeypatch.setattr(outputs.os, "access", lambda path, mode: False)
+    monkeypatch.setattr(outputs.os, "statvfs", ReadOnly)
+    with pytest.raises(RenderError, match="the file system is read-only \\(EROFS\\)"):
+        O.checked(O.RenderOptions(out=str(tmp_path / "out")), O.CLI_NAMES)
+    with pytest.raises(RenderError, match="the file system is read-only \\(EROFS\\) for the folder"):
+        O.checked(O.RenderOptions(gif=str(tmp_path / "a.gif")), O.CLI_NAMES)
+    monkeypatch.setattr(outputs.os, "statvfs", real_statvfs)
+    with pytest.raises(RenderError, match="permission denied"):
+        O.checked(O.RenderOptions(out=str(tmp_path / "out")), O.CLI_NAMES)

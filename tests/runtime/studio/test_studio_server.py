@@ -145,6 +145,7 @@ def test_paths_outside_its_files_are_404(server, path):
         (json.dumps({"action": "next", "mode": "sideways"}), "mode"),
         ('{"action": "next", "intensity": NaN}', "intensity"),
         (b"\xff\xfe{}", "not JSON"),
+        ("[" * 60_000, "not JSON"),  # issue 24: a RecursionError was a 500
     ],
 )
 def test_bad_requests_are_400_and_change_nothing(server, body, why):
@@ -288,3 +289,15 @@ def test_a_program_file_and_its_models(tmp_path):
         timeout=120,
     )
     assert r.returncode == 1 and "bad.lig:1:" in r.stderr and "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize("lengths", [["+2"], ["0_2"], ["2", "3"], ["2", "2"], ["\u0662"]])
+def test_a_content_length_must_be_one_and_digits_only(server, lengths):
+    # Issue 24: "+2" and "0_2" parsed as lengths, and two different headers were accepted.
+    head = "".join(f"Content-Length: {n}\r\n" for n in lengths)
+    start = f"POST /api/action HTTP/1.1\r\nHost: 127.0.0.1:{server.port}\r\nContent-Type: application/json\r\n"
+    payload = (start + head + "\r\n{}").encode("utf-8")
+    answer = _raw(server, payload)
+    assert answer.startswith(b"HTTP/1.1 400 ") or answer.startswith(b"HTTP/1.0 400 "), answer[:80]
+    assert b"Content-Length is not a length" in answer
+    _alive(server)
