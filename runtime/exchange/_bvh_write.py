@@ -33,6 +33,7 @@ from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure.kinematics import joint_transforms, matrix_from_euler_zyx
 from liganimate.runtime.values import Graphical
 
+from ._names import own_names
 from ._numbers import format_rows
 from ._rotations import decompose_trs, euler_from_matrix
 
@@ -46,24 +47,7 @@ _POSITIONS = ("Xposition", "Yposition", "Zposition")
 
 def _joint_names(fig) -> list:
     """A BVH name per link: its source name, else its own name where unique, else with its joint id."""
-    counts: dict = {}
-    for l in fig.links:
-        if l.name is not None:
-            counts[l.name.upper()] = counts.get(l.name.upper(), 0) + 1
-    names = []
-    for i, l in enumerate(fig.links):
-        if l.source is not None:
-            names.append(l.source.name)
-            continue
-        up = fig.parent_joint_of(i)
-        if l.name is None or l.name.startswith("<"):
-            base = "SEGMENT"
-        else:
-            base = re.sub(r"[^A-Za-z0-9_]", "_", l.name.upper())
-        if l.name is None or counts.get(l.name.upper(), 0) > 1 or l.name.startswith("<"):
-            base = f"{base}_{up.id}" if up is not None else f"{base}_ROOT"
-        names.append(base)
-    return names
+    return own_names(fig, lambda name: re.sub(r"[^A-Za-z0-9_]", "_", name.upper()), "_")
 
 
 def _end_site(fig, i: int, far: np.ndarray) -> np.ndarray:

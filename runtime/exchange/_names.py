@@ -13,7 +13,45 @@ from __future__ import annotations
 
 from liganimate.runtime.values import Graphical
 
-__all__ = ["added_origin", "joint_names", "link_names"]
+__all__ = ["added_origin", "joint_names", "link_names", "own_names"]
+
+
+def own_names(fig, spell, sep: str) -> list[str]:
+    """Per link of ``fig``: its source's name, else ``spell(name)``, with the joint id where not unique.
+
+    The rule every exporter follows (glTF with ``spell=str, sep=" "``, BVH
+    with names cut to its alphabet and ``sep="_"``); the names are not made
+    distinct (:func:`link_names` does that for glTF).
+
+    Parameters
+    ----------
+    fig : Figure
+    spell : callable
+        A LIG link name to the exporter's spelling of it.
+    sep : str
+        What stands between a name and the id of the joint that attaches it
+        (``ROOT`` for the original main link).
+
+    Returns
+    -------
+    list of str
+    """
+    counts: dict = {}
+    for l in fig.links:
+        if l.name is not None:
+            counts[l.name.upper()] = counts.get(l.name.upper(), 0) + 1
+    names = []
+    for i, l in enumerate(fig.links):
+        if l.source is not None:
+            names.append(l.source.name)
+            continue
+        named = l.name is not None and not l.name.startswith("<")
+        base = spell(l.name) if named else "SEGMENT"
+        if not named or counts.get(l.name.upper(), 0) > 1:
+            up = fig.parent_joint_of(i)
+            base = f"{base}{sep}{up.id}" if up is not None else f"{base}{sep}ROOT"
+        names.append(base)
+    return names
 
 
 def link_names(fig) -> list[str]:
@@ -31,21 +69,7 @@ def link_names(fig) -> list[str]:
         name followed by `` <joint id>`` of the joint that attaches it (``ROOT``
         for the original main link); ``SEGMENT <joint id>`` for an unnamed link.
     """
-    counts: dict = {}
-    for l in fig.links:
-        if l.name is not None:
-            counts[l.name.upper()] = counts.get(l.name.upper(), 0) + 1
-    names = []
-    for i, l in enumerate(fig.links):
-        if l.source is not None:
-            names.append(l.source.name)
-            continue
-        named = l.name is not None and not l.name.startswith("<")
-        base = l.name if named else "SEGMENT"
-        if not named or counts.get(l.name.upper(), 0) > 1:
-            up = fig.parent_joint_of(i)
-            base = f"{base} {up.id}" if up is not None else f"{base} ROOT"
-        names.append(base)
+    names = own_names(fig, str, " ")
     taken: set = set()
     for i, name in enumerate(names):
         # Two links called FOOT and a third called "FOOT 4" could still meet.
