@@ -103,12 +103,20 @@ def _extra(row) -> list:
     return [joint, None if rpy is None else list(rpy), None if mimic is None else list(mimic)]
 
 
-def _extra_back(row) -> tuple:
-    """:func:`_extra` read back (a row cached before the columns existed has neither)."""
+def _row_back(row) -> tuple:
+    """A name-table row read back from the cache, as ``lang.name_table`` reads it from the text.
+
+    A row with no joint name, RPY or MIMIC is the three values alone there,
+    so it is here too: a library must lower to the same module whether it
+    came from the cache or was compiled afresh.
+    """
+    base = (row[0], tuple(row[1]), None if row[2] is None else tuple(row[2]))
     joint = row[3] if len(row) > 3 else None
     rpy = row[4] if len(row) > 4 else None
     mimic = row[5] if len(row) > 5 else None
-    return (joint, None if rpy is None else tuple(rpy), None if mimic is None else tuple(mimic))
+    if joint is None and rpy is None and mimic is None:
+        return base
+    return (*base, joint, None if rpy is None else tuple(rpy), None if mimic is None else tuple(mimic))
 
 
 def stdlib_dir() -> Path:
@@ -302,10 +310,7 @@ def _from_json(obj: dict) -> Library:
         signatures=sigs,
         descriptions=dict(obj["descriptions"]),
         warnings=warnings,
-        names={
-            m: {k: (v[0], tuple(v[1]), None if v[2] is None else tuple(v[2]), *_extra_back(v)) for k, v in rows.items()}
-            for m, rows in obj.get("names", {}).items()
-        },
+        names={m: {k: _row_back(v) for k, v in rows.items()} for m, rows in obj.get("names", {}).items()},
         deps=tuple((p, h) for p, h in obj["deps"]),
         scenes=bool(obj["scenes"]),
     )

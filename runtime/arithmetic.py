@@ -100,7 +100,7 @@ class Arithmetic:
         trips = _trips(start, stop, step)
         limit = max_loop_trips()
         if trips > limit:
-            shown = f"{trips:.3g}" if trips != math.inf else "endlessly many"
+            shown = N.magnitude(float(trips)) if trips != math.inf else "endlessly many"
             self.fail(
                 at,
                 f"this DO loop would make {shown} passes, over the budget of {limit} passes for one loop",

@@ -315,3 +315,25 @@ def test_a_failing_library_is_reported_once_at_its_load():
         compile_text("LOAD X FROM 'no_such_library'\nY = 1\n")
     found = [d for d in info.value.diagnostics if "no_such_library" in d.message]
     assert len(found) == 1 and found[0].pos.line == 1
+
+
+def test_a_library_from_the_cache_lowers_as_one_compiled_afresh(tmp_path):
+    # robot_arm.lig LOADs a URDF import whose name table has rows with and
+    # without joint columns; read back from the cache, a row without them
+    # used to gain three Nones, so the module changed with the cache's state.
+    import os
+
+    example = pathlib.Path(__file__).resolve().parents[2] / "examples" / "robot_arm.lig"
+    env = {**os.environ, "LIGANIMATE_CACHE": str(tmp_path / "cache")}
+    texts = []
+    for run in ("miss", "hit", "no cache"):
+        if run == "no cache":
+            env["LIGANIMATE_CACHE"] = ""
+        out = tmp_path / f"{run.replace(' ', '_')}.py"
+        r = cli("compile", str(example), "-o", str(out), env=env)
+        assert r.returncode == 0, r.stderr
+        texts.append(out.read_text())
+        if run == "miss":
+            assert any((tmp_path / "cache").rglob("*.json")), "the first compile stores the library"
+    assert texts[0] == texts[1] == texts[2]
+    assert "'RAIL': ('rail', (), None)," in texts[0]

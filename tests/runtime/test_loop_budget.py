@@ -32,7 +32,7 @@ def test_an_integer_loop_over_the_budget_is_refused_and_the_budget_can_be_change
     )
     monkeypatch.setenv(arithmetic.LOOP_TRIPS_ENV, "999")
     d = refused(text)
-    assert d.message == "this DO loop would make 1e+03 passes, over the budget of 999 passes for one loop"
+    assert d.message == "this DO loop would make 1000 passes, over the budget of 999 passes for one loop"
     monkeypatch.setenv(arithmetic.LOOP_TRIPS_ENV, "1000")
     program, _ = load_program(text=text, name="t.lig")
     program.check()

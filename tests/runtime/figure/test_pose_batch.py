@@ -107,6 +107,7 @@ def test_renderer_memory_of_frames_changes_nothing():
     m = motions()[1]
     r = Renderer.__new__(Renderer)
     r._angles = {}
+    r.angle_frames = 0
     frames = [0.0, 1.5, 3.0, 0.0, 7.0, 1.5, 20.0, 3.0]
     first = r._joint_angles(fig, m, frames)
     np.testing.assert_array_equal(first, pose.joint_angles(fig, m, np.array(frames)))
