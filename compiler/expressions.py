@@ -19,7 +19,7 @@ from . import types as T
 from .scopes import State, animated_here, unknown
 
 
-def expr_type(types: dict, e) -> str | None:
+def expr_type(types: dict, e) -> T.Type | None:
     """The type the checker settled for expression ``e`` (``types`` is :attr:`Checked.types`).
 
     Literals are not in the table: a literal's type follows from its value.
@@ -56,7 +56,7 @@ class ExpressionTyper(NodeVisitor):
         self.st = state
 
     # ------------------------------------------------------------ wants
-    def want(self, e, t: str, what: str) -> None:
+    def want(self, e, t: T.Type, what: str) -> None:
         """Type ``e`` and report it unless it fits a ``t`` (an INTEGER fits a REAL)."""
         got = self.expr(e)
         if got is None:
@@ -73,7 +73,7 @@ class ExpressionTyper(NodeVisitor):
         if got is not None and not T.is_numeric(got):
             self.st.out.error(e, f"{what} must be a number, not {T.NOUN[got]}")
 
-    def want_var(self, name: A.Name, t: str, what: str | None = None) -> None:
+    def want_var(self, name: A.Name, t: T.Type, what: str | None = None) -> None:
         """``name`` must be a variable of type ``t`` (a statement naming a MODEL, say)."""
         got = self.st.scope.types.get(name.name)
         if got is None:
@@ -147,7 +147,7 @@ class ExpressionTyper(NodeVisitor):
         self._refuse(e, lt, rt)
         return None
 
-    def _refuse(self, e, lt: str, rt: str) -> None:
+    def _refuse(self, e, lt: T.Type, rt: T.Type) -> None:
         """Explain why no row of the operator table takes these operands."""
         op, out = e.op, self.st.out
         if op in ("+", "-"):

@@ -107,7 +107,7 @@ class Lowerer(NodeVisitor):
     def emit(self, text: str) -> None:
         self.lines.append("    " * self.indent + text)
 
-    def type_of(self, e) -> str | None:
+    def type_of(self, e) -> T.Type | None:
         return expr_type(self.c.types, e)
 
     # ------------------------------------------------------------- module

@@ -196,7 +196,7 @@ OPERATORS = (
 )
 
 
-def operators_for(symbol: str, left: str, right: str) -> list:
+def operators_for(symbol: str, left: str | None, right: str | None) -> list:
     """The rows of :data:`OPERATORS` for ``symbol`` that take operands of these types, in table order."""
     return [o for o in OPERATORS if o.symbol == symbol and left in o.left and right in o.right]
 

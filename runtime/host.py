@@ -14,7 +14,7 @@ import dataclasses
 import io
 import sys
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
 
@@ -292,7 +292,7 @@ class Runtime(Arithmetic):
     def pos(self, at: int) -> Pos:
         return Pos(*self.program.positions[at])
 
-    def fail(self, at: int, message: str, hint: str | None = None):
+    def fail(self, at: int, message: str, hint: str | None = None) -> NoReturn:
         """Raise a diagnostic at the statement ``at``."""
         raise LigDiagnostics([Diagnostic(self.program.name, self.pos(at), message, hint, source=self.program.source)])
 

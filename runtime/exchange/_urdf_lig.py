@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -184,7 +185,7 @@ class _Meshes:
                 visual.pos, f"reading meshes needs trimesh ({exc}).", "pip install trimesh"
             ) from None
         try:
-            mesh = trimesh.load(path, force="mesh", process=False)
+            mesh: Any = trimesh.load(path, force="mesh", process=False)  # force="mesh": a Trimesh
         except Exception as exc:  # trimesh raises many kinds; any is the same for the user
             raise self.robot.error(
                 visual.pos,

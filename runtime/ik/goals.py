@@ -156,7 +156,7 @@ def resolve_link(figure: Figure, ref) -> tuple[int, str | None]:
             )
         warning = None
         if len(found) > 1:
-            others = ", ".join(str(figure.parent_joint_of(i).id) for i in found[1:])
+            others = ", ".join(str(j.id) for i in found[1:] if (j := figure.parent_joint_of(i)) is not None)
             up = figure.parent_joint_of(found[0])
             which = "the original main link" if up is None else f"the one attached by joint {up.id}"
             warning = (

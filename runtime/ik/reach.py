@@ -417,7 +417,7 @@ def _hold_slides(figure: Figure, start) -> tuple[Figure, np.ndarray, np.ndarray]
     for value, k in zip(values, np.flatnonzero(slides)):
         j = joints[k]
         shift = j.slide_scale * (figure.frames[k] @ value)
-        joints[k] = Joint(j.id, j.primary, j.secondary, j.loc1 + shift, j.loc2, ((0.0, 0.0),))
+        joints[k] = Joint(j.id, j.primary, j.secondary, j.loc1 + shift, j.loc2, np.zeros((1, 2)))
     held = Figure(figure.links, tuple(joints), root=figure.root, main=figure.main, placement=figure.placement)
     start_deg[..., slides, :] = 0.0
     return held, start_deg, values

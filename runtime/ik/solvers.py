@@ -179,6 +179,7 @@ class _Problem:
         model = self.model
         V = model.n_vars
         t = x[V:] * model.length if model.translate else None
+        assert self.base_cs is not None, "one() is only called on a batch of one start pose"
         X, omega, pivot = model.forward_one(model.cos_sin_one(x[:V], self.base_cs))
         return self.stack.evaluate_one(X, t, omega, pivot)
 

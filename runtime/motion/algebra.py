@@ -425,13 +425,15 @@ class Motion:
         opened, tail = set(self._open), set(other._tail)
         for j in self._tracks.keys() | other._tracks.keys():
             ta, tb = self._tracks.get(j), other._tracks.get(j)
-            if tb is None and lb == 0:
-                tracks[j] = tr.pad(ta, la)  # the empty motion (or any of length 0) is an identity
-                if j in self._tail:
+            if tb is None:
+                assert ta is not None  # j is driven by one operand at least
+                if lb == 0:
+                    tracks[j] = tr.pad(ta, la)  # the empty motion (or any of length 0) is an identity
+                    if j in self._tail:
+                        tail.add(j)
+                else:
+                    tracks[j] = tr.pad(ta, la + lb, hold_from=la)  # a's end value is held through b
                     tail.add(j)
-            elif tb is None:
-                tracks[j] = tr.pad(ta, la + lb, hold_from=la)  # a's end value is held through b
-                tail.add(j)
             elif ta is None and la == 0:
                 tracks[j] = tb
                 if j in other._open:
@@ -606,7 +608,7 @@ class Motion:
         for joint, axes in free_axes.items():
             j = _joint_id(joint)
             if j in tracks and any(axes):
-                tracks[j] = tr.unwrap(tracks[j], tuple(bool(a) for a in axes), memo)
+                tracks[j] = tr.unwrap(tracks[j], (bool(axes[0]), bool(axes[1]), bool(axes[2])), memo)
         return Motion(tracks, ("unwrap", self._expr), self._length, (self._open, self._tail), self._root)
 
     # -- evaluation -------------------------------------------------------

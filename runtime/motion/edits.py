@@ -38,7 +38,7 @@ class KeyframeEdits:
         self.base = base
         self.edit = edit
         self.parent = parent
-        self._cache = None
+        self._cache: Motion | None = None
 
     @property
     def at(self):

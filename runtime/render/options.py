@@ -26,7 +26,6 @@ from typing import Any
 
 from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render.look import DEFAULT_LOOK, check_look
-from liganimate.runtime.render.outputs import check_fps, check_outputs
 from liganimate.runtime.render.raster import MAX_AA
 from liganimate.runtime.render.video import (
     DEFAULT_CRF,
@@ -37,6 +36,8 @@ from liganimate.runtime.render.video import (
     check_preset,
     find_ffmpeg,
 )
+
+from .outputs import check_fps, check_outputs
 
 __all__ = [
     "CLI_NAMES",

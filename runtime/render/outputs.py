@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 from liganimate.runtime.errors import RenderError
 
 if TYPE_CHECKING:
-    from liganimate.runtime.render.options import RenderOptions
+    from .options import RenderOptions
 
 # POSIX record locks where there are (fcntl), Windows' byte locks where not (msvcrt).
 try:

@@ -183,9 +183,7 @@ class Session:
         spec = {}
         for k, j in enumerate(g.figure.joints):
             start = tuple(float(a) for a in g.kept[0][k])
-            keys = [
-                Keyframe(frames[n], tuple(float(a) for a in g.kept[n][k]), self.method) for n in range(1, len(frames))
-            ]
+            keys = [Keyframe(frames[n], _three(g.kept[n][k]), self.method) for n in range(1, len(frames))]
             spec[j.id] = (start, keys)
         motion = M.Motion.from_tracks(spec)
         times = np.arange(frames[-1] + 1, dtype=np.float64)
@@ -359,3 +357,9 @@ def write_library(path: str, text: str, checked_as: str | None = None) -> None:
 
     check_library(text if checked_as is None else checked_as, path)
     write_files([(path, text.encode("utf-8"))])
+
+
+def _three(values) -> tuple[float, float, float]:
+    """A joint's kept value (three angles, or a slide's three lengths) as plain floats."""
+    x, y, z = (float(a) for a in values)
+    return (x, y, z)
