@@ -450,7 +450,7 @@ class Runtime(Arithmetic):
         p = self._segment(primary, names[0], at)
         s = self._segment(secondary, names[1], at)
         fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes, _joint_kind(kind))
-        return self._guard(at, limits.check_figure, fig, "the joined model")
+        return self._guard(at, limits.check_joined, fig, p, s, "the joined model")
 
     def model_block(self, name, specs, at):
         shapes = {}
