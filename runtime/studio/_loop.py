@@ -239,7 +239,7 @@ class ConnectionLoop:
             "connections": len(self._conns),
             "queued": self._jobs.qsize(),
             "busy": self._busy,
-            "threads": len(self._threads),
+            "threads": sum(t.is_alive() for t in self._threads),
             **self._counts,
         }
 
@@ -338,11 +338,15 @@ class ConnectionLoop:
             except OSError:  # out of descriptors, or the client gave up already: try again next turn
                 return
             sock.setblocking(False)
-            if len(self._conns) >= self.limits.connections:
-                self._counts["refused"] += 1
-                _refuse(sock, self.limits)
-                continue
             conn = _Conn(sock, client, deadline=time.monotonic() + self.limits.idle_timeout)
+            if len(self._conns) >= self.limits.connections:
+                self._counts["too_many_connections"] += 1
+                if len(self._conns) >= 2 * self.limits.connections:
+                    _refuse(sock)  # not even room to close gently
+                    continue
+                self._conns.add(conn)  # answered, then closed gently like any other (see _linger)
+                self._send(conn, Answer(_busy(f"the studio has {self.limits.connections} connections open, its limit")))
+                continue
             self._conns.add(conn)
             self._watch(conn, selectors.EVENT_READ)
 
@@ -383,10 +387,8 @@ class ConnectionLoop:
         try:
             self._jobs.put_nowait((priority, next(self._order), conn, request))
         except queue.Full:
-            self._counts["busy_503"] += 1
-            message = _json_error("the studio is busy; try again in a second")
-            answer = status_bytes(503, "Service Unavailable", message, {"Retry-After": "1"})
-            return self._send(conn, Answer(answer))
+            self._counts["queue_full"] += 1
+            return self._send(conn, Answer(_busy(f"the studio is busy: {self.limits.queue} requests wait already")))
         conn.phase = "busy"
         self._watch(conn, 0)
 
@@ -462,16 +464,14 @@ class ConnectionLoop:
             pass
 
 
-def _refuse(sock: socket.socket, limits: StudioLimits) -> None:
-    """Answer 503 to a connection beyond the limit and close it, without waiting for anything."""
+def _busy(why: str) -> bytes:
+    return status_bytes(503, "Service Unavailable", _json_error(why + "; try again in a second"), {"Retry-After": "1"})
+
+
+def _refuse(sock: socket.socket) -> None:
+    """Answer 503 and close at once: more connections are open than the loop will even linger on."""
     try:
-        try:
-            sock.recv(limits.max_head)  # what has come already, so that closing does not reset the answer away
-        except (BlockingIOError, InterruptedError):
-            pass
-        message = _json_error(f"the studio has {limits.connections} connections open, its limit; try again in a second")
-        sock.send(status_bytes(503, "Service Unavailable", message, {"Retry-After": "1"}))
-        sock.shutdown(socket.SHUT_WR)
+        sock.send(_busy("the studio has too many connections open"))
     except OSError:
         pass
     finally:

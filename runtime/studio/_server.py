@@ -344,17 +344,17 @@ class _Handler(BaseHTTPRequestHandler):
         session = self.server.session
         try:
             if isinstance(body, dict) and body.get("action") == "save":
-                session.check_save()
-                self.deferred = self._save  # answered from the slow lane: the disk holds no worker
+                ticket = session.ask_save()
+                self.deferred = lambda: self._save(ticket)  # answered from the slow lane: the disk holds no worker
                 return
             state = session.act(body)
         except RequestError as exc:
             return self._error(exc.status, str(exc))
         self._json(200, state)
 
-    def _save(self) -> None:
+    def _save(self, ticket: int) -> None:
         try:
-            state = self.server.session.save()
+            state = self.server.session.save(ticket)
         except RequestError as exc:
             return self._error(exc.status, str(exc))
         except LigDiagnostics as exc:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
+import math
 import os
 import threading
 from dataclasses import dataclass
@@ -88,6 +89,16 @@ class _Snapshot:
 
 def _b64(a) -> str:
     return base64.b64encode(np.ascontiguousarray(a, dtype="<f4").tobytes()).decode("ascii")
+
+
+def _number(v) -> bool:
+    """Whether ``v`` is a finite JSON number (a bool is not; a whole number past a double's range is not)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    try:
+        return math.isfinite(float(v))
+    except OverflowError:
+        return False
 
 
 def _int(body: dict, key: str, lo: int, hi: int) -> int:
@@ -254,9 +265,7 @@ class Session:
 
     def _settings(self, g, body) -> None:
         intensity, mode = body.get("intensity"), body.get("mode")
-        if intensity is not None and (
-            isinstance(intensity, bool) or not isinstance(intensity, (int, float)) or not 0 <= intensity <= 1
-        ):
+        if intensity is not None and (not _number(intensity) or not 0 <= intensity <= 1):
             raise RequestError("'intensity' must be a number from 0 to 1")
         if mode is not None and mode not in MODES:
             raise RequestError("'mode' must be 'flexion' or 'twist'")
@@ -301,11 +310,7 @@ class Session:
     def _do_set(self, g, body):
         joint, name = self._link_joint(g, body)
         angles = body.get("angles")
-        if (
-            not isinstance(angles, list)
-            or len(angles) != 3
-            or any(isinstance(a, bool) or not isinstance(a, (int, float)) or not np.isfinite(a) for a in angles)
-        ):
+        if not isinstance(angles, list) or len(angles) != 3 or not all(_number(a) for a in angles):
             raise RequestError("'angles' must be three numbers (degrees about X, Y and Z)")
         g.set_angles(joint, angles)
         a = g.current[joint]
@@ -370,20 +375,33 @@ class Session:
         g = self.generator
         return _Snapshot(tuple(g.kept), tuple(g.kept_frames), self.method, g.seed)
 
-    def check_save(self) -> None:
-        """Refuse a Save now if there is nothing to save (RequestError), before it is queued."""
+    def ask_save(self) -> int:
+        """Ask for a Save: its ticket for :meth:`save`, or RequestError now if there is nothing to save.
+
+        A Save is done when a write that began after it was asked has
+        ended; so Saves asked while another is being written are written
+        once, together.
+        """
         with self.lock:
             if not self.generator.kept:
                 raise RequestError("keep a pose first: the saved motion is made of the kept poses")
+            self._saves_asked += 1
+            return self._saves_asked
 
-    def save(self) -> dict:
+    def save(self, ticket: int | None = None) -> dict:
         """Write the library (model and kept poses) and return the state; Saves asked at once write once.
 
         The poses are copied under :attr:`lock`; the library is made,
         compiled and written outside it, so the page's state and actions
-        go on meanwhile.  Saves asked while another writes wait for it,
+        go on meanwhile.  Saves asked while another writes wait for it;
         then the first of them writes the poses as they are by then, and
         the others find their Save done (they asked before it began).
+
+        Parameters
+        ----------
+        ticket : int, optional
+            From :meth:`ask_save` when the Save was asked earlier (the
+            server asks when the request comes, and saves in turn).
 
         Raises
         ------
@@ -394,10 +412,8 @@ class Session:
         OSError
             If it cannot be written (the old file stays).
         """
-        self.check_save()
-        with self.lock:
-            self._saves_asked += 1
-            ticket = self._saves_asked
+        if ticket is None:
+            ticket = self.ask_save()
         with self._save_lock:
             if self._saves_done < ticket:
                 with self.lock:
