@@ -22,7 +22,7 @@ from liganimate.lang import keyframe_table, messages
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
-from liganimate.runtime import limits, printing
+from liganimate.runtime import budgets, limits, printing
 from liganimate.runtime.arithmetic import Arithmetic
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
@@ -450,7 +450,7 @@ class Runtime(Arithmetic):
         p = self._segment(primary, names[0], at)
         s = self._segment(secondary, names[1], at)
         fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes, _joint_kind(kind))
-        return self._guard(at, limits.check_figure, fig, "the joined model")
+        return self._guard(at, limits.check_joined, fig, p, s, "the joined model")
 
     def model_block(self, name, specs, at):
         shapes = {}
@@ -674,11 +674,20 @@ class Runtime(Arithmetic):
             self.fail(at if sameframe_at is None else sameframe_at, f"SAMEFRAME must be at least 1, not {sameframe}")
         state = self.scene
         state.length, state.sameframe = length, sameframe
+        if self.renderer is not None:
+            self._guard(at, budgets.check_frames, length, sameframe)
         progress = self.progress
+        mark = (0, 0)  # (tick, work done) at the last estimate
         for t in range(length):
             state.tick = t
-            if progress is not None and not t % PROGRESS_TICKS:
-                progress(state.id, t, length)
+            if t == 1 or not t % PROGRESS_TICKS:
+                if t:  # estimate the scene's work from the ticks run so far (runtime/budgets.py)
+                    done = state.posed + t
+                    rate = (done - mark[1]) / (t - mark[0])
+                    self._guard(at, budgets.check_joint_ticks, length, t, done, rate)
+                    mark = (t, done)
+                if progress is not None:
+                    progress(state.id, t, length)
             yield t
         if progress is not None and length >= PROGRESS_TICKS:
             progress(state.id, length, length)
@@ -687,6 +696,7 @@ class Runtime(Arithmetic):
         fig = self._model(m, at, name)
         motion = self._motion(motion, at)
         t = self.scene.tick
+        self.scene.posed += fig.n_joints  # the scene's work (runtime/budgets.py)
         if t < start or t > end:
             return m  # another ANIMATE of this model may cover this tick
         frame = float(t - start)
@@ -791,6 +801,7 @@ class SceneState:
         self.at = at
         self.viewed = False  # a VIEW statement has run before or in the scene
         self.extent = None  # world box of what is drawn at the ticks measured
+        self.posed = 0  # joints its ANIMATE statements have posed so far
 
     def measure(self) -> None:
         """Add this tick's drawing (and the background) to :attr:`extent`, for the default framing."""
