@@ -33,7 +33,7 @@ import time
 
 import numpy as np
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.figure.pose import joint_angles, world_transforms
 from liganimate.runtime.host import Posed
 
