@@ -41,7 +41,7 @@ import tempfile
 import numpy as np
 from _clock import Cost, best_of, load_text, measure
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure.pose import joint_angles, world_transforms
 from liganimate.runtime.host import Posed

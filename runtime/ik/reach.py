@@ -36,7 +36,8 @@ from liganimate.runtime.figure import pose as PO
 from liganimate.runtime.figure.tree import Figure, Joint
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
 from liganimate.runtime.ik.model import IKModel
-from liganimate.runtime.ik.solvers import CONVERGED, DEFAULT_SOLVER, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
+from liganimate.runtime.ik.options import ReachOptions
+from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
@@ -76,42 +77,6 @@ class SolveStatus(StrEnum):
 
 #: The solvers' status codes (runtime/ik/solvers.py) as the solution reports them.
 _STATUS = {CONVERGED: SolveStatus.CONVERGED, STALLED: SolveStatus.STALLED, LIMIT: SolveStatus.LIMIT}
-
-
-@dataclass(frozen=True)
-class ReachOptions:
-    """How a pose is solved: the one value REACH, :func:`reach`, :func:`reach_keyframes` and :func:`solve_pose` pass on.
-
-    Attributes
-    ----------
-    movable : None, int or tuple of int
-        Which joints may turn: all (None), the ``n`` joints nearest each
-        goal's link toward the main link (an int: a chain length), or joint
-        ids.  The others keep their start angles, and so does every axis
-        locked by its extremes (``min == max``).
-    translate : bool
-        Whether the whole figure may also move (POSIT's root translation).
-    solver : str
-        A name in :data:`solvers.SOLVER_NAMES`: "dls" (the default), "transpose" or "ccd".
-    tolerance : float or None
-        World units; default :data:`DEFAULT_TOLERANCE` times the figure's
-        length.  The solve stops when every goal is this close (an axis goal
-        counts its angle in radians times its link's length).
-    max_iterations : int or None
-        Default :data:`DEFAULT_MAX_ITERATIONS` for the solver.
-    restarts : int
-        When the goals are not met from the start pose (a local minimum,
-        often against joint limits), try up to this many other start poses,
-        drawn within the limits by a fixed-seed generator, and keep the
-        first that meets them (see :func:`solvers.solve`).
-    """
-
-    movable: int | tuple[int, ...] | None = None
-    translate: bool = False
-    solver: str = DEFAULT_SOLVER
-    tolerance: float | None = None
-    max_iterations: int | None = None
-    restarts: int = 0
 
 
 def reach_options(options: ReachOptions | None = None, **fields) -> ReachOptions:
