@@ -4,7 +4,9 @@
 stands: ``"top"`` (the program or a PRIMITIVE body), ``"scene"`` (a scene's
 initialisation) or ``"scene-body"`` (between STARTSCENE and ENDSCENE).
 Expressions are typed by :class:`~.expressions.ExpressionTyper`, names bound
-by the rules of :mod:`.scopes`.
+by the rules of :mod:`.scopes`. A declared statement (``@declared`` in
+lang/ast.py) has no method of its own: ``_s_Declared`` checks it from its
+declaration.
 """
 
 from __future__ import annotations
