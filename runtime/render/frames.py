@@ -47,6 +47,7 @@ from liganimate.runtime.errors import RenderError
 from liganimate.runtime.figure.pose import (
     joint_angles,
     mesh_table,
+    morphed,
     static_triangles,
     world_transforms,
     world_triangles,
@@ -309,9 +310,9 @@ class Renderer:
             frames = np.array([r[4].frame for r in reqs])
             placements = np.stack([np.asarray(r[4].figure.placement, dtype=np.float64) for r in reqs])
             angles = self._joint_angles(fig, motion, frames.tolist())
-            X = world_transforms(fig, angles, placements)
+            X, local = morphed(fig, motion, frames, world_transforms(fig, angles, placements))
             table = mesh_table(fig)
-            tris = world_triangles(table, X)
+            tris = world_triangles(table, X, local)
             mirrored = np.linalg.det(placements[:, :3, :3]) < 0
             for n, r in enumerate(reqs):
                 cull = table.closed if not mirrored[n] else np.zeros(len(table.closed), dtype=bool)
