@@ -112,7 +112,8 @@ class Binding:
     Attributes
     ----------
     scales : tuple of (link indices, link name)
-    shapes : tuple of (link indices, link name, targets' triangles in link coordinates per link index)
+    shapes : tuple of (link indices, link name, targets' triangles in link coordinates per link index,
+        which targets are the link's own shape per link index)
     """
 
     scales: tuple
@@ -129,9 +130,9 @@ def bind(fig: F.Figure, morphs: mo.Morphs) -> Binding:
         whose structure is not the link's own.
     """
     names: dict = {}
-    for i, link in enumerate(fig.links):
-        if link.name is not None:
-            names.setdefault(link.name.upper(), []).append(i)
+    for i, each in enumerate(fig.links):
+        if each.name is not None:
+            names.setdefault(each.name.upper(), []).append(i)
     scales, shapes = [], []
     for kind in (mo.SCALE, mo.SHAPE):
         for link in morphs.links(kind):
@@ -145,8 +146,16 @@ def bind(fig: F.Figure, morphs: mo.Morphs) -> Binding:
             if kind == mo.SCALE:
                 scales.append((tuple(where), link))
             else:
-                shapes.append((tuple(where), link, _targets(fig, where, link, morphs)))
+                own = {i: _own(fig, i, morphs.shape(link, np.zeros(1))[0]) for i in where}
+                shapes.append((tuple(where), link, _targets(fig, where, link, morphs), own))
     return Binding(tuple(scales), tuple(shapes))
+
+
+def _own(fig: F.Figure, i: int, targets: list) -> np.ndarray:
+    """Which targets are link ``i``'s own shape (equal triangles, lightness and colour)."""
+    shape = fig.links[i].shape
+    key = target(shape).key if isinstance(shape, Graphical) else None
+    return np.array([t.key == key for t in targets], dtype=bool)
 
 
 def _targets(fig: F.Figure, where: list, link: str, morphs: mo.Morphs) -> dict:
@@ -197,7 +206,7 @@ def apply(binding: Binding, morphs: mo.Morphs, frames, X: np.ndarray, table) -> 
     if not binding.shapes:
         return X, None
     local = np.broadcast_to(table.triangles, (len(t), *table.triangles.shape)).copy()
-    for where, link, targets in binding.shapes:
+    for where, link, targets, _own in binding.shapes:
         _, w = morphs.shape(link, t)  # (T, K)
         for i in where:
             rows = np.flatnonzero(table.link == i)
@@ -205,3 +214,26 @@ def apply(binding: Binding, morphs: mo.Morphs, frames, X: np.ndarray, table) -> 
             delta = targets[i] - base[None]  # (K, R, 3, 3)
             local[:, rows] += np.einsum("tk,krij->trij", w, delta)
     return X, local
+
+
+def record(binding: Binding, morphs: mo.Morphs, frames) -> list[dict]:
+    """What ``--poses`` writes for morphed links, per frame: ``{link index: {"scale": [...], "shape": [own]}}``.
+
+    ``own`` is how much of the drawn shape is the segment's own: 1 where it
+    shows its own shape (or a shape equal to it), 0 where it shows only
+    other shapes.
+    """
+    t = np.asarray(frames, dtype=np.float64).reshape(-1)
+    out: list[dict] = [{} for _ in t]
+    for where, link in binding.scales:
+        s = morphs.scale(link, t)
+        for n in range(len(t)):
+            for i in where:
+                out[n].setdefault(i, {})["scale"] = s[n].tolist()
+    for where, link, _targets, own in binding.shapes:
+        _, w = morphs.shape(link, t)
+        for i in where:
+            mine = 1.0 - w[:, ~own[i]].sum(axis=1)
+            for n in range(len(t)):
+                out[n].setdefault(i, {})["shape"] = [float(mine[n])]
+    return out

@@ -247,13 +247,27 @@ def morphed(fig: F.Figure, motion: Motion | None, frames, X: np.ndarray) -> tupl
     morphs = None if motion is None else motion.morphs
     if morphs is None:
         return X, None
+    return MO.apply(_binding(fig, morphs), morphs, frames, X, mesh_table(fig))
+
+
+def _binding(fig: F.Figure, morphs) -> MO.Binding:
+    """A motion's morphs bound to a model's links, remembered per (links, morphs)."""
     key = (id(fig.links), id(morphs))
     hit = _bindings.get(key)
     if hit is None or hit[0] is not fig.links or hit[1] is not morphs:
         if len(_bindings) >= _BOUND_MAX:
             _bindings.clear()
         hit = _bindings[key] = (fig.links, morphs, MO.bind(fig, morphs))
-    return MO.apply(hit[2], morphs, frames, X, mesh_table(fig))
+    return hit[2]
+
+
+def morph_record(fig: F.Figure, motion: Motion | None, frames) -> list[dict]:
+    """Per frame, the morphed links' scale factors and shape weights (``--poses``; see :func:`.morphing.record`)."""
+    n = len(np.asarray(frames).reshape(-1))
+    morphs = None if motion is None else motion.morphs
+    if morphs is None:
+        return [{} for _ in range(n)]
+    return MO.record(_binding(fig, morphs), morphs, frames)
 
 
 def static_triangles(fig: F.Figure):

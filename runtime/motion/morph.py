@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -41,6 +41,18 @@ if TYPE_CHECKING:
     from liganimate.runtime.motion.algebra import Motion
 
 SCALE, SHAPE = "SCALE", "SHAPE"
+
+
+def _channels(m: Motion) -> dict[Any, tr.Track]:
+    """An inner motion's tracks, keyed by channel (a Motion's are typed by joint id)."""
+    return cast("dict[Any, tr.Track]", m._tracks)
+
+
+def _gaps(m: Motion) -> tuple[frozenset[Any], frozenset[Any]]:
+    """An inner motion's channels that begin with a gap, and those that end with a hold."""
+    return cast("frozenset[Any]", m._open), cast("frozenset[Any]", m._tail)
+
+
 ONE = (1.0, 1.0, 1.0)
 
 
@@ -83,7 +95,7 @@ class Morphs:
     @property
     def end(self) -> float:
         """The last frame at which a morph channel changes."""
-        return max((t.end for t in self.motion._tracks.values()), default=0.0)
+        return max((t.end for t in _channels(self.motion).values()), default=0.0)
 
     def fitted(self, length: float) -> Morphs:
         """The same channels inside a motion of ``length`` frames (the outer motion's)."""
@@ -95,24 +107,24 @@ class Morphs:
 
     def links(self, kind: str) -> tuple[str, ...]:
         """Links with a channel of ``kind`` (SCALE or SHAPE), in name order."""
-        return tuple(dict.fromkeys(k[1] for k in self.motion._tracks if k[0] == kind))
+        return tuple(dict.fromkeys(k[1] for k in _channels(self.motion) if k[0] == kind))
 
     def scale(self, link: str, times: np.ndarray) -> np.ndarray:
         """The link's scale factors at ``times``, shape (T, 3)."""
         with np.errstate(all="ignore"):
-            return self.motion._tracks[(SCALE, link)].sample_x(np.asarray(times, dtype=float))
+            return _channels(self.motion)[(SCALE, link)].sample_x(np.asarray(times, dtype=float))
 
     def shape(self, link: str, times: np.ndarray) -> tuple[list[Target], np.ndarray]:
         """The link's targets and their weights at ``times``, shape (T, K)."""
-        keys = [k for k in self.motion._tracks if k[0] == SHAPE and k[1] == link]
+        keys = [k for k in _channels(self.motion) if k[0] == SHAPE and k[1] == link]
         t = np.asarray(times, dtype=float)
         with np.errstate(all="ignore"):
-            w = np.stack([self.motion._tracks[k].sample_x(t)[:, 0] for k in keys], axis=1)
+            w = np.stack([_channels(self.motion)[k].sample_x(t)[:, 0] for k in keys], axis=1)
         return [self.targets[k[2]] for k in keys], w
 
     def channels(self) -> tuple:
         """Every channel key, sorted."""
-        return tuple(self.motion._tracks)
+        return tuple(_channels(self.motion))
 
 
 def _leaf(who: str, start, keys: list) -> tr.Leaf:
@@ -217,26 +229,38 @@ def _empty(motion_type, length: float) -> Morphs:
 
 def _families(m: Morphs) -> dict:
     out: dict = {}
-    for k in m.motion._tracks:
+    for k in _channels(m.motion):
         if k[0] == SHAPE:
             out.setdefault(k[1], []).append(k[2])
     return out
 
 
 def _completed(m: Morphs, other: Morphs) -> Morphs:
-    """``m`` with every shape target ``other`` uses on a link ``m`` also shapes, at weight 0."""
+    """``m`` with every shape target ``other`` uses on a link ``m`` also shapes, at weight 0.
+
+    The new channel is a sibling of the family scaled by 0: the same pieces,
+    gaps and holds, so that ``+`` refills and holds it as it does the family
+    (a gap shows the previous motion's weight of that target), and ``+``
+    stays associative.
+    """
     mine, theirs = _families(m), _families(other)
-    extra = {}
+    inner = m.motion
+    extra, opened, tail = {}, set(_gaps(inner)[0]), set(_gaps(inner)[1])
     for link, keys in mine.items():
+        sibling = (SHAPE, link, keys[0])
         for key in theirs.get(link, ()):
             if key not in keys:
-                extra[(SHAPE, link, key)] = tr.Const((0.0, 0.0, 0.0))
+                new = (SHAPE, link, key)
+                extra[new] = tr.scale_extremes(_channels(inner)[sibling], 0.0)
+                if sibling in _gaps(inner)[0]:
+                    opened.add(new)
+                if sibling in _gaps(inner)[1]:
+                    tail.add(new)
     if not extra:
         return m
-    inner = m.motion
-    tracks = dict(inner._tracks)
+    tracks = dict(_channels(inner))
     tracks.update(extra)
-    return Morphs(type(inner)(tracks, inner._expr, inner._length, (inner._open, inner._tail)), m.targets)
+    return Morphs(type(inner)(tracks, inner._expr, inner._length, (opened, tail)), m.targets)
 
 
 def concat(a: Morphs | None, la: float, b: Morphs | None, lb: float, motion_type) -> Morphs | None:
@@ -275,7 +299,7 @@ def synchronize(parts: Iterable[tuple[int, Morphs | None]], motion_type) -> Morp
     for i, m in parts:
         if m is None:
             continue
-        for k, t in m.motion._tracks.items():
+        for k, t in _channels(m.motion).items():
             family = k[:2]
             if family in owner and owner[family] != i and tracks.get(k) is not t:
                 raise MotionError(
@@ -286,8 +310,8 @@ def synchronize(parts: Iterable[tuple[int, Morphs | None]], motion_type) -> Morp
             owner[family] = i
             tracks[k] = t
         targets.update(m.targets)
-        opened |= m.motion._open
-        tail |= m.motion._tail
+        opened |= _gaps(m.motion)[0]
+        tail |= _gaps(m.motion)[1]
     if not tracks:
         return None
     ends = max(t.end for t in tracks.values())
@@ -296,4 +320,4 @@ def synchronize(parts: Iterable[tuple[int, Morphs | None]], motion_type) -> Morp
 
 def keyframes(m: Morphs, key: tuple, limit: int) -> tuple[tuple, list[Keyframe]]:
     """One channel written out as a keyframe list (for PRINT)."""
-    return tr.materialize(m.motion._tracks[key], limit)
+    return tr.materialize(_channels(m.motion)[key], limit)
