@@ -155,7 +155,7 @@ def placed(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     B = angles.shape[0]
     if root is not None:
         root = np.asarray(root, dtype=np.float64)
-    values = angles[:, walk.order].transpose(2, 1, 0)  # (3, J, B): axis, joint in walk order, frame
+    values = angles.take(walk.order, axis=1).transpose(2, 1, 0)  # (3, J, B): axis, joint in walk order, frame
     if B <= BLOCK:
         return _block(walk, values, root)[:, :, walk.where].transpose(3, 2, 0, 1)
     out = np.empty((4, 4, figure.n_links, B))
@@ -177,11 +177,12 @@ def _block(walk: Walk, values: np.ndarray, root) -> np.ndarray:
     else:
         X[:3, :, 0] = root[:, :3].transpose(1, 2, 0)
     if b and len(walk.order):
-        A = _local(walk, values)
+        A = _local(walk, values)[None]  # (1, 4, 4, J, b)
+        X3 = X[:3]
         for first, end, parents, jl, jh in walk.levels:
             # child[i, j] = sum_m parent[i, m] A[m, j], m = 0..3 in order.
-            P = X[:3, :, parents]  # (3, 4, n, b): each child's parent's [R | t]
-            np.add.reduce(P[:, :, None] * A[None, :, :, jl:jh], axis=1, out=X[:3, :, first:end])
+            P = X3.take(parents, axis=2)[:, :, None]  # (3, 4, 1, n, b): each child's parent's [R | t]
+            np.add.reduce(P * A[:, :, :, jl:jh], axis=1, out=X3[:, :, first:end])
     return X
 
 
@@ -192,7 +193,7 @@ def _local(walk: Walk, values: np.ndarray) -> np.ndarray:
     """Every joint's 4x4 ``A[i, j, joint, frame]`` (walk order) from its angles ``values`` (3, J, b) in degrees."""
     J, b = values.shape[1:]
     # cs rows: cy, sy, cz, sz, cx, sx, so that every group used below is a slice.
-    a = np.deg2rad(values[_YZX])
+    a = np.deg2rad(values.take(_YZX, axis=0))
     cs = np.empty((6, J, b))
     np.cos(a, out=cs[0::2])
     np.sin(a, out=cs[1::2])
