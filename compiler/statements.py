@@ -4,7 +4,9 @@
 stands: ``"top"`` (the program or a PRIMITIVE body), ``"scene"`` (a scene's
 initialisation) or ``"scene-body"`` (between STARTSCENE and ENDSCENE).
 Expressions are typed by :class:`~.expressions.ExpressionTyper`, names bound
-by the rules of :mod:`.scopes`.
+by the rules of :mod:`.scopes`. A declared statement (``@declared`` in
+lang/ast.py) has no method of its own: ``_s_Declared`` checks it from its
+declaration.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from liganimate.lang import ast as A
 from liganimate.lang import bindings, keyframe_table, messages, numbers
 from liganimate.lang.diagnostics import did_you_mean
 from liganimate.lang.visitor import NodeVisitor
-from liganimate.lang.vocabulary import DRAW_WITH
+from liganimate.lang.vocabulary import DRAW_WITH, NUMBER
 from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS  # the solver registry, by name only
 from liganimate.runtime.motion import interpolation
 
@@ -307,15 +309,27 @@ class StatementChecker(NodeVisitor):
                 s, "BACKGROUND outside a scene has no effect", "put it between INITIALIZE SCENE and ENDSCENE"
             )
 
-    def _s_View(self, s, context):
-        if s.what == "POINT":
-            self.t.want(s.value, T.VECTOR, "a view point (x, y, z)")
-        else:
-            self.t.want_number(s.value, "a view width")
+    def _s_Declared(self, s: A.Declared, context: str) -> None:
+        """A declared statement (lang/ast.py): where it may stand, and the types of its parts."""
+        declaration = A.DECLARED[type(s)]
+        place = "primitive" if self.st.primitive is not None else context
+        if place not in declaration.places:
+            self.st.out.error(s, declaration.misplaced, declaration.hint)
+        for name, part in declaration.parts:
+            value = getattr(s, name)
+            for e in value if part.many else (value,):
+                self._part(e, part)
 
-    def _s_Shoot(self, s, context):
-        if self.st.primitive is not None or context.startswith("scene"):
-            self.st.out.error(s, "SHOOTSCENES belongs outside scenes and primitives")
+    def _part(self, e, part: A.Part) -> None:
+        if part.accepts == NUMBER:
+            self.t.want_number(e, part.what)
+        elif len(part.accepts) == 1:
+            self.t.want(e, part.accepts[0], part.what)
+        else:
+            got = self.t.expr(e)
+            if got is not None and not any(T.fits(t, got) for t in part.accepts):
+                nouns = " or ".join(T.NOUN[t] for t in part.accepts)
+                self.st.out.error(e, f"{part.what} must be {nouns}, not {T.NOUN[got]}")
 
     # ------------------------------------------------------------ other
     def _s_Print(self, s, context):
