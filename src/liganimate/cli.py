@@ -62,6 +62,7 @@ def shot_scenes(path: str, doing: str) -> list:
 
     ``doing`` finishes the sentence "there is nothing to ..." (export, view).
     """
+    from liganimate.compiler import load_program
     from liganimate.runtime import exchange as X
     from liganimate.runtime.errors import LigError
 
@@ -73,13 +74,6 @@ def shot_scenes(path: str, doing: str) -> list:
     if not scenes:
         raise LigError(NO_SCENE.format(doing=doing), NO_SCENE_HINT)
     return scenes
-
-
-def load_program(path: str):
-    """Compile a .lig file in memory (the same lowering ``compile`` writes) and return (program, warnings)."""
-    from liganimate.compiler import load_program as _load
-
-    return _load(path)
 
 
 def _add_render_options(p: argparse.ArgumentParser) -> None:
@@ -360,6 +354,8 @@ def cmd_run(args) -> int:
         stem = os.path.splitext(os.path.basename(args.file))[0]
         _usage_checked(args, args.parser)
         options = _render_options(args, stem)
+        from liganimate.compiler import load_program
+
         program, warnings = load_program(args.file)
         return _render(program, warnings, options, asked=args.progress)
 
@@ -368,6 +364,8 @@ def cmd_run(args) -> int:
 
 def cmd_check(args) -> int:
     def go():
+        from liganimate.compiler import load_program
+
         program, warnings = load_program(args.file)
         _print_diagnostics(warnings)
         _print_diagnostics(_checked(program, False, stdout=sys.stdout, asked=args.progress).warnings)
@@ -438,6 +436,7 @@ def cmd_lib(args) -> int:
 
 def cmd_plot(args) -> int:
     def go():
+        from liganimate.compiler import load_program
         from liganimate.runtime.render.plot import plot_motion
 
         program, warnings = load_program(args.file)
