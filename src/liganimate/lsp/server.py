@@ -51,6 +51,7 @@ class LigServer(LanguageServer):
         self.good: dict = {}  # uri -> the last Analysis whose text parsed
         self.pending: dict = {}  # uri -> the asyncio task that will analyse it
         self.reparsers: dict = {}  # uri -> its Reparser (lang/incremental.py), used only by the worker
+        self.whole_parse = False  # True: no Reparser, every change parses the whole text (liganimate lsp --whole-parse)
         self.worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="liganimate-analysis")
 
     def encoding(self) -> str:
@@ -88,11 +89,12 @@ async def _analyse_until_current(ls: LigServer, uri: str) -> None:
     keystrokes costs one analysis more than the one running, and a single
     change is analysed at once, with no pause. The diagnostics go out as
     soon as they are known, before the index and the values that requests
-    use are built (until then requests are answered from the last analysis).
+    use are built (until then requests are answered from the last analysis),
+    and those are built only for a text that is still current.
     """
     loop = asyncio.get_running_loop()
     await asyncio.sleep(0)  # the change's own handler first
-    reparser = ls.reparsers.setdefault(uri, reparser_for_document())
+    reparser = None if ls.whole_parse else ls.reparsers.setdefault(uri, reparser_for_document())
     while uri in ls.workspace.text_documents:
         doc = ls.workspace.get_text_document(uri)
         version, source = doc.version, doc.source
@@ -101,19 +103,19 @@ async def _analyse_until_current(ls: LigServer, uri: str) -> None:
         )
         if uri not in ls.workspace.text_documents:
             return  # closed meanwhile
-        current = ls.workspace.get_text_document(uri).version == version
-        if current:
-            ls.text_document_publish_diagnostics(
-                lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
-            )
+        if ls.workspace.get_text_document(uri).version != version:
+            continue  # changed meanwhile: the newer text next, at once
+        ls.text_document_publish_diagnostics(
+            lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
+        )
         result = await loop.run_in_executor(ls.worker, _complete_safely, result)
         if uri not in ls.workspace.text_documents:
             return
         ls.latest[uri] = result
         if result.parsed:
             ls.good[uri] = result
-        if current:
-            return
+        if ls.workspace.get_text_document(uri).version == version:
+            return  # else a change came meanwhile, which _schedule left to this task
 
 
 def _analyse_safely(source: str, path: str | None, version, encoding: str, reparser) -> Analysis:
@@ -121,7 +123,8 @@ def _analyse_safely(source: str, path: str | None, version, encoding: str, repar
         return analyse(source, path, version, encoding, whole=False, reparser=reparser)
     except Exception:  # noqa: BLE001 - a bug must cost one analysis, not the editor's server
         log.exception("the analysis failed")
-        reparser.forget()  # the next analysis parses the whole text
+        if reparser is not None:
+            reparser.forget()  # the next analysis parses the whole text
         return Analysis(Text(source, encoding), version, path, [])
 
 
@@ -471,8 +474,9 @@ def on_folding(ls: LigServer, params: lsp.FoldingRangeParams) -> list:
     ]
 
 
-def main() -> int:
-    """Serve over stdin and stdout until the client says exit."""
+def main(*, whole_parse: bool = False) -> int:
+    """Serve over stdin and stdout until the client says exit; ``whole_parse``: see :class:`LigServer`."""
+    server.whole_parse = whole_parse
     server.start_io()
     return 0
 
