@@ -432,7 +432,7 @@ async def test_typing_in_a_big_program_ends_with_the_diagnostics_of_the_last_tex
     body = PROGRAM[PROGRAM.index("      STARTMODEL ARM") : PROGRAM.index("      SHOOTSCENES")]
     copies = [body.replace("ARM", f"ARM{i}").replace("BEND", f"BEND{i}").replace("BOTH", f"BOTH{i}") for i in range(60)]
     big = PROGRAM.replace(body, "".join(copies))
-    path = folder / "typing.lig"
+    path = folder / "keystrokes.lig"
     path.write_text(big)
     uri = await open_doc(client, path, big)
     assert list(PUBLISHED[(uri, 1)]) == []
