@@ -18,7 +18,7 @@ import numpy as np
 from liganimate import __version__
 from liganimate.runtime.figure.pose import mesh_table
 from liganimate.runtime.values import rgb_levels
-from liganimate.runtime.view import Blob, asset, fill, inline_code, json_for_script
+from liganimate.runtime.view import Blob, fill, gl_script, inline_code, json_for_script
 
 from ._generator import POPULATION
 
@@ -87,7 +87,7 @@ def studio_page(generator, title: str) -> str:
             "CSS": inline_code(_own("studio.css")),
             "MANIFEST": json_for_script(manifest),
             "BLOB": base64.b64encode(blob.tobytes()).decode("ascii"),
-            "GLJS": inline_code(asset("gl.js")),
+            "GLJS": gl_script(),
             "STUDIOJS": inline_code(_own("studio.js")),
         },
     )
