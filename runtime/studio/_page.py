@@ -1,7 +1,7 @@
 """The studio page: built once when the server starts, the model's triangles inlined.
 
-The page is ``studio.html`` with ``studio.css``, the viewer's ``gl.js`` and
-``studio.js`` inlined, and the model's segments (triangles in segment
+The page is ``studio.html`` with ``studio.css``, the viewer's drawing code
+(``shadow.js`` and ``gl.js``) and ``studio.js`` inlined, and the model's segments (triangles in segment
 coordinates, grey levels, names, joints) in the same compact form the
 viewer uses.  The poses themselves come from the server as segment
 matrices.

@@ -23,4 +23,14 @@ compiler and the language never do.  The command line reaches it through
 from ._html import asset, fill, gl_script, iframe, inline_code, json_for_script, viewer_html
 from ._scene_data import Blob, scene_manifest
 
-__all__ = ["Blob", "asset", "fill", "gl_script", "iframe", "inline_code", "json_for_script", "scene_manifest", "viewer_html"]
+__all__ = [
+    "Blob",
+    "asset",
+    "fill",
+    "gl_script",
+    "iframe",
+    "inline_code",
+    "json_for_script",
+    "scene_manifest",
+    "viewer_html",
+]

@@ -335,6 +335,8 @@
       draw();
     },
     camera: function () { return state.userCam; },
+    /* The camera the current frame starts from before any orbit: VIEW's, or run's default framing. */
+    sceneCamera: function () { var s = scenes[state.scene]; return sceneCamera(s, tickRange(s, state.image)[0]); },
     ready: performance.now()
   };
 })();
