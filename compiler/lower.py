@@ -311,7 +311,9 @@ class Lowerer(NodeVisitor):
         )
 
     def joint_or_root(self, e) -> str:
-        """A keyframe's joint identifier, or None for the ROOT track."""
+        """A keyframe's joint identifier, None for the ROOT track, ``(kind, link)`` for a morph track."""
+        if isinstance(e, A.MorphTrack):
+            return repr((e.kind, e.link))
         return "None" if isinstance(e, A.RootTrack) else self.expr(e)
 
     def position(self, items: list) -> str:

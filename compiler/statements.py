@@ -115,9 +115,9 @@ class StatementChecker(NodeVisitor):
         self.t.want(s.index, T.INTEGER, "a keyframe number")
         self._keyframe(s.keyframe)
 
-    def _keyframe(self, k: A.Keyframe) -> None:
+    def _keyframe(self, k: A.Keyframe, shape: bool = False) -> None:
         self.t.want_number(k.frame, "a frame number")
-        self._position(k.position, k)
+        self._shape(k.position, k) if shape else self._position(k.position, k)
         if k.method is not None:
             self._method(k.method)
 
@@ -144,16 +144,24 @@ class StatementChecker(NodeVisitor):
                 f"a position is three angles or one vector, not {len(items)} values",
             )
 
+    def _shape(self, items: list, node) -> None:
+        """A SHAPE track's position: one GRAPHICAL object, the shape the link takes."""
+        if len(items) != 1:
+            self.st.out.error(items[1], f"a shape is one graphical object, not {len(items)} values")
+            return
+        self.t.want(items[0], T.GRAPHICAL, "a shape (a GRAPHICAL object)")
+
     def _s_MotionBlock(self, s, context):
         S.define_as(self.st, s.name, T.MOTION, "{name} is {noun}, not a MOTION")
         seen: dict = {}
         for j in s.joints:
             self._track_joint(s, j.joint, seen)
+            shape = isinstance(j.joint, A.MorphTrack) and j.joint.kind == "SHAPE"
             if j.start is not None:
-                self._position(j.start, j)
+                self._shape(j.start, j) if shape else self._position(j.start, j)
             last = None
             for k in j.keyframes:
-                self._keyframe(k)
+                self._keyframe(k, shape)
                 c = const(k.frame)
                 if c is not None and last is not None and c < last:
                     self.st.out.error(k.frame, messages.keyframes_out_of_order(c, last))
@@ -168,6 +176,16 @@ class StatementChecker(NodeVisitor):
 
     def _track_joint(self, s, joint, seen: dict) -> None:
         """The JOINT (or ROOT) a track of a STARTMOTION block drives (an entry or a table's column), each once."""
+        if isinstance(joint, A.MorphTrack):
+            key = (joint.kind, joint.link)
+            if key in seen:
+                self.st.out.error(
+                    joint,
+                    f"{joint.kind} LINK {joint.link} appears twice in motion {s.name.name}",
+                    f"the first is at line {seen[key].line}; put all its keyframes under one entry",
+                )
+            seen[key] = joint.pos
+            return
         if isinstance(joint, A.RootTrack):
             if "ROOT" in seen:
                 self.st.out.error(

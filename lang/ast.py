@@ -345,8 +345,16 @@ class RootTrack(Node):
 
 
 @dataclass(slots=True)
+class MorphTrack(Node):
+    """``SCALE LINK name`` or ``SHAPE LINK name`` where a joint identifier stands: a link's morph track."""
+
+    kind: str  # "SCALE" or "SHAPE"
+    link: str  # the link's name, in capitals (a name of the model's, not a variable)
+
+
+@dataclass(slots=True)
 class MotionJoint(Node):
-    joint: Node  # RootTrack for the ROOT entry
+    joint: Node  # RootTrack for the ROOT entry, MorphTrack for SCALE and SHAPE
     start: list | None
     keyframes: list
 

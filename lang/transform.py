@@ -313,6 +313,13 @@ class ToAst(Transformer):
         joint.start, joint.keyframes = rest.start, rest.keyframes
         return joint
 
+    def motion_morph(self, children):
+        track = A.MorphTrack(span(children[:3]), upper_name(children[0].value), upper_name(children[2].value))
+        joint = A.MotionJoint(span(children), track, None, [])
+        rest = self.motion_joint([children[0], None] + list(children[3:]))
+        joint.start, joint.keyframes = rest.start, rest.keyframes
+        return joint
+
     def figure_stmt(self, children):
         model = _name(children[1])
         if len(children) <= 3:

@@ -26,6 +26,7 @@ from liganimate.runtime import budgets, limits, printing
 from liganimate.runtime.arithmetic import Arithmetic
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import morphing as MO
 from liganimate.runtime.figure import pose as P
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.ik.options import ReachOptions  # generated modules build it as _host.ReachOptions
@@ -569,18 +570,17 @@ class Runtime(Arithmetic):
 
     def motion_block(self, joints, at, tables=()):
         spec = {}
+        morphs = []  # SCALE and SHAPE entries: (kind, link, start, keyframes, at)
         for joint, start, kfs, jat in joints:
+            if isinstance(joint, tuple):
+                self._frames_in_order(kfs)
+                morphs.append((*joint, start, kfs, jat))
+                continue
             if joint in spec:
                 self.fail(jat, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
-            last = 0
-            for frame, pos, _method, kat in kfs:
-                self._guard(kat, E.check_frame, frame)
+            for _frame, pos, _method, kat in kfs:
                 self._guard(kat, E.check_angles, pos, joint is None)
-                if frame < last:
-                    self.fail(kat, messages.keyframes_out_of_order(frame, last))
-                if 0 < frame - last < N.MIN_FRAME_GAP:
-                    self.fail(kat, messages.keyframes_too_close(frame, last), messages.GAP_HINT)
-                last = frame
+            self._frames_in_order(kfs)
             if start is not None:
                 self._guard(jat, E.check_angles, start, joint is None)
             spec[joint] = (
@@ -589,7 +589,21 @@ class Runtime(Arithmetic):
             )
         root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
         arrays = self._table_tracks(tables, spec, root is not None)
-        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays))
+        motion = self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays))
+        if not morphs:
+            return motion
+        return self._guard(at, lambda: motion.with_morphs(MO.channels(morphs, motion.length, self.fail)))
+
+    def _frames_in_order(self, kfs) -> None:
+        """A track's keyframe frames: each within the limits, in order, and a step or the least gap apart."""
+        last = 0
+        for frame, _pos, _method, kat in kfs:
+            self._guard(kat, E.check_frame, frame)
+            if frame < last:
+                self.fail(kat, messages.keyframes_out_of_order(frame, last))
+            if 0 < frame - last < N.MIN_FRAME_GAP:
+                self.fail(kat, messages.keyframes_too_close(frame, last), messages.GAP_HINT)
+            last = frame
 
     def _table_tracks(self, tables, spec: dict, has_root: bool) -> dict:
         """Each table column as ``(start, frames, values)``: its first row is the start, the others keyframes."""
@@ -748,6 +762,8 @@ class Runtime(Arithmetic):
                 f"the motion drives joint{'s' if len(missing) > 1 else ''} "
                 f"{', '.join(map(str, missing))}, which the model does not have",
             )
+        if motion.morphs is not None:
+            self._guard(at, MO.bind, fig, motion.morphs)
         if fig.slides.any():
             problem = P.slide_out_of_range(fig, motion)
             if problem is not None:

@@ -18,6 +18,7 @@ import numpy as np
 from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
+from liganimate.runtime.motion import morph as mo
 from liganimate.runtime.motion import path as rp
 from liganimate.runtime.motion import track as tr
 from liganimate.runtime.motion.keyframe import RAMP, Keyframe
@@ -154,7 +155,7 @@ class Motion:
     ``n * m`` and the methods below.  All operations return new motions.
     """
 
-    __slots__ = ("_derived", "_expr", "_length", "_open", "_root", "_tail", "_tracks")
+    __slots__ = ("_derived", "_expr", "_length", "_morph", "_open", "_root", "_tail", "_tracks")
 
     def __init__(
         self,
@@ -163,6 +164,7 @@ class Motion:
         length: float | None = None,
         gaps: tuple[Iterable[int], Iterable[int]] = ((), ()),
         root: tr.Track | None = None,
+        morph: mo.Morphs | None = None,
     ):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
 
@@ -179,12 +181,15 @@ class Motion:
             joints whose track ends with such a time (a hold).
         root : Track, optional
             The root path (see :mod:`liganimate.runtime.motion.path`).
+        morph : Morphs, optional
+            The links' scale and shape channels (see :mod:`liganimate.runtime.motion.morph`).
         """
         self._tracks = dict(sorted(tracks.items()))
         self._root = root
         self._open = frozenset(gaps[0]) & self._tracks.keys()
         self._tail = frozenset(gaps[1]) & self._tracks.keys()
         ends = [t.end for t in self._tracks.values()] + ([root.end] if root is not None else [])
+        ends += [morph.end] if morph is not None else []
         self._length = float(length if length is not None else max(ends, default=0.0))
         if not math.isfinite(self._length):
             # n * m and SCALE FRAMES multiply lengths; LEN must stay a finite REAL.
@@ -193,6 +198,7 @@ class Motion:
                 hint="repeat or stretch it less",
             )
         self._expr = expr
+        self._morph = None if morph is None else morph.fitted(self._length)
         self._derived: dict | None = None
 
     def _derive(self, key: tuple, keep, make) -> Motion:
@@ -218,12 +224,13 @@ class Motion:
         return out
 
     def __getstate__(self):
-        return (self._tracks, self._length, self._expr, self._open, self._tail, self._root)
+        return (self._tracks, self._length, self._expr, self._open, self._tail, self._root, self._morph)
 
     def __setstate__(self, state):
         self._tracks, self._length, self._expr = state[:3]
         self._open, self._tail = state[3:5] if len(state) > 3 else (frozenset(), frozenset())
         self._root = state[5] if len(state) > 5 else None
+        self._morph = state[6] if len(state) > 6 else None
         self._derived = None
 
     # -- construction -----------------------------------------------------
@@ -310,6 +317,25 @@ class Motion:
         if e[0] != "*" or e[1] < 2 or self._length <= 0:
             return None
         return int(e[1]), self._length / e[1]
+
+    @property
+    def morphs(self) -> mo.Morphs | None:
+        """The links' scale and shape channels, or None for a motion that morphs nothing."""
+        return self._morph
+
+    def with_morphs(self, morph: mo.Morphs | None) -> Motion:
+        """This motion with morph channels added (STARTMOTION's SCALE and SHAPE entries).
+
+        Parameters
+        ----------
+        morph : Morphs or None
+
+        Returns
+        -------
+        Motion
+            Its length covers the morph channels too.
+        """
+        return Motion(self._tracks, self._expr, None, (self._open, self._tail), self._root, morph)
 
     @property
     def root(self) -> tr.Track | None:
@@ -450,7 +476,8 @@ class Motion:
                 ta, tb = tr.join_smoothly(ta, tb, la)
                 tracks[j] = tr.concat(ta, tb, la)
         root = rp.concat(self._root, la, other._root, lb)
-        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail), root=root)
+        morph = mo.concat(self._morph, la, other._morph, lb, Motion)
+        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail), root=root, morph=morph)
 
     def repeat(self, n: int) -> Motion:
         """``n`` copies played back to back (the thesis' ``n * motion``).
@@ -481,12 +508,13 @@ class Motion:
     def _repeat(self, n: int) -> Motion:
         expr = ("*", n, self._expr)
         root = self._root
+        morph = mo.repeat(self._morph, n, self._length)
         if n == 0:
             still = None if root is None else tr.Const(root.start_value)
-            return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr, root=still)
+            return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr, root=still, morph=morph)
         gaps = (self._open, self._tail)
         if n == 1 or self._length == 0:
-            return Motion(self._tracks, expr, self._length * n, gaps, root)
+            return Motion(self._tracks, expr, self._length * n, gaps, root, morph)
         L = self._length
         tracks = {}
         for j, t in self._tracks.items():
@@ -500,7 +528,7 @@ class Motion:
                 tracks[j] = tr.concat(t, rest, L, end=end if end is not None else (n - 1) * L + t.end)
             else:
                 tracks[j] = tr.repeat_smoothly(t, n, L, end)
-        return Motion(tracks, expr, n * L, gaps, None if root is None else rp.repeat(root, n, L))
+        return Motion(tracks, expr, n * L, gaps, None if root is None else rp.repeat(root, n, L), morph)
 
     def __mul__(self, n) -> Motion:
         return self.repeat(n)
@@ -528,8 +556,10 @@ class Motion:
         for joint in joints:
             j = self._driven(joint, "the motion being stripped")
             kept[j] = self._tracks[j]
-        # The root path is not a joint: STRIP keeps it.
-        return Motion(kept, ("strip", tuple(kept), self._expr), gaps=(self._open, self._tail), root=self._root)
+        # The root path and the morphs are not joints: STRIP keeps them.
+        return Motion(
+            kept, ("strip", tuple(kept), self._expr), gaps=(self._open, self._tail), root=self._root, morph=self._morph
+        )
 
     def scale_frames(self, r: float) -> Motion:
         """Stretch time by ``|r|``; a negative ``r`` also plays the motion backwards.
@@ -565,7 +595,7 @@ class Motion:
             tracks = {j: tr.reverse(t, L, memo) for j, t in tracks.items()}
             gaps = (self._tail, self._open)  # a trailing hold played backwards is a leading gap
             root = None if root is None else rp.reverse(root, L, memo)
-        return Motion(tracks, ("frames", r, self._expr), L, gaps, root)
+        return Motion(tracks, ("frames", r, self._expr), L, gaps, root, mo.scale_frames(self._morph, r, self._length))
 
     def scale_extremes(self, r: float) -> Motion:
         """Multiply every angle (start and keyframe positions) by ``r``.
@@ -584,8 +614,9 @@ class Motion:
     def _scale_extremes(self, r: float) -> Motion:
         memo: dict = {}
         tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
-        # Positions are not angles: the root path is left as it is.
-        return Motion(tracks, ("extremes", r, self._expr), self._length, (self._open, self._tail), self._root)
+        # Positions, scales and shapes are not angles: the root path and the morphs are left as they are.
+        gaps = (self._open, self._tail)
+        return Motion(tracks, ("extremes", r, self._expr), self._length, gaps, self._root, self._morph)
 
     def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> Motion:
         """Take the short way round on axes that can turn freely.
@@ -609,7 +640,7 @@ class Motion:
             j = _joint_id(joint)
             if j in tracks and any(axes):
                 tracks[j] = tr.unwrap(tracks[j], (bool(axes[0]), bool(axes[1]), bool(axes[2])), memo)
-        return Motion(tracks, ("unwrap", self._expr), self._length, (self._open, self._tail), self._root)
+        return Motion(tracks, ("unwrap", self._expr), self._length, (self._open, self._tail), self._root, self._morph)
 
     # -- evaluation -------------------------------------------------------
 
@@ -894,7 +925,8 @@ def synchronize(*motions: Motion) -> Motion:
             tracks[j] = t
         opened |= m._open
         tail |= m._tail
-    return Motion(tracks, ("sync", tuple(m._expr for m in motions)), gaps=(opened, tail), root=root)
+    morph = mo.synchronize(enumerate((m._morph for m in motions), start=1), Motion)
+    return Motion(tracks, ("sync", tuple(m._expr for m in motions)), gaps=(opened, tail), root=root, morph=morph)
 
 
 def scale_frames(a: Motion, r: float) -> Motion:

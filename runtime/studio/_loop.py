@@ -29,6 +29,7 @@ the bytes of one whole request into an :class:`Answer`.
 from __future__ import annotations
 
 import collections
+import functools
 import itertools
 import queue
 import selectors
@@ -273,7 +274,7 @@ class ConnectionLoop:
             with self._busy_lock:
                 self._busy += 1
             try:
-                answer = self.handle(request, conn.client)
+                answer = self._safely(functools.partial(self.handle, request, conn.client))
             finally:
                 with self._busy_lock:
                     self._busy -= 1
@@ -286,8 +287,17 @@ class ConnectionLoop:
             if item is None:
                 return
             conn, deferred = item
-            self._done.append((conn, deferred()))
+            self._done.append((conn, self._safely(deferred)))
             self._wake()
+
+    def _safely(self, make: Callable[[], Answer]) -> Answer:
+        """``make()``, or a 500 if it raised: a bug costs one answer, never a worker of the pool."""
+        try:
+            return make()
+        except Exception as exc:  # noqa: BLE001 - the handler guards itself; this is the last line
+            self.log(f"studio: internal error: {type(exc).__name__}: {exc}")
+            body = _json_error("internal error in the studio; the server keeps running")
+            return Answer(status_bytes(500, "Internal Server Error", body))
 
     # --------------------------------------------------------------- loop
     def _turn(self, poll_interval: float) -> None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import http.client
 import json
+import os
 import socket
 import struct
 import threading
@@ -20,7 +21,15 @@ import time
 
 import pytest
 
-from liganimate.runtime.studio import Session, StudioLimits, StudioServer, _session, start_in_thread, studio_page
+from liganimate.runtime.studio import (
+    Session,
+    StudioLimits,
+    StudioServer,
+    _server,
+    _session,
+    start_in_thread,
+    studio_page,
+)
 from liganimate.runtime.studio._generator import HISTORY_MAX, KEPT_MAX
 
 
@@ -377,6 +386,7 @@ def test_every_field_of_the_wrong_type_or_size_is_a_400_sentence(shared, body):
         (b'{"action": "set", "link": 2, "angles": [1, 2, 99999999999999999999]}', None),
         (b'{"action": "state", "x": ' + b"[" * 900 + b"]" * 900 + b"}", None),
     ],
+    ids=lambda v: v[:36].decode() if isinstance(v, bytes) else str(v),
 )
 def test_bodies_of_any_shape_are_a_400_sentence(shared, raw, says):
     server, _ = shared
@@ -395,6 +405,52 @@ def test_bodies_of_any_shape_are_a_400_sentence(shared, raw, says):
     assert status == 400 and says in message and "\n" not in message
 
 
+# --------------------------------------------------------- HTTP framing
+def test_pipelined_requests_are_answered_in_turn_and_a_get_body_closes(humanoid, tmp_path):
+    with studio(humanoid, tmp_path) as (server, _, _):
+        port = server.port
+        s = socket.create_connection(("127.0.0.1", port))
+        s.settimeout(10)
+        fp = s.makefile("rb")  # one reader for all the answers: each reads exactly its own bytes
+        s.sendall(_get_bytes(port) + _post_bytes(port, {"action": "next"}) + _get_bytes(port, "/nowhere"))
+        assert [_read_answer(fp)[0] for _ in range(3)] == [200, 200, 404]
+        # A body on a GET is not ours to read as the next request: answered, then the connection closed.
+        smuggled = _get_bytes(port).replace(b"\r\n\r\n", b"\r\nContent-Length: 15\r\n\r\n") + b"GET / HTTP/1.1\r\n"
+        s.sendall(smuggled)
+        status, headers = _read_answer(fp)
+        assert status == 200 and headers["connection"] == "close"
+        assert fp.read(100) == b""
+        fp.close()
+        s.close()
+
+
+def _read_answer(fp) -> tuple[int, dict]:
+    """Status and headers of the next answer on ``fp``, its body read past."""
+    status = int(fp.readline().split()[1])
+    headers = {}
+    while (line := fp.readline()) not in (b"\r\n", b""):
+        name, _, value = line.decode("latin-1").partition(":")
+        headers[name.strip().lower()] = value.strip()
+    fp.read(int(headers["content-length"]))
+    return status, headers
+
+
+def test_a_bug_in_the_handler_is_a_500_and_the_pool_keeps_its_workers(humanoid, tmp_path, monkeypatch):
+    with studio(humanoid, tmp_path, workers=2) as (server, session, log):
+
+        def broken(self):
+            raise KeyError("boom")
+
+        # Past the handler's own guard (which answers 500 for a bug in an action): in its HTTP parsing.
+        monkeypatch.setattr(_server._Handler, "parse_request", broken)
+        for _ in range(3):  # more than the workers: none of them died
+            assert _request(server, "GET", "/api/state")[0] == 500
+        monkeypatch.undo()
+        assert _request(server, "GET", "/api/state")[0] == 200
+        assert server.stats()["threads"] == 3
+        assert log.lines[0] == "studio: internal error: KeyError: 'boom'"
+
+
 # ------------------------------------------------------------ environment
 def test_limits_come_from_the_environment_and_bad_values_are_one_line():
     from liganimate.runtime.errors import LigError
@@ -410,6 +466,15 @@ def test_limits_come_from_the_environment_and_bad_values_are_one_line():
     ):
         with pytest.raises(LigError, match=var):
             StudioLimits.from_environment({var: text})
+
+
+def test_the_command_refuses_a_bad_limit_in_one_line(tmp_path):
+    from commands import liganimate
+
+    env = dict(os.environ, LIGANIMATE_STUDIO_QUEUE="lots")
+    r = liganimate("studio", "--no-browser", cwd=tmp_path, timeout=120, env=env)
+    assert r.returncode == 1 and "LIGANIMATE_STUDIO_QUEUE='lots' is not a positive whole number" in r.stderr
+    assert "Traceback" not in r.stderr
 
 
 # ------------------------------------------------------------------ crowd
