@@ -156,7 +156,9 @@ class Evaluator:
             extremes = tuple((p[1], p[2]) for p in pairs) + ((0.0, 0.0),) * (3 - len(pairs))
         parent = _link(primary, args[1])
         # A secondary model is held by its current main link (thesis 3.3), a primary by its original one.
-        child = (secondary.current or secondary.main) if isinstance(secondary, ModelValue) else _link(secondary, args[3])
+        child = (
+            (secondary.current or secondary.main) if isinstance(secondary, ModelValue) else _link(secondary, args[3])
+        )
         joints: list | None = []
         for part in (primary, secondary):
             if isinstance(part, ModelValue):
