@@ -23,13 +23,14 @@ from pygls.uris import from_fs_path, to_fs_path
 
 from liganimate import __version__
 from liganimate.lang.parser import BUILTIN_PRIMITIVES
+from liganimate.lang.parser import reparser as reparser_for_document
 from liganimate.lang.source import prepare
 
 from . import completion as C
 from . import hover as H
 from . import navigation as N
 from . import outline, scan
-from .analysis import COMPILER_LOCK, Analysis, analyse
+from .analysis import COMPILER_LOCK, Analysis, analyse, complete
 from .lookup import target
 from .text import Text
 
@@ -49,6 +50,8 @@ class LigServer(LanguageServer):
         self.latest: dict = {}  # uri -> Analysis of some version (maybe not the newest)
         self.good: dict = {}  # uri -> the last Analysis whose text parsed
         self.pending: dict = {}  # uri -> the asyncio task that will analyse it
+        self.reparsers: dict = {}  # uri -> its Reparser (lang/incremental.py), used only by the worker
+        self.whole_parse = False  # True: no Reparser, every change parses the whole text (liganimate lsp --whole-parse)
         self.worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="liganimate-analysis")
 
     def encoding(self) -> str:
@@ -84,32 +87,53 @@ async def _analyse_until_current(ls: LigServer, uri: str) -> None:
     A change that arrives while an analysis runs is not analysed on its
     own: the next round takes the text as it is then, so a burst of
     keystrokes costs one analysis more than the one running, and a single
-    change is analysed at once, with no pause.
+    change is analysed at once, with no pause. The diagnostics go out as
+    soon as they are known, before the index and the values that requests
+    use are built (until then requests are answered from the last analysis),
+    and those are built only for a text that is still current.
     """
     loop = asyncio.get_running_loop()
     await asyncio.sleep(0)  # the change's own handler first
+    reparser = None if ls.whole_parse else ls.reparsers.setdefault(uri, reparser_for_document())
     while uri in ls.workspace.text_documents:
         doc = ls.workspace.get_text_document(uri)
         version, source = doc.version, doc.source
-        result = await loop.run_in_executor(ls.worker, _analyse_safely, source, _path(uri), version, ls.encoding())
+        result = await loop.run_in_executor(
+            ls.worker, _analyse_safely, source, _path(uri), version, ls.encoding(), reparser
+        )
         if uri not in ls.workspace.text_documents:
             return  # closed meanwhile
+        if ls.workspace.get_text_document(uri).version != version:
+            continue  # changed meanwhile: the newer text next, at once
+        ls.text_document_publish_diagnostics(
+            lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
+        )
+        result = await loop.run_in_executor(ls.worker, _complete_safely, result)
+        if uri not in ls.workspace.text_documents:
+            return
         ls.latest[uri] = result
         if result.parsed:
             ls.good[uri] = result
         if ls.workspace.get_text_document(uri).version == version:
-            ls.text_document_publish_diagnostics(
-                lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
-            )
-            return
+            return  # else a change came meanwhile, which _schedule left to this task
 
 
-def _analyse_safely(source: str, path: str | None, version, encoding: str) -> Analysis:
+def _analyse_safely(source: str, path: str | None, version, encoding: str, reparser) -> Analysis:
     try:
-        return analyse(source, path, version, encoding)
+        return analyse(source, path, version, encoding, whole=False, reparser=reparser)
     except Exception:  # noqa: BLE001 - a bug must cost one analysis, not the editor's server
         log.exception("the analysis failed")
+        if reparser is not None:
+            reparser.forget()  # the next analysis parses the whole text
         return Analysis(Text(source, encoding), version, path, [])
+
+
+def _complete_safely(a: Analysis) -> Analysis:
+    try:
+        return complete(a)
+    except Exception:  # noqa: BLE001 - as in _analyse_safely
+        log.exception("the analysis failed")
+        return Analysis(a.text, a.version, a.path, a.diagnostics)
 
 
 _SEVERITY = {"error": lsp.DiagnosticSeverity.Error, "warning": lsp.DiagnosticSeverity.Warning}
@@ -188,6 +212,7 @@ async def did_close(ls: LigServer, params: lsp.DidCloseTextDocumentParams) -> No
         task.cancel()
     ls.latest.pop(uri, None)
     ls.good.pop(uri, None)
+    ls.reparsers.pop(uri, None)
     ls.text_document_publish_diagnostics(lsp.PublishDiagnosticsParams(uri=uri, diagnostics=[]))
 
 
@@ -449,8 +474,9 @@ def on_folding(ls: LigServer, params: lsp.FoldingRangeParams) -> list:
     ]
 
 
-def main() -> int:
-    """Serve over stdin and stdout until the client says exit."""
+def main(*, whole_parse: bool = False) -> int:
+    """Serve over stdin and stdout until the client says exit; ``whole_parse``: see :class:`LigServer`."""
+    server.whole_parse = whole_parse
     server.start_io()
     return 0
 
