@@ -186,9 +186,10 @@ def scene_manifest(scenes, blob: Blob) -> list:
         One JSON-ready entry per scene: ``id``, ``length``, ``sameframe``,
         ``cameras`` (per tick: eye x, y, z and VIEW WIDTH, float32),
         ``bounds`` (centre x, y, z and radius of everything drawn),
-        ``framing`` (for a scene that sets no VIEW: the modern look's
-        camera, ``eye``, ``target`` and ``k``, the view width over the
-        distance, framing everything drawn in a 4:3 picture; else None),
+        ``framing`` (for a scene that sets no VIEW: the camera
+        ``liganimate run`` uses for it in the modern look at 640x480,
+        ``eye``, ``target``, ``width`` and ``k``, the view width over the
+        distance, from the box the program's check measured; else None),
         ``models`` and ``backgrounds``.
     """
     out = []
@@ -200,11 +201,11 @@ def scene_manifest(scenes, blob: Blob) -> list:
         pts = np.concatenate(extent)
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         framing = None
-        if not take.viewed and len(pts) > 1:
-            drawn = pts[1:]  # without the origin that seeds the extent
-            eye, width, target = framing_view((drawn.min(axis=0), drawn.max(axis=0)), (640, 480))
+        if take.framing is not None:
+            # The camera `liganimate run` uses for this scene at the viewer's 4:3 shape.
+            eye, width, target = framing_view(take.framing, (640, 480))
             distance = float(np.linalg.norm(np.subtract(eye, target)))
-            framing = {"eye": list(eye), "target": list(target), "k": width / distance}
+            framing = {"eye": list(eye), "target": list(target), "k": width / distance, "width": width}
         centre = (lo + hi) / 2
         radius = float(np.linalg.norm(hi - lo) / 2) or 1.0
         out.append(

@@ -105,7 +105,7 @@
     var need = s.capacity * 9 + 9;
     if (frame.pos.length < need) { frame.pos = new Float32Array(need); frame.col = new Uint8Array(need); }
     var pos = frame.pos, col = frame.col, o = 0, oc = 0;
-    var ranges = [], spans = [];
+    var ranges = [], spans = [], objects = [];
     var tr = tickRange(s, state.image);
     var mark = state.pinned || state.hover;
     var add = function (first, cam) {
@@ -120,6 +120,7 @@
       var first = o / 3;
       pos.set(b.pos, o); o += b.pos.length;
       oc = LigGL.colours(col, oc, b.rgb, null, -1, TINT);
+      objects.push({ first: first, count: o / 3 - first });
       add(first, cam0);
     });
     for (var t = tr[0]; t <= tr[1]; t++) {
@@ -132,18 +133,20 @@
         var tint = mark && mark.model === mi && mark.tick === t ? mark.link : -1;
         oc = LigGL.colours(col, oc, m.rgb, m.link, tint, TINT);
         spans.push({ first: first, count: o / 3 - first, model: mi, tick: t, row: row, cam: cam });
+        objects.push({ first: first, count: o / 3 - first });
         add(first, cam);
       }
     }
     frame.ranges = ranges;
     frame.spans = spans;
+    frame.objects = objects;  // each casts or receives the contact shadow as one object
     frame.used = o;
   }
 
   function draw() {
     build();
     renderer.draw({ pos: frame.pos.subarray(0, frame.used), col: frame.col.subarray(0, frame.used),
-      ranges: frame.ranges }, scenes[state.scene].bounds);
+      ranges: frame.ranges, objects: frame.objects }, scenes[state.scene].bounds);
     showFrame();
     showInfo();
   }
@@ -347,6 +350,8 @@
       draw();
     },
     camera: function () { return state.userCam; },
+    /* The camera the current frame starts from before any orbit: VIEW's, or run's default framing. */
+    sceneCamera: function () { var s = scenes[state.scene]; return sceneCamera(s, tickRange(s, state.image)[0]); },
     ready: performance.now()
   };
 })();
