@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from liganimate.runtime.figure.pose import mesh_table, static_triangles, world_transforms
+from liganimate.runtime.figure.pose import mesh_table, morphed, static_triangles, world_transforms, world_triangles
 from liganimate.runtime.render.framing import framing_view
 from liganimate.runtime.values import Graphical, rgb_levels
 
@@ -92,11 +92,25 @@ def _link_boxes(table, n_links: int) -> np.ndarray:
     return np.where(sel[None], hi[:, None, :], lo[:, None, :])
 
 
+def _morphs(take, X: np.ndarray, table) -> tuple[np.ndarray, np.ndarray | None]:
+    """The take's SCALE tracks folded into ``X``, and its SHAPE tracks' triangles per tick (None without)."""
+    local = None
+    for rows, fig, motion, frames in take.sources:
+        if motion.morphs is None:
+            continue
+        X[rows], shaped = morphed(fig, motion, frames, X[rows])
+        if shaped is not None:
+            if local is None:
+                local = np.broadcast_to(table.triangles, (len(X), *table.triangles.shape)).copy()
+            local[rows] = shaped
+    return X, local
+
+
 def _model_entry(take, blob: Blob, extent: list) -> dict:
     fig = take.figure
     L = fig.n_links
-    X = world_transforms(fig, take.angles, take.placements)  # (T, L, 4, 4)
     table = mesh_table(fig)
+    X, local = _morphs(take, world_transforms(fig, take.angles, take.placements), table)  # (T, L, 4, 4)
     boxes = _link_boxes(table, L)  # (L, 8, 3)
     world = np.einsum("tlij,lkj->tlki", X[..., :3, :3], boxes) + X[:, :, None, :3, 3]
     extent.append(world.reshape(-1, 3))
@@ -113,7 +127,17 @@ def _model_entry(take, blob: Blob, extent: list) -> dict:
                 "slide": bool(j.slide),  # its values are a displacement, not degrees
             }
         )
+    morph = None
+    if local is not None:
+        moving = np.flatnonzero((local != table.triangles[None]).any(axis=(0, 2, 3)))
+        # (the boxes above are the links' own: a morphed shape that reaches further is still framed by them)
+        extent.append(world_triangles(table, X, local).reshape(-1, 3))
+        morph = {
+            "rows": blob.add(moving, np.uint32),
+            "pos": blob.add(local[:, moving].reshape(-1), np.float32),
+        }
     return {
+        "morph": morph,
         "name": take.name,
         "links": [link.name if link.name is not None else "<anonymous>" for link in fig.links],
         "jointOfLink": joint_of_link,

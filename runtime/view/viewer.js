@@ -40,7 +40,10 @@
       return {
         name: m.name, links: m.links, jointOfLink: m.jointOfLink, joints: m.joints,
         local: V(m.mesh.pos), link: V(m.mesh.link), rgb: V(m.mesh.rgb),
-        rowOf: rowOf, matrices: V(m.matrices), angles: V(m.angles), L: m.links.length, J: m.joints.length
+        rowOf: rowOf, matrices: V(m.matrices), angles: V(m.angles), L: m.links.length, J: m.joints.length,
+        // Morphing segments (SHAPE LINK tracks): the rows that move, and their corners at each drawn tick.
+        morphRows: m.morph ? V(m.morph.rows) : null, morphPos: m.morph ? V(m.morph.pos) : null,
+        scratch: m.morph ? new Float32Array(V(m.mesh.pos)) : null
       };
     });
     var backgrounds = s.backgrounds.map(function (b) {
@@ -85,6 +88,18 @@
     return [t0, Math.min(s.length, t0 + s.k) - 1];
   }
 
+  /* A model's triangles in their links' coordinates at one drawn tick: its own, or, where a
+   * motion morphs segments, with the morphed rows' corners of that tick written in. */
+  function shapeAt(m, row) {
+    if (!m.morphRows) return m.local;
+    var R = m.morphRows.length, local = m.scratch, pos = m.morphPos;
+    for (var q = 0; q < R; q++) {
+      var dst = m.morphRows[q] * 9, from = (row * R + q) * 9;
+      for (var c = 0; c < 9; c++) local[dst + c] = pos[from + c];
+    }
+    return local;
+  }
+
   function build() {
     var s = scenes[state.scene];
     var need = s.capacity * 9 + 9;
@@ -114,7 +129,7 @@
         var m = s.models[mi], row = m.rowOf[t];
         if (row < 0) continue;
         var first = o / 3;
-        o = LigGL.transform(pos, o, m.local, m.link, m.matrices, row * m.L * 12);
+        o = LigGL.transform(pos, o, shapeAt(m, row), m.link, m.matrices, row * m.L * 12);
         var tint = mark && mark.model === mi && mark.tick === t ? mark.link : -1;
         oc = LigGL.colours(col, oc, m.rgb, m.link, tint, TINT);
         spans.push({ first: first, count: o / 3 - first, model: mi, tick: t, row: row, cam: cam });

@@ -18,6 +18,7 @@ from PIL import Image
 ROOT = ROOT_DIR
 APPENDIX = os.path.join(ROOT, "examples", "appendix_a.lig")
 FIVE = os.path.join(ROOT, "benchmarks", "five_humans.lig")
+MAILBOX = os.path.join(ROOT, "examples", "mailbox.lig")  # morphing segments: SCALE LINK and SHAPE LINK tracks
 
 TWO_SCENES = """\
       GRAPHICAL A, B, FLOOR
@@ -68,6 +69,7 @@ def pages(tmp_path_factory):
     five = Path(FIVE).read_text(encoding="utf-8").replace("STARTSCENE LENGTH 1000", "STARTSCENE LENGTH 60")
     five = re.sub(r"FROM 0 TO 999 ", "FROM 0 TO 59 ", five)
     sources = {"appendix": APPENDIX, "five": tmp / "five.lig", "two": tmp / "two.lig", "walk": tmp / "walk.lig"}
+    sources["mailbox"] = MAILBOX
     (tmp / "five.lig").write_text(five, encoding="utf-8")
     (tmp / "walk.lig").write_text(NO_VIEW, encoding="utf-8")
     (tmp / "two.lig").write_text(TWO_SCENES, encoding="utf-8")
@@ -125,6 +127,7 @@ def _run_image(folder, scene_id, image):
         ("appendix", 0, 1, [0]),  # SAMEFRAME 6: six ticks in one picture
         ("two", 0, 1, [0, 10, 20]),  # a background object
         ("two", 1, 2, [0, 3]),  # a camera from above at an angle, SAMEFRAME 2
+        ("mailbox", 0, 1, [0, 30, 41, 60]),  # segments that change shape and size
     ],
 )
 def test_the_canvas_shows_what_liganimate_run_draws(pages, browser, name, scene_index, scene_id, images):
