@@ -247,15 +247,21 @@ def test_the_notebook_display_draws_the_shadow_from_runs_camera(pages, browser, 
     browser.driver.get(host.as_uri())
     browser.driver.switch_to.frame(browser.driver.find_element("tag name", "iframe"))
     try:
-        deadline = time.time() + 30
-        while not browser.driver.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"):
-            assert time.time() < deadline, "the notebook's viewer did not start"
-            time.sleep(0.05)
-        assert browser.driver.execute_script("return ligViewer.sceneCamera()") == expected
+        from selenium.webdriver.support.ui import WebDriverWait
+
+        # Waits for the frame's viewer, however loaded the machine; the bound only stops a hang.
+        WebDriverWait(browser.driver, 60, poll_frequency=0.05).until(
+            lambda d: d.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"),
+            "the notebook's viewer did not start",
+        )
+        start = browser.driver.execute_script("return ligViewer.sceneCamera()")
+        assert start == expected, (start, expected)
         img = browser.canvas().astype(int)
         rows, cols = np.nonzero(img < 200)
+        assert len(rows), "the notebook's viewer drew no figure"
         below = img[rows.max() + 2 : rows.max() + 8, cols.min() : cols.max() + 1]
-        assert img[0, 0] == 244 and below.min() < 240  # the grey background, darker under the feet
+        # The grey background, darker under the feet.
+        assert img[0, 0] == 244 and below.min() < 240, (img.shape, img[0, 0], below.min())
     finally:
         browser.driver.switch_to.default_content()
 
