@@ -311,8 +311,10 @@ class Lowerer(NodeVisitor):
         )
 
     def joint_or_root(self, e) -> str:
-        """A keyframe's joint identifier, or None for the ROOT track."""
-        return "None" if isinstance(e, A.RootTrack) else self.expr(e)
+        """A keyframe's joint identifier, or None for the ROOT track and 'ORIENTATION' for ROOT ORIENTATION."""
+        if isinstance(e, A.RootTrack):
+            return repr("ORIENTATION") if e.orientation else "None"
+        return self.expr(e)
 
     def position(self, items: list) -> str:
         if len(items) == 1:

@@ -570,7 +570,7 @@ class Runtime(Arithmetic):
         spec = {}
         for joint, start, kfs, jat in joints:
             if joint in spec:
-                self.fail(jat, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
+                self.fail(jat, f"{_track_label(joint)} appears twice in this motion")
             last = 0
             for frame, pos, _method, kat in kfs:
                 self._guard(kat, E.check_frame, frame)
@@ -586,11 +586,13 @@ class Runtime(Arithmetic):
                 tuple(start) if start is not None else (0.0, 0.0, 0.0),
                 [Keyframe(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
-        root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
-        arrays = self._table_tracks(tables, spec, root is not None)
-        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays))
+        # The ROOT entries (lower.py writes their joints as None and M.ORIENTATION).
+        root, turn = spec.pop(None, None), spec.pop(M.ORIENTATION, None)
+        given = {j for j, track in ((None, root), (M.ORIENTATION, turn)) if track is not None}
+        arrays = self._table_tracks(tables, spec, given)
+        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays, turn=turn))
 
-    def _table_tracks(self, tables, spec: dict, has_root: bool) -> dict:
+    def _table_tracks(self, tables, spec: dict, given: set) -> dict:
         """Each table column as ``(start, frames, values)``: its first row is the start, the others keyframes."""
         arrays: dict = {}
         for t in tables:
@@ -600,8 +602,8 @@ class Runtime(Arithmetic):
                 self.fail(t.at, "this keyframe table's rows do not have one frame and three numbers per column")
             data = data.reshape(-1, width)
             for n, joint in enumerate(t.columns):
-                if joint in spec or joint in arrays or (joint is None and has_root):
-                    self.fail(t.at, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
+                if joint in spec or joint in arrays or joint in given:
+                    self.fail(t.at, f"{_track_label(joint)} appears twice in this motion")
                 cols = data[:, 1 + 3 * n : 4 + 3 * n]
                 arrays[joint] = (cols[0], data[1:, 0], cols[1:])
         return arrays
@@ -803,12 +805,19 @@ class SceneState:
 
 
 def _rooted(posed: Posed) -> Posed:
-    """A drawn pose with its motion's root path folded into the placement (world = placement @ Trans(root) @ pose)."""
-    if posed.motion.root is None:
+    """A drawn pose with its motion's root track folded into the placement (world = placement @ Trans(root) @ Rot @ pose)."""
+    if posed.motion.root is None and posed.motion.turn is None:
         return posed
     fig = posed.figure
     placed = P.rooted_placements(np.asarray(fig.placement)[None], posed.motion, np.array([posed.frame]))[0]
     return posed.with_figure(fig.with_placement(placed))
+
+
+def _track_label(joint) -> str:
+    """How a diagnostic names a motion's track: ``joint 3``, ``ROOT``, ``ROOT ORIENTATION``."""
+    if joint is None:
+        return "ROOT"
+    return "ROOT ORIENTATION" if joint == M.ORIENTATION else f"joint {joint}"
 
 
 def _joint_kind(kind) -> F.JointKind:
