@@ -248,12 +248,15 @@ def _name_rows(clip, links: list) -> list:
     return rows
 
 
-def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None, ids=None) -> bytes:
+def _motion_text(
+    name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None, ids=None, orientation=None
+) -> bytes:
     """STARTMOTION ... ENDMOTION: keyframes at every frame (or at ``keep[j]``) for every joint that moves.
 
     ``path`` (F, 3), if given, is the ROOT track: its start position, then a
     keyframe at every frame if it moves.  ``ids`` are the joints' identifiers
-    (default 1, 2, ...).  With a keyframe at every frame (``keep`` None) the
+    (default 1, 2, ...).  ``orientation`` (F, 3), if given, is the ROOT
+    ORIENTATION track, written as the path is.  With a keyframe at every frame (``keep`` None) the
     moving tracks go into one keyframe table (``TABLE``, docs/language.md
     4.8), a row a frame; with ``keep``, each joint lists its own keyframes.
     """
@@ -278,9 +281,19 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
         parts.append(format_rows(path[:1], DECIMALS, sep=",", prefix="        ROOT POSITION", suffix="\n"))
         if root_moves:
             parts.append(_keyframe_rows(frames, path[1:]))
+    turns = orientation is not None and F > 1 and bool((orientation != orientation[:1]).any())
+    if orientation is not None and not (table and turns):
+        parts.append(
+            format_rows(orientation[:1], DECIMALS, sep=",", prefix="        ROOT ORIENTATION POSITION", suffix="\n")
+        )
+        if turns:
+            parts.append(_keyframe_rows(frames, orientation[1:]))
     if table:
         columns = [angles[:, j] for j in range(J) if moving[j]] + ([path] if root_moves else [])
         names = [str(ids[j]) for j in range(J) if moving[j]] + (["ROOT"] if root_moves else [])
+        if turns:
+            columns.append(orientation)
+            names.append("ROOT ORIENTATION")
         parts.append(_table_text(names, np.arange(F, dtype=np.float64), columns))
     parts.append(b"      ENDMOTION\n")
     return b"".join(parts)
@@ -292,7 +305,7 @@ def _table_text(names: list, frames: np.ndarray, columns: list) -> bytes:
     for k in range(12, len(names), 12):
         head[-1] += ","
         head.append("              " + ", ".join(names[k : k + 12]))
-    legend = "frame, then x y z of " + ", ".join(n if n == "ROOT" else f"JOINT {n}" for n in names)
+    legend = "frame, then x y z of " + ", ".join(n if n.startswith("ROOT") else f"JOINT {n}" for n in names)
     head.append(f"{{ {legend} }}")
     table = np.column_stack([frames] + columns)
     rows = format_rows(table, [0] + [DECIMALS] * (table.shape[1] - 1), prefix="          |", suffix="\n")
@@ -300,7 +313,13 @@ def _table_text(names: list, frames: np.ndarray, columns: list) -> bytes:
 
 
 def motion_library(
-    name: str, angles: np.ndarray, ids: list, path: np.ndarray, comments: list, tolerance: float = 0.0
+    name: str,
+    angles: np.ndarray,
+    ids: list,
+    path: np.ndarray,
+    comments: list,
+    tolerance: float = 0.0,
+    orientation: np.ndarray | None = None,
 ) -> bytes:
     """A library holding one MOTION: ``comments`` (lines) first, then its declaration and keyframes.
 
@@ -316,12 +335,15 @@ def motion_library(
         Written as ``C`` lines (made safe for a brace comment).
     tolerance : float
         As :class:`ImportOptions`'.
+    orientation : ndarray, shape (F, 3), optional
+        The ROOT ORIENTATION track (degrees, unwrapped along the frames).
     """
     head = [("C " + comment_text(c)).rstrip() for c in comments]
     head += ["", f"      MOTION {name}", ""]
     keep = reduce_keyframes(angles, tolerance) if tolerance > 0 else None
     rotating = np.ones(angles.shape[1], dtype=bool)
-    return ("\n".join(head) + "\n").encode("utf-8") + _motion_text(name, angles, rotating, keep, path, ids)
+    body = _motion_text(name, angles, rotating, keep, path, ids, orientation)
+    return ("\n".join(head) + "\n").encode("utf-8") + body
 
 
 def read_root_path(path: str) -> np.ndarray:
