@@ -266,10 +266,32 @@ def _motion_text(
     if F > 1 and not moving.any():
         moving[0] = True  # keep the motion's length: one joint carries every frame
     ids = list(range(1, J + 1)) if ids is None else list(ids)
-    root_moves = path is not None and F > 1 and bool((path != path[:1]).any())
     table = keep is None and F > 1
     frames = np.arange(1, F, dtype=np.float64)
-    for j in range(J):
+    parts += _joint_entries(angles, rotating, moving, ids, keep, table)
+    columns = [angles[:, j] for j in range(J) if moving[j]] if table else []
+    names = [str(ids[j]) for j in range(J) if moving[j]] if table else []
+    for word, track in (("ROOT", path), ("ROOT ORIENTATION", orientation)):
+        if track is None:
+            continue
+        if table and F > 1 and bool((track != track[:1]).any()):
+            columns.append(track)
+            names.append(word)
+            continue
+        parts.append(format_rows(track[:1], DECIMALS, sep=",", prefix=f"        {word} POSITION", suffix="\n"))
+        if F > 1 and bool((track != track[:1]).any()):
+            parts.append(_keyframe_rows(frames, track[1:]))
+    if table:
+        parts.append(_table_text(names, np.arange(F, dtype=np.float64), columns))
+    parts.append(b"      ENDMOTION\n")
+    return b"".join(parts)
+
+
+def _joint_entries(angles, rotating, moving, ids: list, keep, table: bool) -> list:
+    """``JOINT n POSITION ...`` and its keyframe lines for each joint not in the table."""
+    frames = np.arange(1, len(angles), dtype=np.float64)
+    parts = []
+    for j in range(angles.shape[1]):
         if not rotating[j] and not moving[j] or (table and moving[j]):
             continue
         start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {ids[j]} POSITION", suffix="\n")
@@ -277,26 +299,7 @@ def _motion_text(
         if moving[j]:
             rows = keep[j][keep[j] > 0]
             parts.append(_keyframe_rows(frames[rows - 1], angles[rows, j]))
-    if path is not None and not (table and root_moves):
-        parts.append(format_rows(path[:1], DECIMALS, sep=",", prefix="        ROOT POSITION", suffix="\n"))
-        if root_moves:
-            parts.append(_keyframe_rows(frames, path[1:]))
-    turns = orientation is not None and F > 1 and bool((orientation != orientation[:1]).any())
-    if orientation is not None and not (table and turns):
-        parts.append(
-            format_rows(orientation[:1], DECIMALS, sep=",", prefix="        ROOT ORIENTATION POSITION", suffix="\n")
-        )
-        if turns:
-            parts.append(_keyframe_rows(frames, orientation[1:]))
-    if table:
-        columns = [angles[:, j] for j in range(J) if moving[j]] + ([path] if root_moves else [])
-        names = [str(ids[j]) for j in range(J) if moving[j]] + (["ROOT"] if root_moves else [])
-        if turns:
-            columns.append(orientation)
-            names.append("ROOT ORIENTATION")
-        parts.append(_table_text(names, np.arange(F, dtype=np.float64), columns))
-    parts.append(b"      ENDMOTION\n")
-    return b"".join(parts)
+    return parts
 
 
 def _table_text(names: list, frames: np.ndarray, columns: list) -> bytes:

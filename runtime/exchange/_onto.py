@@ -180,5 +180,10 @@ def _report(clip, fig, name, library, jmap: JointMap, result: Retargeted) -> lis
             f"planted frames: left {planted.get('L', 0)}, right {planted.get('R', 0)}; "
             f"the most a planted ankle moves in a frame: {slide:.3g}"
         )
+    heading = result.orientation[:, 1]
+    lines.append(
+        f"heading (ROOT ORIENTATION, degrees about up): {heading[0]:.0f} to {heading[-1]:.0f}, "
+        f"turning {heading[-1] - heading[0]:+.0f} in all (between {heading.min():.0f} and {heading.max():.0f})"
+    )
     lines += [f"note: {n}" for n in result.notes]
     return lines
