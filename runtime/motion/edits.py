@@ -121,8 +121,10 @@ def apply(m: KeyframeEdits) -> Motion:
         # Keep each keyframe's ramp so a stretched motion stays stretched.
         if j is None:
             start, kfs = base.root_keyframes()
+        elif isinstance(j, str):  # ORIENTATION
+            start, kfs = base.turn_keyframes()
         else:
-            start, kfs = base.turn_keyframes() if j == ORIENTATION else base.keyframes(j)
+            start, kfs = base.keyframes(j)
         tracks[j] = [tuple(start), {i + 1: (kf, None) for i, kf in enumerate(kfs)}]
     for joint, k, frame, position, method, eat in edits:
         entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
