@@ -44,9 +44,13 @@ def _world(tgt, angles: np.ndarray, path: np.ndarray, main: np.ndarray | None = 
     return W, P
 
 
-def leg_chain_positions(tgt, angles: np.ndarray, path: np.ndarray, link: int) -> np.ndarray:
-    """Where link ``link``'s joint is at every frame (F, 3), in the model's frame."""
-    return _world(tgt, angles, path)[1][:, link]
+def leg_chain_positions(tgt, angles: np.ndarray, path: np.ndarray, link: int | None, main=None) -> np.ndarray:
+    """Where link ``link``'s joint is at every frame (F, 3), in the model's frame (``link`` None: every link's, (F, n, 3)).
+
+    ``main`` (F, 3, 3): the main link's world rotation (None: it does not turn).
+    """
+    points = _world(tgt, angles, path, main)[1]
+    return points if link is None else points[:, link]
 
 
 def _knee_axis(tgt, k: int) -> int:

@@ -41,7 +41,7 @@ from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
 from liganimate.runtime.motion.turning import orientation_angles
 
 from ._clip import clip_pose, rest_positions
-from ._feet import keep_feet
+from ._feet import keep_feet, leg_chain_positions
 from ._joint_map import JointMap
 from ._rigging import CLAMP_REPORT, at_least, fit_angles, rotation_between, runs
 
@@ -311,6 +311,19 @@ def _root_path(src: _Source, tgt: _Target, jmap: JointMap, Fm: np.ndarray, scale
     return path
 
 
+def _stand(tgt: _Target, jmap: JointMap, angles: np.ndarray, path: np.ndarray, main: np.ndarray) -> None:
+    """Set the figure on its feet (``path`` changed in place): its ankles, as its own retargeted legs put them, are
+    as low at their lowest (the 5th percentile of both) as they are when the figure stands at rest.
+
+    The capture's hips-over-ankles height, scaled, only approximates this: the figure's legs bend
+    as their extremes let them, not exactly as the actor's.
+    """
+    feet = [jmap.feet[side][1][2] for side in jmap.feet]
+    points = leg_chain_positions(tgt, angles, path, None, main)
+    level = float(np.percentile(points[:, feet, 1], 5))
+    path[:, 1] += float(np.mean(tgt.pivot[feet, 1])) - level
+
+
 def _contacts(src: _Source, jmap: JointMap, Fm: np.ndarray, length: float) -> dict:
     """Per side, the frames where the capture's ankle is planted: near its lowest and nearly still."""
     out = {}
@@ -365,8 +378,10 @@ def retarget(clip, fig, jmap: JointMap, options: RetargetOptions = RetargetOptio
     notes = list(src.notes)
     main = _main_rotation(src)
     orientation = np.degrees(np.unwrap(np.radians(orientation_angles(main)), axis=0))
+    _stand(tgt, jmap, angles, path, main)
     if planted:
         notes += keep_feet(tgt, angles, path, desired, planted, jmap, main)
+        _stand(tgt, jmap, angles, path, main)  # the held feet moved: stand again (all together, so none slides)
     driven = sorted({int(tgt.joint[t]) for _, t in jmap.pairs if tgt.joint[t] >= 0} | _feet_joints(tgt, jmap))
     ids = [tgt.fig.joints[k].id for k in driven]
     return Retargeted(
