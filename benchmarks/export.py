@@ -30,7 +30,7 @@ import sys
 import tempfile
 import time
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime import exchange as X
 
 HERE = os.path.dirname(os.path.abspath(__file__))

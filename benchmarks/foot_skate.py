@@ -46,7 +46,7 @@ import tempfile
 
 import numpy as np
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.figure.pose import (
     joint_angles,
     mesh_table,

@@ -1,23 +1,30 @@
-"""Pose benchmark: joint-frames per second for the Appendix A humanoid.
+"""Pose benchmark: forward kinematics of the library HUMANOID against pinocchio, and a per-frame loop.
 
-The model is HUMAN from ``examples/appendix_a.lig`` (11 links, 10 joints,
-rooted at a FOOT as the program leaves it) and the motion is its SQUAT.
-Poses are evaluated at many (fractional) frames spread over the motion.
-Reported, side by side in one run:
+Two measurements, each side by side in one run, judged on CPU time (this
+process's; wall time and the load average printed beside it, see
+``_clock.py``), best of several interleaved rounds:
 
-* liganimate's batched evaluation, what ``liganimate run`` does: the motion
-  sampled at all frames at once, every angle clamped to its joint's
-  extremes, and the stacked 4x4 link transforms built over all frames
-  (one matrix product per depth level of the tree);
-* what a user would otherwise write: a per-frame Python loop that, for each
-  frame and each joint, interpolates the joint's angles between its
-  keyframes, clamps them, builds the joint's 4x4 matrix and multiplies it
-  down the tree.
+* **Forward kinematics of HUMANOID** (``LOAD 'humanoid'``: 20 links, 19
+  joints, 30 axes that move) from joint angles to every link's transform,
+  at random angles within the extremes, against **pinocchio** (``pin``, C++):
+  the same model exported as URDF (``liganimate export --urdf``'s writer),
+  read by ``pinocchio.buildModelFromXML``, and ``pinocchio.forwardKinematics``
+  called once per frame from Python (what a Python user of pinocchio
+  writes). liganimate is timed batched (``pose_transforms`` over 4,096
+  frames a call, and over 32, the renderer's batch) and one frame a call.
+  Both give the same transforms (checked, to 1e-12, on pinocchio's frame
+  placements). Goals (issue 22): batched at most 2.0 us a frame, one frame
+  at most 20 us.
+* **Sampling a motion and posing** HUMAN of ``examples/appendix_a.lig``
+  (11 links, 10 joints, rooted at a FOOT) over its SQUAT, batched (what
+  ``liganimate run`` does: the motion sampled at all frames at once, every
+  angle clamped, the stacked 4x4 link transforms built), against what a user
+  would otherwise write: a per-frame Python loop that, per frame and per
+  joint, interpolates between keyframes, clamps, builds the joint's 4x4
+  matrix and multiplies it down the tree (an extra row; same transforms to
+  1e-9). A joint-frame is one joint posed at one frame.
 
-Both give the same transforms (checked, to 1e-9).  A joint-frame is one
-joint posed at one frame.  Every figure is the best of several interleaved
-rounds (the machine is shared: other load only slows a round down).  The
-last line printed is one JSON object with the figures.
+The last line printed is one JSON object with the figures.
 
 Usage: ``python benchmarks/pose.py [--quick]``.
 """
@@ -29,11 +36,13 @@ import json
 import math
 import os
 import sys
-import time
+import tempfile
 
 import numpy as np
+from _clock import Cost, best_of, load_text, measure
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
+from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure.pose import joint_angles, world_transforms
 from liganimate.runtime.host import Posed
 
@@ -135,10 +144,137 @@ def loop(setup, n_links: int, frames) -> np.ndarray:
     return out
 
 
+def load_humanoid(folder: str):
+    """The library's HUMANOID (a Figure), from a one-line program that loads it."""
+    path = os.path.join(folder, "load_humanoid.lig")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("LOAD 'humanoid'\n")
+    program, _ = load_program(path)
+    fig = program.execute("check").variables["HUMANOID"]
+    return fig.figure if isinstance(fig, Posed) else fig
+
+
+def pinocchio_model(fig, folder: str):
+    """(model, data, q_of) for pinocchio, or None without it: the figure through our URDF writer.
+
+    ``q_of(angles)`` turns one frame's angles (n_joints, 3) in degrees into
+    pinocchio's configuration vector (radians; cos and sin for a continuous
+    joint).
+    """
+    try:
+        import pinocchio as pin
+    except ImportError as exc:
+        print(f"pinocchio: not measured ({exc}; pip install 'liganimate[bench]')")
+        return None
+    from liganimate.runtime.exchange._urdf_write import joint_columns, urdf_text
+
+    text, _ = urdf_text(fig, "humanoid", os.path.join(folder, "meshes"), "meshes")
+    model = pin.buildModelFromXML(text.decode("utf-8"))
+    slots = []
+    for name, k, axis, _slide in joint_columns(fig):
+        joint = model.joints[model.getJointId(name)]
+        slots.append((joint.idx_q, joint.nq, k, axis))
+
+    def q_of(angles: np.ndarray) -> np.ndarray:
+        q = np.zeros(model.nq)
+        for iq, nq, k, axis in slots:
+            v = math.radians(float(angles[k, axis]))
+            if nq == 2:
+                q[iq : iq + 2] = (math.cos(v), math.sin(v))
+            else:
+                q[iq] = v
+        return q
+
+    return pin, model, model.createData(), q_of
+
+
+def pinocchio_difference(fig, pin_parts, angles: np.ndarray) -> float:
+    """Largest difference between our link transforms and pinocchio's frame placements."""
+    from liganimate.runtime.exchange._urdf_write import link_names
+
+    pin, model, data, q_of = pin_parts
+    ours = K.pose_transforms(fig, angles)
+    ids = [model.getFrameId(name) for name in link_names(fig)]
+    err = 0.0
+    for t in range(len(angles)):
+        pin.framesForwardKinematics(model, data, q_of(angles[t]))
+        theirs = np.stack([data.oMf[i].homogeneous for i in ids])
+        err = max(err, float(np.abs(ours[t] - theirs).max()))
+    return err
+
+
+def humanoid_fk(args, folder: str) -> dict:
+    """Forward kinematics of HUMANOID: liganimate batched and one frame a call, pinocchio per call."""
+    fig = load_humanoid(folder)
+    lo, hi = fig.extremes[..., 0], fig.extremes[..., 1]
+    dof = int(((hi - lo) > 0).sum())
+    rng = np.random.default_rng(20261126)
+    big, small, singles, rounds = 4096, 32, (200 if args.quick else 1000), (5 if args.quick else 9)
+    angles = rng.uniform(lo, hi, size=(big, fig.n_joints, 3))
+    print(
+        f"\nHUMANOID (LOAD 'humanoid'): {fig.n_links} links, {fig.n_joints} joints, {dof} moving axes; "
+        f"random angles within the extremes"
+    )
+    pin_parts = pinocchio_model(fig, folder)
+    err = None
+    if pin_parts is not None:
+        err = pinocchio_difference(fig, pin_parts, angles[:50])
+        print(f"liganimate vs pinocchio: largest difference {err:.2e}")
+        assert err < 1e-12, err
+        pin, model, data, q_of = pin_parts
+        qs = [q_of(a) for a in angles[:singles]]
+    costs: dict[str, list[Cost]] = {"batched": [], "batch32": [], "single": [], "pinocchio": []}
+    for _ in range(rounds):
+        costs["batched"].append(measure(lambda: K.pose_transforms(fig, angles)).per(big))
+        costs["batch32"].append(
+            measure(lambda: [K.pose_transforms(fig, angles[i : i + small]) for i in range(0, big, small)]).per(big)
+        )
+        costs["single"].append(
+            measure(lambda: [K.pose_transforms(fig, angles[i : i + 1]) for i in range(singles)]).per(singles)
+        )
+        if pin_parts is not None:
+            costs["pinocchio"].append(
+                measure(lambda: [pin.forwardKinematics(model, data, q) for q in qs]).per(len(qs))  # noqa: B023
+            )
+    best = {k: best_of(v) for k, v in costs.items() if v}
+    labels = {
+        "batched": f"liganimate, {big:,} frames a call",
+        "batch32": f"liganimate, {small} frames a call",
+        "single": "liganimate, one frame a call",
+        "pinocchio": "pinocchio forwardKinematics a call",
+    }
+    for k, c in best.items():
+        print(f"  {labels[k]:38s} {c.cpu * 1e6:8.2f} us CPU a frame  (wall {c.wall * 1e6:8.2f} us, load {c.load:.1f})")
+    goals = {
+        "batched_at_most_2us": best["batched"].cpu <= 2.0e-6,
+        "single_at_most_20us": best["single"].cpu <= 20e-6,
+    }
+    print("  goals: " + ", ".join(f"{k} {'met' if v else 'NOT met'}" for k, v in goals.items()))
+    return {
+        "links": fig.n_links,
+        "joints": fig.n_joints,
+        "moving_axes": dof,
+        "us_per_frame": {k: c.json(1e6, 3) for k, c in best.items()},
+        "pinocchio_difference": err,
+        "goals": goals,
+    }
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="a short run (under a minute)")
     args = ap.parse_args(argv)
+    print(load_text())
+    with tempfile.TemporaryDirectory() as folder:
+        fk = humanoid_fk(args, folder)
+    sampled = appendix_a_rows(args)
+    print(load_text())
+    print(json.dumps({"humanoid_fk": fk, "appendix_a": sampled, "quick": args.quick}))
+    return 0
+
+
+def appendix_a_rows(args) -> dict:
+    """HUMAN of Appendix A over its SQUAT: batched sampling and posing against the per-frame loop."""
     # 20,000 frames a batch: about what a minute of a 24 fps scene with a
     # dozen models evaluates, and small enough for the transforms (28 MB)
     # not to be dominated by the kernel handing out fresh pages.
@@ -150,7 +286,7 @@ def main(argv=None) -> int:
     loop_frames = frames[:: n_frames // n_loop]
     setup = loop_setup(fig, motion)
     print(
-        f"model: HUMAN of appendix_a.lig, {L} links, {J} joints, main link {fig.links[fig.main].name}; "
+        f"\nmodel: HUMAN of appendix_a.lig, {L} links, {J} joints, main link {fig.links[fig.main].name}; "
         f"motion SQUAT, {motion.length:g} frames"
     )
 
@@ -161,7 +297,6 @@ def main(argv=None) -> int:
     print(f"loop vs batched: largest difference {err:.2e}")
     assert err < 1e-9, err
 
-    best = {"batched": 0.0, "loop": 0.0}
     print(
         f"timing: batched over {n_frames} frames a call, loop over {len(loop_frames)} frames "
         f"100 at a time, best of {rounds} rounds, the two interleaved"
@@ -170,34 +305,27 @@ def main(argv=None) -> int:
     # all the frames, or the loop over 100 frames, so that both have about
     # as many chances to meet a quiet moment of the machine.
     pieces = [loop_frames[i : i + 100] for i in range(0, len(loop_frames), 100)]
+    costs: dict[str, list[Cost]] = {"batched": [], "loop": []}
     for _ in range(rounds):
         for piece in pieces:
-            t0 = time.perf_counter()
-            loop(setup, L, piece)
-            best["loop"] = max(best["loop"], len(piece) * J / (time.perf_counter() - t0))
-            t0 = time.perf_counter()
-            batched(fig, motion, frames)
-            best["batched"] = max(best["batched"], n_frames * J / (time.perf_counter() - t0))
-    ratio = best["batched"] / best["loop"]
-    print(f"liganimate batched:      {best['batched']:14,.0f} joint-frames/s")
-    print(f"per-frame Python loop:   {best['loop']:14,.0f} joint-frames/s")
-    print(f"ratio: {ratio:.0f}x (target 100x: {'met' if ratio >= 100 else 'NOT met'})")
-    print(
-        json.dumps(
-            {
-                "joints": J,
-                "links": L,
-                "frames_batched": n_frames,
-                "frames_loop": len(loop_frames),
-                "batched_joint_frames_per_s": round(best["batched"]),
-                "loop_joint_frames_per_s": round(best["loop"]),
-                "ratio": round(ratio, 1),
-                "max_difference": err,
-                "quick": args.quick,
-            }
-        )
-    )
-    return 0
+            costs["loop"].append(measure(lambda p=piece: loop(setup, L, p)).per(len(piece) * J))
+            costs["batched"].append(measure(lambda: batched(fig, motion, frames)).per(n_frames * J))
+    best = {k: best_of(v) for k, v in costs.items()}
+    ratio = best["loop"].cpu / best["batched"].cpu
+    for k, label in (("batched", "liganimate batched"), ("loop", "per-frame Python loop")):
+        c = best[k]
+        print(f"{label:24s} {1 / c.cpu:14,.0f} joint-frames/s CPU  (wall {1 / c.wall:14,.0f}, load {c.load:.1f})")
+    print(f"ratio (CPU): {ratio:.0f}x (target 100x: {'met' if ratio >= 100 else 'NOT met'})")
+    return {
+        "joints": J,
+        "links": L,
+        "frames_batched": n_frames,
+        "frames_loop": len(loop_frames),
+        "batched_joint_frames_per_cpu_s": round(1 / best["batched"].cpu),
+        "loop_joint_frames_per_cpu_s": round(1 / best["loop"].cpu),
+        "ratio": round(ratio, 1),
+        "max_difference": err,
+    }
 
 
 if __name__ == "__main__":

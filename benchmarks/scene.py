@@ -36,7 +36,7 @@ import time
 
 import numpy as np
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.render import frames as R
 from liganimate.runtime.render.camera import Camera
 

@@ -36,7 +36,7 @@ from browser import Browser, missing  # noqa: E402 - found through the sys.path 
 
 def build_page(folder: str):
     """Run the scene and write its page; return (path, seconds)."""
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
     from liganimate.runtime import exchange as X
     from liganimate.runtime.view import viewer_html
 

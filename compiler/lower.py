@@ -311,7 +311,9 @@ class Lowerer(NodeVisitor):
         )
 
     def joint_or_root(self, e) -> str:
-        """A keyframe's joint identifier, or None for the ROOT track and 'ORIENTATION' for ROOT ORIENTATION."""
+        """A keyframe's joint identifier: None for the ROOT track, 'ORIENTATION' for ROOT ORIENTATION, ``(kind, link)`` for a morph track."""
+        if isinstance(e, A.MorphTrack):
+            return repr((e.kind, e.link))
         if isinstance(e, A.RootTrack):
             return repr("ORIENTATION") if e.orientation else "None"
         return self.expr(e)
@@ -393,19 +395,21 @@ class Lowerer(NodeVisitor):
                 f"target={opt(g.target)}, normal={opt(g.normal)}, weight={opt(g.weight)}, at={self.at(g)})"
             )
         if s.joints is not None:
-            movable = "('joints', (" + "".join(self.expr(j) + ", " for j in s.joints) + "))"
+            movable = "(" + "".join(self.expr(j) + ", " for j in s.joints) + ")"  # joint ids: a tuple
         elif s.chain is not None:
-            movable = f"('chain', {self.expr(s.chain)})"
+            movable = self.expr(s.chain)  # a chain length: an INTEGER
         else:
             movable = "None"
-        solver = repr(SOLVER_KEYWORDS[s.solver.name] if s.solver is not None else DEFAULT_SOLVER)
+        solver = SOLVER_KEYWORDS[s.solver.name] if s.solver is not None else DEFAULT_SOLVER
         method = repr(s.method.name) if s.method is not None else "'LINEAR'"
         target = f"{s.name.name}, {s.translate.name}" if s.translate is not None else f"{s.name.name}, _"
         self.emit(f"{target} = rt.reach({self.expr(s.model)}, {opt(s.start)}, {self.expr(s.frames)}, {method}, (")
         for g in goals:
             self.emit(f"    {g},")
+        # The block's options, one frozen ReachOptions (runtime/ik/options.py) that every IK layer passes on.
         self.emit(
-            f"), {movable}, {s.translate is not None}, {solver}, {opt(s.tolerance)}, {opt(s.iterations)}, {self.at(s)})"
+            f"), _host.ReachOptions(movable={movable}, translate={s.translate is not None!r}, solver={solver!r}, "
+            f"tolerance={opt(s.tolerance)}, max_iterations={opt(s.iterations)}), {self.at(s)})"
         )
 
     def s_FigureStmt(self, s, where):
@@ -480,11 +484,14 @@ class Lowerer(NodeVisitor):
                 parts.append(f"({kind!r}, {self.expr(item.value)}, {label!r})")
         self.emit(f"rt.print_items(({''.join(p + ', ' for p in parts)}), {self.at(s)})")
 
-    def s_View(self, s, where):
-        self.emit(f"rt.view({s.what!r}, {self.expr(s.value)}, {self.at(s)})")
-
-    def s_Shoot(self, s, where):
-        self.emit(f"rt.shoot({self.at(s)})")
+    def s_Declared(self, s, where):
+        # A declared statement (lang/ast.py) is one runtime call with its parts' values.
+        declaration = A.DECLARED[type(s)]
+        args = []
+        for name, part in declaration.parts:
+            value = getattr(s, name)
+            args.append("(" + "".join(self.expr(v) + ", " for v in value) + ")" if part.many else self.expr(value))
+        self.emit(f"rt.{declaration.runtime}({''.join(a + ', ' for a in args)}{self.at(s)})")
 
     def s_Stop(self, s, where):
         # In the main program, hand the variables over so Python users see them.

@@ -4,7 +4,9 @@
 stands: ``"top"`` (the program or a PRIMITIVE body), ``"scene"`` (a scene's
 initialisation) or ``"scene-body"`` (between STARTSCENE and ENDSCENE).
 Expressions are typed by :class:`~.expressions.ExpressionTyper`, names bound
-by the rules of :mod:`.scopes`.
+by the rules of :mod:`.scopes`. A declared statement (``@declared`` in
+lang/ast.py) has no method of its own: ``_s_Declared`` checks it from its
+declaration.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from liganimate.lang import ast as A
 from liganimate.lang import bindings, keyframe_table, messages, numbers
 from liganimate.lang.diagnostics import did_you_mean
 from liganimate.lang.visitor import NodeVisitor
-from liganimate.lang.vocabulary import DRAW_WITH
+from liganimate.lang.vocabulary import DRAW_WITH, NUMBER
 from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS  # the solver registry, by name only
 from liganimate.runtime.motion import interpolation
 
@@ -113,9 +115,9 @@ class StatementChecker(NodeVisitor):
         self.t.want(s.index, T.INTEGER, "a keyframe number")
         self._keyframe(s.keyframe)
 
-    def _keyframe(self, k: A.Keyframe) -> None:
+    def _keyframe(self, k: A.Keyframe, shape: bool = False) -> None:
         self.t.want_number(k.frame, "a frame number")
-        self._position(k.position, k)
+        self._shape(k.position, k) if shape else self._position(k.position, k)
         if k.method is not None:
             self._method(k.method)
 
@@ -142,16 +144,24 @@ class StatementChecker(NodeVisitor):
                 f"a position is three angles or one vector, not {len(items)} values",
             )
 
+    def _shape(self, items: list, node) -> None:
+        """A SHAPE track's position: one GRAPHICAL object, the shape the link takes."""
+        if len(items) != 1:
+            self.st.out.error(items[1], f"a shape is one graphical object, not {len(items)} values")
+            return
+        self.t.want(items[0], T.GRAPHICAL, "a shape (a GRAPHICAL object)")
+
     def _s_MotionBlock(self, s, context):
         S.define_as(self.st, s.name, T.MOTION, "{name} is {noun}, not a MOTION")
         seen: dict = {}
         for j in s.joints:
             self._track_joint(s, j.joint, seen)
+            shape = isinstance(j.joint, A.MorphTrack) and j.joint.kind == "SHAPE"
             if j.start is not None:
-                self._position(j.start, j)
+                self._shape(j.start, j) if shape else self._position(j.start, j)
             last = None
             for k in j.keyframes:
-                self._keyframe(k)
+                self._keyframe(k, shape)
                 c = const(k.frame)
                 if c is not None and last is not None and c < last:
                     self.st.out.error(k.frame, messages.keyframes_out_of_order(c, last))
@@ -166,6 +176,16 @@ class StatementChecker(NodeVisitor):
 
     def _track_joint(self, s, joint, seen: dict) -> None:
         """The JOINT (or ROOT) a track of a STARTMOTION block drives (an entry or a table's column), each once."""
+        if isinstance(joint, A.MorphTrack):
+            key = (joint.kind, joint.link)
+            if key in seen:
+                self.st.out.error(
+                    joint,
+                    f"{joint.kind} LINK {joint.link} appears twice in motion {s.name.name}",
+                    f"the first is at line {seen[key].line}; put all its keyframes under one entry",
+                )
+            seen[key] = joint.pos
+            return
         if isinstance(joint, A.RootTrack):
             word = "ROOT ORIENTATION" if joint.orientation else "ROOT"
             if word in seen:
@@ -308,15 +328,27 @@ class StatementChecker(NodeVisitor):
                 s, "BACKGROUND outside a scene has no effect", "put it between INITIALIZE SCENE and ENDSCENE"
             )
 
-    def _s_View(self, s, context):
-        if s.what == "POINT":
-            self.t.want(s.value, T.VECTOR, "a view point (x, y, z)")
-        else:
-            self.t.want_number(s.value, "a view width")
+    def _s_Declared(self, s: A.Declared, context: str) -> None:
+        """A declared statement (lang/ast.py): where it may stand, and the types of its parts."""
+        declaration = A.DECLARED[type(s)]
+        place = "primitive" if self.st.primitive is not None else context
+        if place not in declaration.places:
+            self.st.out.error(s, declaration.misplaced, declaration.hint)
+        for name, part in declaration.parts:
+            value = getattr(s, name)
+            for e in value if part.many else (value,):
+                self._part(e, part)
 
-    def _s_Shoot(self, s, context):
-        if self.st.primitive is not None or context.startswith("scene"):
-            self.st.out.error(s, "SHOOTSCENES belongs outside scenes and primitives")
+    def _part(self, e, part: A.Part) -> None:
+        if part.accepts == NUMBER:
+            self.t.want_number(e, part.what)
+        elif len(part.accepts) == 1:
+            self.t.want(e, part.accepts[0], part.what)
+        else:
+            got = self.t.expr(e)
+            if got is not None and not any(T.fits(t, got) for t in part.accepts):
+                nouns = " or ".join(T.NOUN[t] for t in part.accepts)
+                self.st.out.error(e, f"{part.what} must be {nouns}, not {T.NOUN[got]}")
 
     # ------------------------------------------------------------ other
     def _s_Print(self, s, context):

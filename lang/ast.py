@@ -8,8 +8,11 @@ runs, so building it never recurses.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Self
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields
+from typing import Any, Self
+
+from .vocabulary import NUMBER, Type
 
 _M12, _M24, _M28, _M32, _M64 = (1 << 12) - 1, (1 << 24) - 1, (1 << 28) - 1, (1 << 32) - 1, (1 << 64) - 1
 _START = _M24 | _M12 << 24 | _M32 << 60  # the line, column and offset bits of a packed Pos
@@ -347,8 +350,16 @@ class RootTrack(Node):
 
 
 @dataclass(slots=True)
+class MorphTrack(Node):
+    """``SCALE LINK name`` or ``SHAPE LINK name`` where a joint identifier stands: a link's morph track."""
+
+    kind: str  # "SCALE" or "SHAPE"
+    link: str  # the link's name, in capitals (a name of the model's, not a variable)
+
+
+@dataclass(slots=True)
 class MotionJoint(Node):
-    joint: Node  # RootTrack for the ROOT entry
+    joint: Node  # RootTrack for the ROOT entry, MorphTrack for SCALE and SHAPE
     start: list | None
     keyframes: list
 
@@ -447,15 +458,114 @@ class Print(Node):
     items: list
 
 
-@dataclass(slots=True)
-class View(Node):
-    what: str  # POINT or WIDTH
-    value: Node
+# ------------------------------------------------------- declared statements
+# A statement made of expressions that the runtime carries out is declared
+# once, here, as pycparser declares its node shapes once: the node's fields
+# are its parts in the grammar's order, each with the types it accepts, and
+# @declared names the grammar rule that makes it, where it may stand and the
+# runtime method that runs it. The transformer (lang/transform.py), the
+# checker (``_s_Declared``, compiler/statements.py) and the lowering
+# (``s_Declared``, compiler/lower.py, which emits ``rt.<runtime>(<parts>, at)``)
+# read the declaration; none of them names the statement.
+
+#: Where a statement may stand: the program's top level (loops and IFs
+#: included), a scene's initialisation, a scene's body, a PRIMITIVE.
+PLACES = frozenset({"top", "scene", "scene-body", "primitive"})
+
+
+@dataclass(frozen=True, slots=True)
+class Part:
+    """One part of a declared statement: an expression of one of ``accepts`` (or, ``many``, a list of them).
+
+    ``what`` names it in messages ("a view point (x, y, z)").
+    """
+
+    accepts: tuple[Type, ...]
+    what: str
+    many: bool = False
+
+
+def part(*accepts: Type, what: str, many: bool = False) -> Any:
+    """The field of a declared statement's node that holds one :class:`Part`."""
+    return field(metadata={"part": Part(tuple(accepts), what, many)})
+
+
+@dataclass(frozen=True, slots=True)
+class Declaration:
+    """How a declared statement is read, checked and lowered (see :func:`declared`)."""
+
+    rule: str
+    runtime: str
+    places: frozenset[str]
+    misplaced: str
+    hint: str | None
+    parts: tuple[tuple[str, Part], ...]
+
+
+#: Each declared statement's node class -> its declaration.
+DECLARED: dict[type, Declaration] = {}
 
 
 @dataclass(slots=True)
-class Shoot(Node):
+class Declared(Node):
+    """Base of the declared statements (the passes dispatch on it when a node has no method of its own)."""
+
+
+def declared(
+    rule: str, runtime: str, places: frozenset[str] = PLACES, misplaced: str = "", hint: str | None = None
+) -> Callable[[type], type]:
+    """Declare a statement: register the node class it decorates.
+
+    Parameters
+    ----------
+    rule : str
+        The grammar rule or alias (lang/lig.lark) whose children, keywords
+        dropped, are the node's parts in order.
+    runtime : str
+        The ``Runtime`` method (runtime/host.py) the statement lowers to,
+        called with the parts' values (a ``many`` part as a tuple) and the
+        statement's position index.
+    places : frozenset of str
+        Where it may stand, a subset of :data:`PLACES`.
+    misplaced, hint : str
+        The error (and its hint) where it stands elsewhere.
+    """
+    assert places <= PLACES and (places == PLACES or misplaced), rule
+
+    def register(cls: type) -> type:
+        parts = tuple((f.name, f.metadata["part"]) for f in fields(cls) if f.name != "pos")
+        # Only the last part may take the rest of the children.
+        assert all(not p.many for _, p in parts[:-1]), cls.__name__
+        DECLARED[cls] = Declaration(rule, runtime, places, misplaced, hint, parts)
+        return cls
+
+    return register
+
+
+@declared("view_point", "set_view_point")
+@dataclass(slots=True)
+class ViewPoint(Declared):
+    point: Node = part(Type.VECTOR, what="a view point (x, y, z)")
+
+
+@declared("view_width", "set_view_width")
+@dataclass(slots=True)
+class ViewWidth(Declared):
+    width: Node = part(*NUMBER, what="a view width")
+
+
+@declared("shoot_stmt", "shoot", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
+@dataclass(slots=True)
+class Shoot(Declared):
     pass
+
+
+# A Shoot, so that a library refuses it and an archive leaves it out as it does SHOOTSCENES.
+@declared("shoot_range", "shoot_range", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
+@dataclass(slots=True)
+class ShootRange(Shoot):
+    first: Node = part(Type.INTEGER, what="the first scene to shoot")
+    last: Node = part(Type.INTEGER, what="the last scene to shoot")
 
 
 @dataclass(slots=True)

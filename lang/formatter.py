@@ -253,6 +253,8 @@ class _Blocks:
             "JOINT": self._joint,
             "ROOT": self._root,
             "TABLE": self._root,
+            "SHAPE": self._root,
+            "SCALE": self._morph,
             "TABLE_ROWS": self._rows,
             "FRAME": self._frame,
             "NAME": self._name,
@@ -344,6 +346,10 @@ class _Blocks:
         depth = len(self.stack)
         self.stack.append(["TABLE" if self._type(i) == "TABLE" else "JOINT", None])
         return depth
+
+    def _morph(self, i: int):
+        """SCALE LINK starts a motion's morph entry (elsewhere SCALE is a modifier's word)."""
+        return self._root(i) if self._type(i + 1) == "LINK" else None
 
     def _rows(self, i: int):
         """A keyframe table's rows (one token, written as it is): on lines of their own, under the TABLE."""

@@ -532,7 +532,10 @@ def _end_of_file(tok: Token, expected: set, text: str, source: Source) -> Diagno
             source.filename, A.Pos(oline, ocol, oline, ocol + len(word)), message, hint, source=source.text
         )
     # Lark's end token borrows the position of the last real token: point just after it.
-    line, col = getattr(tok, "end_line", None), getattr(tok, "end_column", None)
+    # From its end offset, not its end column: a keyframe table's rows are one token
+    # over many lines, and its end column counts from the line it starts on.
+    end = getattr(tok, "end_pos", None)
+    line, col = _line_col(text, end) if isinstance(end, int) and 0 < end <= len(text) else (None, None)
     if not line or not col:
         lines = text.split("\n")
         line, col = len(lines), len(lines[-1]) + 1

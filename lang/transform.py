@@ -311,6 +311,13 @@ class ToAst(Transformer):
         joint.start, joint.keyframes = rest.start, rest.keyframes
         return joint
 
+    def motion_morph(self, children):
+        track = A.MorphTrack(span(children[:3]), upper_name(children[0].value), upper_name(children[2].value))
+        joint = A.MotionJoint(span(children), track, None, [])
+        rest = self.motion_joint([children[0], None] + list(children[3:]))
+        joint.start, joint.keyframes = rest.start, rest.keyframes
+        return joint
+
     def figure_stmt(self, children):
         model = _name(children[1])
         if len(children) <= 3:
@@ -363,12 +370,6 @@ class ToAst(Transformer):
     def print_text(self, children):
         tok = children[0]
         return A.PrintItem(_tpos(tok), "text", tok.value[1:-1])
-
-    def view_stmt(self, children):
-        return A.View(span(children), children[1].type.replace("_KW", ""), children[2])
-
-    def shoot_stmt(self, children):
-        return A.Shoot(span(children))
 
     def load_stmt(self, children):
         lib = children[-1]
@@ -551,3 +552,23 @@ def _operator_rule(rule_name: str, symbol: str):
 # One method per operator of lang/vocabulary.py's table: a new operator needs no code here.
 for _op in OPERATORS:
     setattr(ToAst, _op.rule, _operator_rule(_op.rule, _op.symbol))
+
+
+def _declared_rule(cls: type, declaration: A.Declaration):
+    """The transformer method of a declared statement: its children, keywords dropped, are its parts in order."""
+    many = bool(declaration.parts) and declaration.parts[-1][1].many
+    count = len(declaration.parts)
+
+    def rule(self, children):
+        values = _nodes(children)
+        if many:
+            values = [*values[: count - 1], values[count - 1 :]]
+        return cls(span(children), *values)
+
+    rule.__name__ = declaration.rule
+    return rule
+
+
+# One method per declared statement of lang/ast.py: a new one needs no code here.
+for _cls, _declaration in A.DECLARED.items():
+    setattr(ToAst, _declaration.rule, _declared_rule(_cls, _declaration))

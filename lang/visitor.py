@@ -106,7 +106,7 @@ class NodeVisitor:
     """Base class of the passes over a tree (the checker, the lowering)."""
 
     def dispatch(self, prefix: str, node, generic: bool = True):
-        """The bound method ``<prefix><type of node>``, or :meth:`generic_visit` when the pass has none.
+        """The bound method ``<prefix><type of node>`` (or of its nearest base class that has one), else :meth:`generic_visit`.
 
         ``generic=False`` (for passes that must produce a value, such as an
         expression's type or code) makes a missing method an error instead.
@@ -117,7 +117,12 @@ class NodeVisitor:
             cache = self.__dict__["_methods"] = {}
         method = cache.get(key)
         if method is None:
-            method = getattr(self, prefix + type(node).__name__, None)
+            # The node's own method, else one for a base class (``_s_Declared``
+            # handles every declared statement of lang/ast.py).
+            method = next(
+                (m for c in type(node).__mro__[:-1] if (m := getattr(self, prefix + c.__name__, None)) is not None),
+                None,
+            )
             if method is None:
                 if not generic:
                     raise NotImplementedError(f"{type(self).__name__} has no {prefix}{type(node).__name__}")

@@ -22,12 +22,14 @@ from liganimate.lang import keyframe_table, messages
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
-from liganimate.runtime import limits, printing
+from liganimate.runtime import budgets, limits, printing
 from liganimate.runtime.arithmetic import Arithmetic
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import morphing as MO
 from liganimate.runtime.figure import pose as P
 from liganimate.runtime.figure import tree as F
+from liganimate.runtime.ik.options import ReachOptions  # generated modules build it as _host.ReachOptions
 from liganimate.runtime.library import Library  # noqa: F401  (generated modules name it _host.Library)
 from liganimate.runtime.motion import algebra as M
 from liganimate.runtime.motion import edits as E
@@ -450,7 +452,7 @@ class Runtime(Arithmetic):
         p = self._segment(primary, names[0], at)
         s = self._segment(secondary, names[1], at)
         fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes, _joint_kind(kind))
-        return self._guard(at, limits.check_figure, fig, "the joined model")
+        return self._guard(at, limits.check_joined, fig, p, s, "the joined model")
 
     def model_block(self, name, specs, at):
         shapes = {}
@@ -537,15 +539,15 @@ class Runtime(Arithmetic):
             self.fail(at, _sentence(exc.message), exc.hint)
 
     # ------------------------------------------------------------- REACH
-    def reach(self, model, start, frames, method, goals, movable, translate, solver, tolerance, iterations, at):
+    def reach(self, model, start, frames, method, goals, options: ReachOptions, at):
         """A STARTREACH block: (the motion to the solved pose, the solved translation).
 
-        The arguments are the block's, as the lowering writes them; its
-        options travel on as one ``ReachOptions`` (``ik.language.block_options``).
+        The arguments are the block's, as the lowering writes them; ``options``
+        (MOVE, TRANSLATE INTO, the solver and its settings) is the one
+        :class:`ReachOptions` the generated module built, passed on unchanged.
         """
         from liganimate.runtime.ik import language as RL
 
-        options = RL.block_options(movable, translate, solver, tolerance, iterations)
         fig = self._model(model, at, "the model of a REACH")
         start_motion = self._motion(start, at) if start is not None else None
         self._guard(at, RL.check_frames, frames)
@@ -568,18 +570,17 @@ class Runtime(Arithmetic):
 
     def motion_block(self, joints, at, tables=()):
         spec = {}
+        morphs = []  # SCALE and SHAPE entries: (kind, link, start, keyframes, at)
         for joint, start, kfs, jat in joints:
+            if isinstance(joint, tuple):
+                self._frames_in_order(kfs)
+                morphs.append((*joint, start, kfs, jat))
+                continue
             if joint in spec:
                 self.fail(jat, f"{_track_label(joint)} appears twice in this motion")
-            last = 0
-            for frame, pos, _method, kat in kfs:
-                self._guard(kat, E.check_frame, frame)
+            for _frame, pos, _method, kat in kfs:
                 self._guard(kat, E.check_angles, pos, joint is None)
-                if frame < last:
-                    self.fail(kat, messages.keyframes_out_of_order(frame, last))
-                if 0 < frame - last < N.MIN_FRAME_GAP:
-                    self.fail(kat, messages.keyframes_too_close(frame, last), messages.GAP_HINT)
-                last = frame
+            self._frames_in_order(kfs)
             if start is not None:
                 self._guard(jat, E.check_angles, start, joint is None)
             spec[joint] = (
@@ -590,7 +591,21 @@ class Runtime(Arithmetic):
         root, turn = spec.pop(None, None), spec.pop(M.ORIENTATION, None)
         given = {j for j, track in ((None, root), (M.ORIENTATION, turn)) if track is not None}
         arrays = self._table_tracks(tables, spec, given)
-        return self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays, turn=turn))
+        motion = self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays, turn=turn))
+        if not morphs:
+            return motion
+        return self._guard(at, lambda: motion.with_morphs(MO.channels(morphs, motion.length, self.fail)))
+
+    def _frames_in_order(self, kfs) -> None:
+        """A track's keyframe frames: each within the limits, in order, and a step or the least gap apart."""
+        last = 0
+        for frame, _pos, _method, kat in kfs:
+            self._guard(kat, E.check_frame, frame)
+            if frame < last:
+                self.fail(kat, messages.keyframes_out_of_order(frame, last))
+            if 0 < frame - last < N.MIN_FRAME_GAP:
+                self.fail(kat, messages.keyframes_too_close(frame, last), messages.GAP_HINT)
+            last = frame
 
     def _table_tracks(self, tables, spec: dict, given: set) -> dict:
         """Each table column as ``(start, frames, values)``: its first row is the start, the others keyframes."""
@@ -623,15 +638,17 @@ class Runtime(Arithmetic):
         return self._guard(at, M.synchronize, *[self._motion(m, at) for m in motions])
 
     # -------------------------------------------------------------- scenes
-    def view(self, what, value, at):
+    def set_view_point(self, point, at):
+        """VIEW POINT = point: where the camera stands, in this scene or for the scenes to come."""
         # The limits guarantee that the renderer's camera accepts the view
         # and projects everything drawn to finite pixel coordinates.
-        if what == "POINT":
-            value = Vec(*self._guard(at, limits.check_view_point, value))
-            target = "view_point"
-        else:
-            value = self._guard(at, limits.check_view_width, value)
-            target = "view_width"
+        self._view("view_point", Vec(*self._guard(at, limits.check_view_point, point)))
+
+    def set_view_width(self, width, at):
+        """VIEW WIDTH = width: how wide the camera sees, in this scene or for the scenes to come."""
+        self._view("view_width", self._guard(at, limits.check_view_width, width))
+
+    def _view(self, target, value):
         if self.scene is not None:
             setattr(self.scene, target, value)
             self.scene.viewed = True
@@ -645,7 +662,25 @@ class Runtime(Arithmetic):
         self.scenes[scene_id] = (fn, snapshot, at)
 
     def shoot(self, at):
-        for scene_id in sorted(self.scenes):
+        """SHOOTSCENES: run every scene recorded since the last SHOOTSCENES, in identifier order, then forget them."""
+        self._shoot(sorted(self.scenes))
+
+    def shoot_range(self, first, last, at):
+        """SHOOTSCENES FROM first TO last: shoot only the recorded scenes with those identifiers; forget them all.
+
+        A film made piece by piece can be previewed a few scenes at a time
+        without editing out the others.
+        """
+        if first > last:
+            self.fail(at, f"SHOOTSCENES FROM {first} TO {last} names no scenes: {first} is after {last}")
+        chosen = [scene_id for scene_id in sorted(self.scenes) if first <= scene_id <= last]
+        if not chosen:
+            recorded = ", ".join(str(i) for i in sorted(self.scenes)) or "none"
+            self.warn(at, f"no scene from {first} to {last} has been recorded (recorded: {recorded})")
+        self._shoot(chosen)
+
+    def _shoot(self, chosen):
+        for scene_id in chosen:
             fn, snapshot, sat = self.scenes[scene_id]
             self.scene = SceneState(scene_id, self.view_point, self.view_width, sat)
             self.shot += 1
@@ -676,11 +711,20 @@ class Runtime(Arithmetic):
             self.fail(at if sameframe_at is None else sameframe_at, f"SAMEFRAME must be at least 1, not {sameframe}")
         state = self.scene
         state.length, state.sameframe = length, sameframe
+        if self.renderer is not None:
+            self._guard(at, budgets.check_frames, length, sameframe)
         progress = self.progress
+        mark = (0, 0)  # (tick, work done) at the last estimate
         for t in range(length):
             state.tick = t
-            if progress is not None and not t % PROGRESS_TICKS:
-                progress(state.id, t, length)
+            if t == 1 or not t % PROGRESS_TICKS:
+                if t:  # estimate the scene's work from the ticks run so far (runtime/budgets.py)
+                    done = state.posed + t
+                    rate = (done - mark[1]) / (t - mark[0])
+                    self._guard(at, budgets.check_joint_ticks, length, t, done, rate)
+                    mark = (t, done)
+                if progress is not None:
+                    progress(state.id, t, length)
             yield t
         if progress is not None and length >= PROGRESS_TICKS:
             progress(state.id, length, length)
@@ -689,6 +733,7 @@ class Runtime(Arithmetic):
         fig = self._model(m, at, name)
         motion = self._motion(motion, at)
         t = self.scene.tick
+        self.scene.posed += fig.n_joints  # the scene's work (runtime/budgets.py)
         if t < start or t > end:
             return m  # another ANIMATE of this model may cover this tick
         frame = float(t - start)
@@ -719,6 +764,8 @@ class Runtime(Arithmetic):
                 f"the motion drives joint{'s' if len(missing) > 1 else ''} "
                 f"{', '.join(map(str, missing))}, which the model does not have",
             )
+        if motion.morphs is not None:
+            self._guard(at, MO.bind, fig, motion.morphs)
         if fig.slides.any():
             problem = P.slide_out_of_range(fig, motion)
             if problem is not None:
@@ -793,6 +840,7 @@ class SceneState:
         self.at = at
         self.viewed = False  # a VIEW statement has run before or in the scene
         self.extent = None  # world box of what is drawn at the ticks measured
+        self.posed = 0  # joints its ANIMATE statements have posed so far
 
     def measure(self) -> None:
         """Add this tick's drawing (and the background) to :attr:`extent`, for the default framing."""

@@ -19,6 +19,7 @@ statement that made the geometry.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 
 import numpy as np
 
@@ -28,10 +29,13 @@ from liganimate.runtime.values import Graphical
 
 _HINT = "everything drawn must stay within 1E12 units of the origin along each axis"
 
-# figure_reach per model structure: id(joints) -> (joints, links, reach); a
-# placed or re-rooted copy of a model shares its joints and links tuples.
-_REACH: dict = {}
-_REACH_MAX = 256
+# _reach_parts per model structure, least recently used first: id(joints) ->
+# (joints, links, parts); a placed or re-rooted copy of a model shares its
+# joints and links tuples.
+_REACH: OrderedDict = OrderedDict()
+_REACH_MAX = 16
+# The attribute under which a Figure keeps its own _reach_parts.
+_PARTS = "_liganimate_reach_parts"
 
 
 def _fmt(x: float) -> str:
@@ -50,6 +54,49 @@ def check_graphical(g: Graphical, what: str = "this object") -> Graphical:
     return g
 
 
+def _joint_term(j) -> float:
+    return float(np.max(np.abs(j.loc1))) + float(np.max(np.abs(j.loc2)))
+
+
+def _link_size(link) -> float:
+    if isinstance(link.shape, Graphical):  # the only shapes drawn (pose.MeshTable)
+        return abs(link.scale) * link.shape.extent()
+    return 0.0
+
+
+def _reach_parts(fig) -> tuple[float, float]:
+    """``(sum of the joints' location terms, largest drawn segment)`` of a Figure or a Link, memoised.
+
+    A Link (a graphical object used as a segment) is a one-link model. The
+    memo is the figure's own, else a small one keyed by the joints tuple,
+    which placed and re-rooted copies of a model share with it.
+    """
+    if not hasattr(fig, "joints"):
+        return 0.0, _link_size(fig)
+    parts = fig.__dict__.get(_PARTS)
+    if parts is not None:
+        return parts
+    key = id(fig.joints)
+    hit = _REACH.get(key)
+    if hit is not None and hit[0] is fig.joints and hit[1] is fig.links:
+        _REACH.move_to_end(key)
+        return _remember(fig, hit[2])
+    with np.errstate(all="ignore"):
+        joints = 0.0
+        for j in fig.joints:  # in joint order, as check_joined adds them
+            joints += _joint_term(j)
+        size = max((_link_size(link) for link in fig.links), default=0.0)
+    return _remember(fig, (joints, size))
+
+
+def _remember(fig, parts: tuple[float, float]) -> tuple[float, float]:
+    fig.__dict__[_PARTS] = parts  # a Figure is frozen, but keeps its caches in __dict__
+    if len(_REACH) >= _REACH_MAX:
+        _REACH.popitem(last=False)
+    _REACH[id(fig.joints)] = (fig.joints, fig.links, parts)
+    return parts
+
+
 def figure_reach(fig) -> float:
     """A bound on how far from its main link's origin any point of ``fig`` can be, in any pose.
 
@@ -66,23 +113,26 @@ def figure_reach(fig) -> float:
     float
         Euclidean distance, in the main link's (unplaced) coordinates.
     """
-    hit = _REACH.get(id(fig.joints))
-    if hit is not None and hit[0] is fig.joints and hit[1] is fig.links:
-        return hit[2]
-    root3 = math.sqrt(3.0)
+    joints, size = _reach_parts(fig)
     with np.errstate(all="ignore"):
-        reach = 0.0
-        for j in fig.joints:
-            reach += root3 * (float(np.max(np.abs(j.loc1))) + float(np.max(np.abs(j.loc2))))
-        size = 0.0
-        for link in fig.links:
-            if isinstance(link.shape, Graphical):  # the only shapes drawn (pose.MeshTable)
-                size = max(size, abs(link.scale) * link.shape.extent())
-        reach += root3 * size
-    if len(_REACH) >= _REACH_MAX:
-        _REACH.clear()
-    _REACH[id(fig.joints)] = (fig.joints, fig.links, reach)
-    return reach
+        return math.sqrt(3.0) * (joints + size)
+
+
+def check_joined(fig, primary, secondary, what: str = "the joined model"):
+    """:func:`check_figure` for ``fig = JOINT id, primary, ..., secondary, ...``, in time independent of their size.
+
+    ``fig``'s joints are the primary's, the new joint, then the secondary's
+    (``figure.tree.join``), so its reach is the sum of theirs; the operands'
+    reaches are memoised (each was checked when it was made), which keeps a
+    model built one JOINT at a time linear in its joints (a loop
+    ``M :- JOINT I, M, ...`` used to measure all of M again on each pass).
+    """
+    pj, ps = _reach_parts(primary)
+    sj, ss = _reach_parts(secondary)
+    n = len(getattr(primary, "joints", ()))
+    with np.errstate(all="ignore"):
+        _remember(fig, (pj + sj + _joint_term(fig.joints[n]), max(ps, ss)))
+    return check_figure(fig, what)
 
 
 def check_figure(fig, what: str = "the model"):

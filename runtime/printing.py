@@ -47,9 +47,29 @@ def motion_listing(motion, label: str) -> str:
             lines.append(f"  ROOT ORIENTATION POSITION {_vector(start)}")
             for k in kfs:
                 lines.append(f"    FRAME {k.frame:g} POSITION {_vector(k.position)} INTERPOLATE {k.method}")
+        if motion.morphs is not None:
+            lines += _morph_lines(motion.morphs)
     except LigError:
         lines.append("  " + motion.describe())
     return "\n".join(lines)
+
+
+def _morph_lines(morphs) -> list[str]:
+    """A motion's SCALE tracks as keyframes, and its SHAPE tracks as each target's weight (1: that shape)."""
+    from liganimate.runtime.motion import morph as mo
+
+    lines = []
+    for key in morphs.channels():
+        start, kfs = mo.keyframes(morphs, key, 1000)
+        if key[0] == mo.SCALE:
+            lines.append(f"  SCALE LINK {key[1]} POSITION {_vector(start)}")
+            values = [_vector(k.position) for k in kfs]
+        else:
+            n = morphs.targets[key[2]].triangles
+            lines.append(f"  SHAPE LINK {key[1]}: weight of a shape of {n} triangles ({key[2][:8]}) {start[0]:g}")
+            values = [f"{k.position[0]:g}" for k in kfs]
+        lines += [f"    FRAME {k.frame:g} POSITION {v} INTERPOLATE {k.method}" for k, v in zip(kfs, values)]
+    return lines
 
 
 def value_line(kind: str, value, label: str) -> str:

@@ -264,7 +264,7 @@ def program_named(tmp_path, name):
     """A compiled program: ``edges``, ``crane`` or ``walking_humanoid`` (above), or an example's name."""
     from paths import ROOT_DIR
 
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     if name == "edges":
         path = tmp_path / "edges.lig"

@@ -2,7 +2,7 @@
 
 Shared by the fuzz tests (tests/test_fuzz_*.py) and ``benchmarks/fuzz.py``.
 A case is a program text. :func:`run_case` writes it to a file, loads it
-with :func:`liganimate.cli.load_program` (what ``check`` and ``run`` call),
+with :func:`liganimate.compiler.load_program` (what ``check`` and ``run`` call),
 runs ``program.check()`` and then renders every shot tick at 16x12 into a
 scratch folder, and sorts what happened into one outcome:
 
@@ -203,7 +203,7 @@ def run_case(
     case may add (0: no limit); ``workdir`` is a folder for the scratch
     files (default: a fresh temporary folder, removed afterwards).
     """
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
     from liganimate.lang.diagnostics import LigDiagnostics
     from liganimate.runtime.errors import LigError
 

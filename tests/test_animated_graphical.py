@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from liganimate.cli import load_program
-from liganimate.compiler import NotParsed
+from liganimate.compiler import NotParsed, load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.runtime import values
 

@@ -189,3 +189,15 @@ def test_the_tools_may_compile(tmp_path, monkeypatch):
 def test_no_module_below_the_command_line_imports_it():
     for name in MODULES:
         assert not any(m.startswith(ABOVE) for m in imports_of(name)), name
+
+
+def test_one_function_loads_a_program():
+    # The command line, the Python API, the tools and the tests load programs through
+    # compiler.load_program; a second loader (the command line had one) is a second way to drift.
+    found = sorted(
+        path.relative_to(ROOT).as_posix()
+        for folder in ("lang", "compiler", "runtime", "src")
+        for path in (ROOT / folder).rglob("*.py")
+        if "def load_program(" in path.read_text(encoding="utf-8")
+    )
+    assert found == ["compiler/__init__.py"]

@@ -159,7 +159,7 @@ def test_fmt_rewrites_in_place_keeping_the_mode_and_goes_on_past_a_broken_file(t
 def test_plot_names_each_curve_by_the_link_its_joint_moves_and_the_title_clears_the_legend():
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
     from liganimate.runtime.render.plot import joint_links, plot_motion_figure
 
     program, _ = load_program(str(ROOT / "examples" / "appendix_a.lig"))

@@ -19,7 +19,7 @@ import pathlib
 import goldens
 import pytest
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"

@@ -20,8 +20,7 @@ import re
 import numpy as np
 import pytest
 
-from liganimate.cli import load_program
-from liganimate.compiler import library
+from liganimate.compiler import library, load_program
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import pose as P
 

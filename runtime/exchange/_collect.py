@@ -198,7 +198,7 @@ def collect(program, warnings: list | None = None) -> list:
     Parameters
     ----------
     program : Program
-        A compiled program (``liganimate.cli.load_program``).
+        A compiled program (``liganimate.compiler.load_program``).
     warnings : list, optional
         Receives the run's warning diagnostics (those ``liganimate check``
         shows).

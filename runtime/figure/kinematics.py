@@ -22,6 +22,8 @@ import math
 
 import numpy as np
 
+from liganimate.runtime.figure import folded as _folded
+from liganimate.runtime.figure import walk as _walk
 from liganimate.runtime.figure.tree import Figure
 
 __all__ = [
@@ -190,51 +192,30 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, shape (B, n_links, 4, 4)
-        ``root @ pose`` for every link: a view of component-major storage,
-        not C-contiguous (``np.ascontiguousarray`` makes it so).
+        ``root @ pose`` for every link: a view of other storage, not
+        C-contiguous (``np.ascontiguousarray`` makes it so).
 
     Notes
     -----
-    Computed component-major: every entry of every joint's rotation and
-    translation is one contiguous array over the batch, so each step is one
-    long vector operation (numpy is slow on trailing axes of length 3 or 4,
-    and batched 4x4 ``matmul`` spends most of its time on overhead and on
-    the constant bottom row).  A child link's transform is its parent's
-    times the joint's, ``R = Rp Rj`` and ``t = Rp tj + tp``, summed in
-    the order a 4x4 product would.  Only elementwise operations are used,
-    never BLAS, so the result is the same on every machine.
+    A batch of fewer than :data:`SHORT` poses is walked by
+    :func:`liganimate.runtime.figure.walk.placed` (all joints at once, one
+    product per depth level of the tree: a few dozen numpy calls whatever
+    the number of joints), a longer one by
+    :func:`liganimate.runtime.figure.folded.placed_long` (one joint at a
+    time over contiguous rows of frames, the arithmetic of each joint's
+    kind only).  Both compute every entry with the operations of a 4x4
+    product in the same order, summed ``m = 0, 1, 2`` then the
+    translation, with elementwise numpy only (never BLAS), so the result
+    is the same on every machine and for any batch size (an exact zero
+    may differ in sign).
     """
-    B, J, L = angles.shape[0], figure.n_joints, figure.n_links
-    # Component-major storage: buf[i, j, link] holds entry (i, j) of that
-    # link's transform for every frame, contiguous; the result is a
-    # transposed view of it, so nothing is copied into frame-major order.
-    buf = np.empty((4, 4, L, B))
-    buf[3, :3] = 0.0
-    buf[3, 3] = 1.0
-    if B == 0:
-        return buf.transpose(3, 2, 0, 1)
-    if root is not None:
-        root = np.asarray(root, dtype=np.float64)
-    # Joints whose angles hold still over the batch (not driven, or pinned
-    # by their extremes) have one local transform, computed once.
-    flat = angles.reshape(B, -1)
-    moving = np.flatnonzero((flat != flat[0]).any(axis=0).reshape(J, 3).any(axis=1))
-    R0, T0 = _local_transforms(figure, np.arange(J), angles[:1].transpose(2, 1, 0))
-    values = np.ascontiguousarray(angles[:, moving].transpose(2, 1, 0))  # (3, moving, B), contiguous
-    # Blocks of frames small enough for the intermediates to stay in cache.
-    for lo in range(0, B, _BLOCK):
-        hi = min(lo + _BLOCK, B)
-        R = np.empty((3, 3, J, hi - lo))
-        T = np.empty((3, J, hi - lo))
-        R[...] = R0
-        T[...] = T0
-        if len(moving):
-            R[:, :, moving], T[:, moving] = _local_transforms(figure, moving, values[:, :, lo:hi])
-        _compose(figure, R, T, None if root is None else root[lo:hi], buf[:, :, :, lo:hi])
-    return buf.transpose(3, 2, 0, 1)
+    if angles.shape[0] < SHORT:
+        return _walk.placed(figure, angles, root)
+    return _folded.placed_long(figure, angles, root)
 
 
-_BLOCK = 4096
+SHORT = 64
+"""Batches shorter than this take the short-batch walk: there the number of numpy calls is the cost."""
 
 
 def _local_transforms(figure: Figure, joints: np.ndarray, values: np.ndarray):
@@ -282,47 +263,6 @@ def _local_transforms(figure: Figure, joints: np.ndarray, values: np.ndarray):
         gain = (figure.slide_scales[k] * np.where(rev[slides], -1.0, 1.0))[:, None]
         T[:, slides] += np.einsum("sia,asb->isb", F, d) * gain
     return R, T
-
-
-def _compose(figure: Figure, R: np.ndarray, T: np.ndarray, root, buf: np.ndarray) -> None:
-    """Walk the tree: fill ``buf`` (4, 4, n_links, B) from the joints' local transforms."""
-    main = figure.main
-    XR = buf[:3, :3]  # XR[i, j, link]: entry (i, j) of the link's rotation, over the frames
-    Xt = buf[:3, 3]
-    if root is None:
-        XR[:, :, main] = np.eye(3)[:, :, None]
-        Xt[:, main] = 0.0
-    else:
-        XR[:, :, main] = root[:, :3, :3].transpose(1, 2, 0)
-        Xt[:, main] = root[:, :3, 3].T
-    for k, p, c in _walk_order(figure):
-        # Link c = link p through joint k: R = P Rj and t = P tj + tp, each
-        # entry summed over m = 0, 1, 2 in order, as a 4x4 product would
-        # (einsum without optimize: no BLAS).  Slices keep every operand a view.
-        P = XR[:, :, p]
-        np.einsum("imkb,mjkb->ijkb", P, R[:, :, k], out=XR[:, :, c])
-        t = np.einsum("imkb,mkb->ikb", P, T[:, k], out=Xt[:, c])
-        t += Xt[:, p]
-
-
-def _walk_order(figure: Figure) -> list:
-    """(joint, parent link, child link) as one-element slices, parents placed before children."""
-    levels = figure.traversal
-    hit = _WALKS.get(id(levels))
-    if hit is not None and hit[0] is levels:
-        return hit[1]
-    order = [
-        tuple(slice(int(v), int(v) + 1) for v in row)
-        for level in levels
-        for row in zip(level.joints, level.parents, level.children)
-    ]
-    if len(_WALKS) >= 256:
-        _WALKS.clear()
-    _WALKS[id(levels)] = (levels, order)
-    return order
-
-
-_WALKS: dict = {}  # id(figure.traversal) -> (traversal, walk order); the stored traversal keeps the id valid
 
 
 def _cos_sin(a: np.ndarray):

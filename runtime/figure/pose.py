@@ -13,6 +13,7 @@ import numpy as np
 
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import morphing as MO
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.turning import orientation_matrix
@@ -206,13 +207,74 @@ def world_transforms(fig: F.Figure, angles: np.ndarray, placements: np.ndarray) 
     return X
 
 
-def world_triangles(table: MeshTable, X: np.ndarray) -> np.ndarray:
-    """Triangles in world coordinates, shape (T, M, 3, 3), from link transforms X (T, L, 4, 4)."""
+def world_triangles(table: MeshTable, X: np.ndarray, local: np.ndarray | None = None) -> np.ndarray:
+    """Triangles in world coordinates, shape (T, M, 3, 3), from link transforms X (T, L, 4, 4).
+
+    ``local`` (T, M, 3, 3), when given, replaces the table's triangles frame by
+    frame (a motion's SHAPE tracks, :func:`morphed`).
+    """
     if len(table.triangles) == 0:
         return np.zeros((X.shape[0], 0, 3, 3))
     R = X[:, table.link, :3, :3]  # (T, M, 3, 3)
     t = X[:, table.link][..., :3, 3]  # (T, M, 3)
+    if local is not None:
+        return np.einsum("tmij,tmkj->tmki", R, local, optimize=True) + t[:, :, None, :]
     return np.einsum("tmij,mkj->tmki", R, table.triangles, optimize=True) + t[:, :, None, :]
+
+
+_bindings: dict = {}
+
+
+def morphed(fig: F.Figure, motion: Motion | None, frames, X: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """A motion's SCALE and SHAPE tracks applied to a model's link transforms and triangles.
+
+    Parameters
+    ----------
+    fig : Figure
+    motion : Motion or None
+    frames : array_like, shape (T,)
+        Motion frames.
+    X : ndarray, shape (T, L, 4, 4)
+        From :func:`world_transforms`.
+
+    Returns
+    -------
+    X : ndarray, shape (T, L, 4, 4)
+        With each scaled link's scale factors (along its own axes) folded in.
+    local : ndarray, shape (T, M, 3, 3), or None
+        The mesh table's triangles, morphed, per frame; None when the motion
+        shapes no link (draw the table's own).
+
+    Raises
+    ------
+    LigError
+        If the motion morphs a link the model has not, or a shape whose
+        structure is not the link's (ANIMATE's check reports it first).
+    """
+    morphs = None if motion is None else motion.morphs
+    if morphs is None:
+        return X, None
+    return MO.apply(_binding(fig, morphs), morphs, frames, X, mesh_table(fig))
+
+
+def _binding(fig: F.Figure, morphs) -> MO.Binding:
+    """A motion's morphs bound to a model's links, remembered per (links, morphs)."""
+    key = (id(fig.links), id(morphs))
+    hit = _bindings.get(key)
+    if hit is None or hit[0] is not fig.links or hit[1] is not morphs:
+        if len(_bindings) >= _BOUND_MAX:
+            _bindings.clear()
+        hit = _bindings[key] = (fig.links, morphs, MO.bind(fig, morphs))
+    return hit[2]
+
+
+def morph_record(fig: F.Figure, motion: Motion | None, frames) -> list[dict]:
+    """Per frame, the morphed links' scale factors and shape weights (``--poses``; see :func:`.morphing.record`)."""
+    n = len(np.asarray(frames).reshape(-1))
+    morphs = None if motion is None else motion.morphs
+    if morphs is None:
+        return [{} for _ in range(n)]
+    return MO.record(_binding(fig, morphs), morphs, frames)
 
 
 def static_triangles(fig: F.Figure):
@@ -256,9 +318,10 @@ def posed_graphical(fig: F.Figure, motion: Motion | None, frame: float) -> Graph
     else:
         angles = joint_angles(fig, motion, np.array([float(frame)]))
     X = world_transforms(fig, angles, rooted_placements(placement[None], motion, np.array([float(frame)])))
+    X, local = morphed(fig, motion, np.array([float(frame)]), X)
     table = mesh_table(fig)
     closed = table.closed & (np.linalg.det(placement[:3, :3]) > 0)
-    return Graphical(world_triangles(table, X)[0], table.lightness, closed, table.colour)
+    return Graphical(world_triangles(table, X, local)[0], table.lightness, closed, table.colour)
 
 
 def slide_out_of_range(fig: F.Figure, motion: Motion, limit: int = 100_000) -> tuple[str, str] | None:

@@ -497,6 +497,27 @@ class Figure:
         if len(self.preorder) != n:
             raise FigureError("the joints do not connect every link to the main link in one tree.")
 
+    @classmethod
+    def _grafted(cls, links: tuple, joints: tuple, base: Figure, index: dict[int, int]) -> Figure:
+        """A figure made by :func:`_graft`, without re-checking its tree.
+
+        Attaching one valid tree below a link of another by one new joint
+        gives a valid tree, and ``_graft`` has checked the identifiers
+        (``index``); re-walking every joint here would make building a model
+        one JOINT at a time quadratic in its joints.
+        """
+        fig = object.__new__(cls)
+        for name, value in (
+            ("links", links),
+            ("joints", joints),
+            ("root", base.root),
+            ("main", base.main),
+            ("placement", base.placement),
+        ):
+            object.__setattr__(fig, name, value)
+        fig.__dict__["_id_index"] = index
+        return fig
+
     # ----------------------------------------------------------------- structure
 
     @classmethod
@@ -958,22 +979,24 @@ def _graft(base: Figure, at: int, joint_id, loc1, sub: Figure, loc2, extremes, k
     the new joint is the root's last child and ``sub``'s links follow.
     """
     new = Joint(joint_id, at, len(base.links) + sub.root, loc1, loc2, extremes, **kind.fields(joint_id))
-    taken = set(base.joint_ids)
+    # The result's identifier index is the base's, copied at C speed, plus the
+    # new joint and sub's: Python-level work is O(1 + sub's joints), so a model
+    # built one JOINT at a time stays linear in its joints.
+    index = dict(base._id_index)
     for jid in (new.id, *sub.joint_ids):
-        if jid in taken:
+        if jid in index:
             raise FigureError(
                 f"joint identifier {jid} is used twice in one model.",
                 hint="translate one submodel's identifiers with <TRANS JOINTS BY n>",
             )
-        taken.add(jid)
+        index[jid] = len(index)
     off = len(base.links)
     shifted = tuple(dataclasses.replace(j, primary=j.primary + off, secondary=j.secondary + off) for j in sub.joints)
-    return Figure(
+    return Figure._grafted(
         base.links + sub.links,
         base.joints + (new,) + shifted,
-        root=base.root,
-        main=base.main,
-        placement=base.placement,
+        base,
+        index,
     )
 
 

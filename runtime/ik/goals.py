@@ -329,6 +329,33 @@ def _gathered(model: IKModel, goals: tuple, B: int, warnings: list) -> tuple[dic
     return pts, pls, axs
 
 
+_STACKS: dict = {}  # (id(model), structure) -> (model, GoalStack); the stored model keeps the id valid
+_STACKS_MAX = 256
+
+
+def _structure(goals: Sequence, batch: int) -> tuple | None:
+    """What a :class:`GoalStack` packs besides the targets, as a key; None when it cannot serve as one.
+
+    Each goal's kind, link, link point or axis and weight, the latter as a
+    plain number (a batch of weights, or anything else, is packed afresh).
+    """
+    parts: list = [int(batch)]
+    for g in goals:
+        if type(g) not in (PointGoal, PlaneGoal, AxisGoal):
+            return None
+        w = g.weight
+        if type(w) not in (float, int) or isinstance(w, bool):
+            return None
+        local = g.axis if isinstance(g, AxisGoal) else g.point
+        if type(local) is not tuple or len(local) != 3 or any(type(x) not in (float, int) for x in local):
+            return None
+        link = g.link
+        if type(link) not in (str, int):
+            return None
+        parts.append((type(g), link, local, w))
+    return tuple(parts)
+
+
 class GoalStack:
     """A list of goals packed into arrays, evaluated for a batch of poses.
 
@@ -403,6 +430,63 @@ class GoalStack:
         self._points_only = Q == 0 and H == 0
         self._unit_rows = B == 1 and bool(np.all(self.row_weight == 1.0))
         self._p_local_h = np.concatenate((self.p_local, np.ones((G, 1))), axis=1)[:, :, None]
+
+    @classmethod
+    def cached(cls, model: IKModel, goals: Sequence[Goal], batch: int) -> GoalStack:
+        """A :class:`GoalStack`, reusing the packing of the same goals on the same model.
+
+        A script that solves one figure again and again (STARTREACH in a DO
+        loop, a batch of single solves) asks for the same links, link points,
+        axes and weights each time, and only the targets change.  Resolving
+        the links and packing the weights and Jacobian masks is done once per
+        such set of goals (remembered for the last :data:`_STACKS_MAX` sets);
+        the targets, planes and directions are checked and packed on every
+        call, exactly as the constructor does.  Goals whose weight is a
+        batch, or any other value than a number, are packed afresh.
+
+        Parameters, returns and raises as the constructor.
+        """
+        key = _structure(goals, batch)
+        if key is None:
+            return cls(model, goals, batch)
+        key = (id(model),) + key
+        hit = _STACKS.get(key)
+        if hit is None or hit[0] is not model:
+            stack = cls(model, goals, batch)
+            if len(_STACKS) >= _STACKS_MAX:
+                _STACKS.clear()
+            _STACKS[key] = (model, stack)
+            return stack
+        return hit[1]._with_targets(tuple(goals))
+
+    def _with_targets(self, goals: tuple) -> GoalStack:
+        """This packing with the targets, plane points, normals and directions of ``goals`` (same structure)."""
+        B = self.batch
+        pts: list = []
+        origins: list = []
+        normals: list = []
+        dirs: list = []
+        for i, g in enumerate(goals):
+            what = f"goal {i + 1}"
+            if isinstance(g, PointGoal):
+                pts.append(_batched(_vectors(g.target, f"the target of {what}", B), (B, 3)))
+            elif isinstance(g, PlaneGoal):
+                origins.append(_batched(_vectors(g.origin, f"the plane point of {what}", B), (B, 3)))
+                n = _vectors(g.normal, f"the plane normal of {what}", B)
+                normals.append(_batched(_unit(n, f"the plane normal of {what}"), (B, 3)))
+            else:
+                d = _vectors(g.direction, f"the direction of {what}", B)
+                dirs.append(_batched(_unit(d, f"the direction of {what}"), (B, 3)))
+        out = object.__new__(GoalStack)
+        out.__dict__.update(self.__dict__)
+        out.goals = goals
+        out.warnings = list(self.warnings)
+        out.p_target = np.stack(pts, axis=1) if pts else self.p_target
+        if origins:
+            out.q_origin, out.q_normal = np.stack(origins, axis=1), np.stack(normals, axis=1)
+        if dirs:
+            out.h_dir = np.stack(dirs, axis=1)
+        return out
 
     # ------------------------------------------------------------ batches
 

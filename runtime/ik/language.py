@@ -115,25 +115,6 @@ def language_goal(
     return AxisGoal(index, tuple(normal), tuple(target), w), ambiguous
 
 
-def block_options(movable, translate, solver: str, tolerance, iterations) -> ReachOptions:
-    """A STARTREACH block's options as the compiled program gives them, as one :class:`ReachOptions`.
-
-    Parameters
-    ----------
-    movable : ("joints", ids) or ("chain", n) or None
-        MOVE JOINTS or MOVE CHAIN.
-    translate : bool
-        Whether the whole model may move (TRANSLATE INTO).
-    solver, tolerance, iterations
-        USING, TOLERANCE and ITERATIONS (None where the block does not say).
-    """
-    if movable is not None:
-        movable = tuple(movable[1]) if movable[0] == "joints" else int(movable[1])
-    return ReachOptions(
-        movable=movable, translate=bool(translate), solver=solver, tolerance=tolerance, max_iterations=iterations
-    )
-
-
 def reach_block(
     figure: Figure,
     goals: Sequence,
@@ -157,7 +138,7 @@ def reach_block(
     start : Motion or None
         The motion whose last pose the solve starts from; None for the neutral pose.
     options : ReachOptions
-        MOVE, TRANSLATE INTO, the solver and its settings (:func:`block_options`).
+        MOVE, TRANSLATE INTO, the solver and its settings, as the compiled program built them.
 
     Returns
     -------

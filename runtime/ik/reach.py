@@ -36,7 +36,8 @@ from liganimate.runtime.figure import pose as PO
 from liganimate.runtime.figure.tree import Figure, Joint
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
 from liganimate.runtime.ik.model import IKModel
-from liganimate.runtime.ik.solvers import CONVERGED, DEFAULT_SOLVER, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
+from liganimate.runtime.ik.options import ReachOptions
+from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
@@ -78,40 +79,8 @@ class SolveStatus(StrEnum):
 _STATUS = {CONVERGED: SolveStatus.CONVERGED, STALLED: SolveStatus.STALLED, LIMIT: SolveStatus.LIMIT}
 
 
-@dataclass(frozen=True)
-class ReachOptions:
-    """How a pose is solved: the one value REACH, :func:`reach`, :func:`reach_keyframes` and :func:`solve_pose` pass on.
-
-    Attributes
-    ----------
-    movable : None, int or tuple of int
-        Which joints may turn: all (None), the ``n`` joints nearest each
-        goal's link toward the main link (an int: a chain length), or joint
-        ids.  The others keep their start angles, and so does every axis
-        locked by its extremes (``min == max``).
-    translate : bool
-        Whether the whole figure may also move (POSIT's root translation).
-    solver : str
-        A name in :data:`solvers.SOLVER_NAMES`: "dls" (the default), "transpose" or "ccd".
-    tolerance : float or None
-        World units; default :data:`DEFAULT_TOLERANCE` times the figure's
-        length.  The solve stops when every goal is this close (an axis goal
-        counts its angle in radians times its link's length).
-    max_iterations : int or None
-        Default :data:`DEFAULT_MAX_ITERATIONS` for the solver.
-    restarts : int
-        When the goals are not met from the start pose (a local minimum,
-        often against joint limits), try up to this many other start poses,
-        drawn within the limits by a fixed-seed generator, and keep the
-        first that meets them (see :func:`solvers.solve`).
-    """
-
-    movable: int | tuple[int, ...] | None = None
-    translate: bool = False
-    solver: str = DEFAULT_SOLVER
-    tolerance: float | None = None
-    max_iterations: int | None = None
-    restarts: int = 0
+_DEFAULT_OPTIONS = ReachOptions()
+_OPTION_NAMES = frozenset(f.name for f in dataclasses.fields(ReachOptions))
 
 
 def reach_options(options: ReachOptions | None = None, **fields) -> ReachOptions:
@@ -122,8 +91,8 @@ def reach_options(options: ReachOptions | None = None, **fields) -> ReachOptions
     GoalError
         For a keyword that is not a field of :class:`ReachOptions`.
     """
-    base = options if options is not None else ReachOptions()
-    unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(ReachOptions)})
+    base = options if options is not None else _DEFAULT_OPTIONS
+    unknown = sorted(set(fields) - _OPTION_NAMES)
     if unknown:
         raise GoalError(f"there is no REACH option {', '.join(unknown)}.")
     return dataclasses.replace(base, **fields) if fields else base
@@ -525,7 +494,7 @@ def solve_pose(
         raise GoalError(f"the number of restarts must be a non-negative whole number, not {restarts!r}.")
     start_deg, base, B, batched = _start_batch(figure, goals, start)
     model = IKModel.cached(figure, _movable_mask(figure, goals, o.movable), translate)
-    stack = GoalStack(model, goals, B)
+    stack = GoalStack.cached(model, goals, B)
     x0 = np.zeros((B, model.n_params))
     x0[:, : model.n_vars] = np.deg2rad(start_deg).reshape(B, -1)[:, model.var_flat]
     result = solve(
@@ -551,7 +520,7 @@ def _start_batch(figure: Figure, goals: list, start) -> tuple:
     GoalError
         When the goals and the start poses are batches of different sizes.
     """
-    start_deg = start_pose(figure, start)
+    start_deg = _neutral(figure) if start is None else start_pose(figure, start)
     B_goals = batch_size(goals)
     B_start = start_deg.shape[0] if start_deg.ndim == 3 else None
     if B_goals is not None and B_start is not None and B_goals != B_start:
@@ -563,6 +532,22 @@ def _start_batch(figure: Figure, goals: list, start) -> tuple:
         start_deg[None] if start_deg.ndim == 2 and B == 1 else np.broadcast_to(start_deg, (B, figure.n_joints, 3))
     )
     return start_deg, base, B, batched
+
+
+def _neutral(figure: Figure) -> np.ndarray:
+    """``start_pose(figure)``, the neutral pose clamped into the extremes, remembered per figure (read-only)."""
+    hit = _NEUTRAL.get(id(figure.joints))
+    if hit is not None and hit[0] is figure.joints:
+        return hit[1]
+    pose = start_pose(figure)
+    pose.setflags(write=False)
+    if len(_NEUTRAL) >= 256:
+        _NEUTRAL.clear()
+    _NEUTRAL[id(figure.joints)] = (figure.joints, pose)
+    return pose
+
+
+_NEUTRAL: dict = {}  # id(joints) -> (joints, neutral pose); the stored joints keep the id valid
 
 
 def _pose_solution(figure, model, stack, result, start_deg, tol: float, translate: bool, batched: bool):

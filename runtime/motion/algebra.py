@@ -18,6 +18,7 @@ import numpy as np
 from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
+from liganimate.runtime.motion import morph as mo
 from liganimate.runtime.motion import path as rp
 from liganimate.runtime.motion import track as tr
 from liganimate.runtime.motion.keyframe import RAMP, Keyframe
@@ -164,7 +165,7 @@ class Motion:
     ``n * m`` and the methods below.  All operations return new motions.
     """
 
-    __slots__ = ("_derived", "_expr", "_length", "_open", "_root", "_tail", "_tracks", "_turn")
+    __slots__ = ("_derived", "_expr", "_length", "_morph", "_open", "_root", "_tail", "_tracks", "_turn")
 
     def __init__(
         self,
@@ -173,6 +174,7 @@ class Motion:
         length: float | None = None,
         gaps: tuple[Iterable[int], Iterable[int]] = ((), ()),
         root: tr.Track | None = None,
+        morph: mo.Morphs | None = None,
         turn: tr.Track | None = None,
     ):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
@@ -190,6 +192,8 @@ class Motion:
             joints whose track ends with such a time (a hold).
         root : Track, optional
             The root path (see :mod:`liganimate.runtime.motion.path`).
+        morph : Morphs, optional
+            The links' scale and shape channels (see :mod:`liganimate.runtime.motion.morph`).
         turn : Track, optional
             The root orientation: three angles (see :mod:`liganimate.runtime.motion.turning`).
         """
@@ -199,6 +203,7 @@ class Motion:
         self._open = frozenset(gaps[0]) & self._tracks.keys()
         self._tail = frozenset(gaps[1]) & self._tracks.keys()
         ends = [t.end for t in self._tracks.values()] + [t.end for t in (root, turn) if t is not None]
+        ends += [morph.end] if morph is not None else []
         self._length = float(length if length is not None else max(ends, default=0.0))
         if not math.isfinite(self._length):
             # n * m and SCALE FRAMES multiply lengths; LEN must stay a finite REAL.
@@ -207,6 +212,7 @@ class Motion:
                 hint="repeat or stretch it less",
             )
         self._expr = expr
+        self._morph = None if morph is None else morph.fitted(self._length)
         self._derived: dict | None = None
 
     def _derive(self, key: tuple, keep, make) -> Motion:
@@ -232,13 +238,14 @@ class Motion:
         return out
 
     def __getstate__(self):
-        return (self._tracks, self._length, self._expr, self._open, self._tail, self._root, self._turn)
+        return (self._tracks, self._length, self._expr, self._open, self._tail, self._root, self._morph, self._turn)
 
     def __setstate__(self, state):
         self._tracks, self._length, self._expr = state[:3]
         self._open, self._tail = state[3:5] if len(state) > 3 else (frozenset(), frozenset())
         self._root = state[5] if len(state) > 5 else None
-        self._turn = state[6] if len(state) > 6 else None
+        self._morph = state[6] if len(state) > 6 else None
+        self._turn = state[7] if len(state) > 7 else None
         self._derived = None
 
     # -- construction -----------------------------------------------------
@@ -337,6 +344,25 @@ class Motion:
         if e[0] != "*" or e[1] < 2 or self._length <= 0:
             return None
         return int(e[1]), self._length / e[1]
+
+    @property
+    def morphs(self) -> mo.Morphs | None:
+        """The links' scale and shape channels, or None for a motion that morphs nothing."""
+        return self._morph
+
+    def with_morphs(self, morph: mo.Morphs | None) -> Motion:
+        """This motion with morph channels added (STARTMOTION's SCALE and SHAPE entries).
+
+        Parameters
+        ----------
+        morph : Morphs or None
+
+        Returns
+        -------
+        Motion
+            Its length covers the morph channels too.
+        """
+        return Motion(self._tracks, self._expr, None, (self._open, self._tail), self._root, morph, self._turn)
 
     @property
     def root(self) -> tr.Track | None:
@@ -544,7 +570,8 @@ class Motion:
         delta = 0.0 if (self._turn is None and la == 0) else self.heading("end") - other.heading("start")
         root = rp.concat(self._root, la, other._root, lb, delta)
         turn = _concat_turns(self._turn, la, other._turn, lb, delta)
-        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail), root=root, turn=turn)
+        morph = mo.concat(self._morph, la, other._morph, lb, Motion)
+        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail), root=root, morph=morph, turn=turn)
 
     def repeat(self, n: int) -> Motion:
         """``n`` copies played back to back (the thesis' ``n * motion``).
@@ -575,13 +602,15 @@ class Motion:
     def _repeat(self, n: int) -> Motion:
         expr = ("*", n, self._expr)
         root, turn = self._root, self._turn
+        morph = mo.repeat(self._morph, n, self._length)
         if n == 0:
             still = None if root is None else tr.Const(root.start_value)
             facing = None if turn is None else tr.Const(turn.start_value)
-            return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr, root=still, turn=facing)
+            consts = {j: tr.Const(t.start_value) for j, t in self._tracks.items()}
+            return Motion(consts, expr, root=still, morph=morph, turn=facing)
         gaps = (self._open, self._tail)
         if n == 1 or self._length == 0:
-            return Motion(self._tracks, expr, self._length * n, gaps, root, turn)
+            return Motion(self._tracks, expr, self._length * n, gaps, root, morph, turn)
         L = self._length
         tracks = {}
         for j, t in self._tracks.items():
@@ -597,7 +626,7 @@ class Motion:
                 tracks[j] = tr.repeat_smoothly(t, n, L, end)
         delta = self.heading("end") - self.heading("start")
         root = None if root is None else rp.repeat(root, n, L, delta)
-        return Motion(tracks, expr, n * L, gaps, root, _repeat_turn(turn, n, L, delta))
+        return Motion(tracks, expr, n * L, gaps, root, morph, _repeat_turn(turn, n, L, delta))
 
     def __mul__(self, n) -> Motion:
         return self.repeat(n)
@@ -625,9 +654,14 @@ class Motion:
         for joint in joints:
             j = self._driven(joint, "the motion being stripped")
             kept[j] = self._tracks[j]
-        # The root path is not a joint: STRIP keeps it.
+        # The root tracks and the morphs are not joints: STRIP keeps them.
         return Motion(
-            kept, ("strip", tuple(kept), self._expr), gaps=(self._open, self._tail), root=self._root, turn=self._turn
+            kept,
+            ("strip", tuple(kept), self._expr),
+            gaps=(self._open, self._tail),
+            root=self._root,
+            morph=self._morph,
+            turn=self._turn,
         )
 
     def scale_frames(self, r: float) -> Motion:
@@ -667,7 +701,8 @@ class Motion:
             back = self.heading("start") - self.heading("end")  # walk back facing as it came
             root = None if root is None else rp.reverse(root, L, memo, back)
             turn = None if turn is None else rp.reverse(turn, L, memo, 0.0, (0.0, back, 0.0))
-        return Motion(tracks, ("frames", r, self._expr), L, gaps, root, turn)
+        morph = mo.scale_frames(self._morph, r, self._length)
+        return Motion(tracks, ("frames", r, self._expr), L, gaps, root, morph, turn)
 
     def scale_extremes(self, r: float) -> Motion:
         """Multiply every angle (start and keyframe positions) by ``r``.
@@ -686,9 +721,10 @@ class Motion:
     def _scale_extremes(self, r: float) -> Motion:
         memo: dict = {}
         tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
-        # Positions are not angles: the root path is left as it is, and so is where the figure faces.
+        # Positions, scales and shapes are not angles: the root tracks and the morphs are left as they
+        # are (where the figure faces is not a joint's angle either).
         gaps = (self._open, self._tail)
-        return Motion(tracks, ("extremes", r, self._expr), self._length, gaps, self._root, self._turn)
+        return Motion(tracks, ("extremes", r, self._expr), self._length, gaps, self._root, self._morph, self._turn)
 
     def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> Motion:
         """Take the short way round on axes that can turn freely.
@@ -713,7 +749,7 @@ class Motion:
             if j in tracks and any(axes):
                 tracks[j] = tr.unwrap(tracks[j], (bool(axes[0]), bool(axes[1]), bool(axes[2])), memo)
         gaps = (self._open, self._tail)
-        return Motion(tracks, ("unwrap", self._expr), self._length, gaps, self._root, self._turn)
+        return Motion(tracks, ("unwrap", self._expr), self._length, gaps, self._root, self._morph, self._turn)
 
     # -- evaluation -------------------------------------------------------
 
@@ -1041,7 +1077,9 @@ def synchronize(*motions: Motion) -> Motion:
             tracks[j] = t
         opened |= m._open
         tail |= m._tail
-    return Motion(tracks, ("sync", tuple(m._expr for m in motions)), gaps=(opened, tail), root=root, turn=turn)
+    morph = mo.synchronize(enumerate((m._morph for m in motions), start=1), Motion)
+    sync = ("sync", tuple(m._expr for m in motions))
+    return Motion(tracks, sync, gaps=(opened, tail), root=root, morph=morph, turn=turn)
 
 
 def scale_frames(a: Motion, r: float) -> Motion:

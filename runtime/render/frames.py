@@ -47,6 +47,8 @@ from liganimate.runtime.errors import RenderError
 from liganimate.runtime.figure.pose import (
     joint_angles,
     mesh_table,
+    morph_record,
+    morphed,
     static_triangles,
     world_transforms,
     world_triangles,
@@ -309,15 +311,16 @@ class Renderer:
             frames = np.array([r[4].frame for r in reqs])
             placements = np.stack([np.asarray(r[4].figure.placement, dtype=np.float64) for r in reqs])
             angles = self._joint_angles(fig, motion, frames.tolist())
-            X = world_transforms(fig, angles, placements)
+            X, local = morphed(fig, motion, frames, world_transforms(fig, angles, placements))
             table = mesh_table(fig)
-            tris = world_triangles(table, X)
+            tris = world_triangles(table, X, local)
             mirrored = np.linalg.det(placements[:, :3, :3]) < 0
+            morphs = morph_record(fig, motion, frames) if self._poses_fh is not None else None
             for n, r in enumerate(reqs):
                 cull = table.closed if not mirrored[n] else np.zeros(len(table.closed), dtype=bool)
                 results[(r[0], r[1], r[2])] = (tris[n], table.shade, cull)
-                if self._poses_fh is not None:
-                    results[(r[0], r[1], r[2], "pose")] = (angles[n], X[n], fig)
+                if morphs is not None:
+                    results[(r[0], r[1], r[2], "pose")] = (angles[n], X[n], fig, morphs[n])
         for i, img in enumerate(self.pending):
             draws = [(img["background"][0], img["background"][1])]
             for j, (tick, camera, drawn) in enumerate(img["ticks"]):
@@ -325,8 +328,8 @@ class Renderer:
                 draws.append((camera, parts))
                 if self._poses_fh is not None:
                     for o, (name, _posed) in enumerate(drawn):
-                        angles, X, fig = results[(i, j, o, "pose")]
-                        self._write_pose(img["scene"], tick, img["image"], name, fig, angles, X)
+                        angles, X, fig, morph = results[(i, j, o, "pose")]
+                        self._write_pose(img["scene"], tick, img["image"], name, fig, angles, X, morph)
             self._submit((img["scene"], img["image"]), draws)
         self.pending = []
 
@@ -360,18 +363,19 @@ class Renderer:
                 memo[f] = row
         return np.stack([memo[f] for f in keys])
 
-    def _write_pose(self, scene, tick, image, name, fig, angles, X) -> None:
+    def _write_pose(self, scene, tick, image, name, fig, angles, X, morph) -> None:
         joints = {str(j): [_r(a) for a in angles[k]] for k, j in enumerate(fig.joint_ids)}
         segments = []
         for i, link in enumerate(fig.links):
             parent = fig.parent_joint_of(i)
-            segments.append(
-                {
-                    "link": link.name,
-                    "joint": parent.id if parent is not None else None,
-                    "matrix": [_r(x) for x in X[i].reshape(-1)],
-                }
-            )
+            segment = {
+                "link": link.name,
+                "joint": parent.id if parent is not None else None,
+                "matrix": [_r(x) for x in X[i].reshape(-1)],
+            }
+            for field, values in morph.get(i, {}).items():  # a morphed segment's "scale" and "shape"
+                segment[field] = [_r(v) for v in values]
+            segments.append(segment)
         rec = {"scene": scene, "tick": tick, "image": image, "model": name, "joints": joints, "segments": segments}
         self._poses_fh.write((json.dumps(rec, separators=(", ", ": ")) + "\n").encode("utf-8"))
 

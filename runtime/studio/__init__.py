@@ -11,7 +11,9 @@ This sub-package owns ``liganimate studio``:
 * Save: the posed model and the kept poses as a LIG library
   (:mod:`._library`), written atomically;
 * the session the page talks to (:mod:`._session`), the loopback web
-  server (:mod:`._server`, the standard library's ``http.server``) and
+  server (:mod:`._server`, a handler from the standard library's
+  ``http.server``), the connection loop under it with its bounded pool
+  and queue (:mod:`._loop`), their limits (:mod:`._limits`) and
   its page (:mod:`._page`, with ``studio.html``, ``studio.css`` and
   ``studio.js`` as package data and the viewer's ``gl.js``);
 * finding the model to pose (:mod:`._model`).
@@ -28,6 +30,7 @@ Nothing imports it but ``liganimate.view_cli``.  See ``docs/viewer.md``.
 from ._generator import POPULATION, Generator
 from ._genes import JointAxes, alternatives, joint_axes
 from ._library import library_text, lig_name, widened_extremes
+from ._limits import StudioLimits
 from ._model import studio_model
 from ._page import studio_page
 from ._server import MAX_BODY, StudioServer, serve, start_in_thread
@@ -43,6 +46,7 @@ __all__ = [
     "JointAxes",
     "RequestError",
     "Session",
+    "StudioLimits",
     "StudioServer",
     "alternatives",
     "circle",

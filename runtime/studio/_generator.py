@@ -36,13 +36,16 @@ from liganimate.runtime.figure.pose import world_transforms
 
 from ._genes import alternatives, joint_axes
 
-__all__ = ["POPULATION", "Generator"]
+__all__ = ["HISTORY_MAX", "KEPT_MAX", "POPULATION", "Generator"]
 
 # "Nine poses was found to be an ideal number" (chapter IV, 5.1).
 POPULATION = 9
 MODES = ("flexion", "twist")
 SEED_MAX = 2**32 - 1
-_HISTORY = 500
+#: Actions :meth:`Generator.undo` can go back (older ones are forgotten): the history's memory is bounded.
+HISTORY_MAX = 500
+#: Kept poses at most: a Save's compile time and the page's state grow with them (200 save in about 0.2 s of CPU).
+KEPT_MAX = 200
 
 
 class Generator:
@@ -155,7 +158,15 @@ class Generator:
         self.current = self.neutral.copy()
 
     def keep(self, spacing: int = 24) -> None:
-        """Append the current pose to the kept poses (the next keyframe, ``spacing`` frames after the last)."""
+        """Append the current pose to the kept poses (the next keyframe, ``spacing`` frames after the last).
+
+        Raises
+        ------
+        ValueError
+            When :data:`KEPT_MAX` poses are kept already.
+        """
+        if len(self.kept) >= KEPT_MAX:
+            raise ValueError(f"at most {KEPT_MAX} poses may be kept")
         self._push()
         self.kept = self.kept + [self.current.copy()]
         self.kept_frames = self.kept_frames + [self.kept_frames[-1] + spacing if self.kept_frames else 0]
@@ -318,7 +329,7 @@ class Generator:
                 self.seed,
             )
         )
-        if len(self._history) > _HISTORY:
+        if len(self._history) > HISTORY_MAX:
             del self._history[0]
 
     def _check_joint(self, joint) -> int:

@@ -4,20 +4,29 @@ The page sends choices as ``{"action": ..., ...}`` objects; :meth:`Session.act`
 checks every field before anything changes and answers with the whole
 state (:meth:`Session.state`).  All the posing logic is the
 :class:`~._generator.Generator`'s; this module only translates.
+
+Many threads may use one session (the server's workers and its slow
+lane): every action holds :attr:`Session.lock` for as long as it takes to
+change the poses and describe them, never longer.  A Save takes a copy of
+what it writes under the lock and compiles and writes it outside
+(:meth:`Session.save`), so a slow disk never holds up the page's state.
 """
 
 from __future__ import annotations
 
 import base64
 import hashlib
+import json
+import math
 import os
 import threading
+from dataclasses import dataclass
 
 import numpy as np
 
 from liganimate.runtime.motion.interpolation import names as interpolation_names
 
-from ._generator import MODES, POPULATION, SEED_MAX, Generator
+from ._generator import KEPT_MAX, MODES, POPULATION, SEED_MAX, Generator
 from ._library import library
 
 __all__ = ["ACTIONS", "RequestError", "Session"]
@@ -46,11 +55,50 @@ MAX_PLAY_FRAMES = 2400
 
 
 class RequestError(ValueError):
-    """A request the studio refuses: the page gets it as a 400 with this message."""
+    """A request the studio refuses: the page gets it with this message and :attr:`status` (400, or 409 at a cap).
+
+    Parameters
+    ----------
+    message : str
+        One sentence.
+    status : int
+        The HTTP status the server answers with.
+    """
+
+    def __init__(self, message: str, status: int = 400):
+        super().__init__(message)
+        self.status = status
+
+
+@dataclass(frozen=True)
+class _Snapshot:
+    """What a Save writes, copied under the session lock: the kept poses, their frames, how they are joined."""
+
+    kept: tuple
+    frames: tuple
+    method: str
+    seed: int
+
+    @property
+    def key(self) -> bytes:
+        """Equal for equal contents: whether the file on disk holds these poses."""
+        h = hashlib.sha256(np.ascontiguousarray(np.asarray(self.kept, dtype=np.float64)).tobytes())
+        h.update(repr((self.frames, self.method)).encode("ascii"))
+        return h.digest()
 
 
 def _b64(a) -> str:
     return base64.b64encode(np.ascontiguousarray(a, dtype="<f4").tobytes()).decode("ascii")
+
+
+def _number(v) -> bool:
+    """Whether ``v`` is a finite JSON number (a bool is not; a whole number past a double's range is not)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    try:
+        return math.isfinite(float(v))
+    except OverflowError:
+        return False
 
 
 def _int(body: dict, key: str, lo: int, hi: int) -> int:
@@ -81,8 +129,12 @@ class Session:
         self.save_path = os.path.abspath(save_path)
         self.spacing = spacing
         self.method = "LINEAR"  # how the saved motion reaches each kept pose
-        self.saved = False
         self.lock = threading.Lock()
+        self._save_lock = threading.Lock()  # one Save writes at a time, outside self.lock
+        self._saves_asked = 0  # Saves asked for; a Save is done when a write begun after it asked has ended
+        self._saves_done = 0
+        self._written: _Snapshot | None = None  # what the file holds (None: nothing written yet)
+        self._state_json: bytes | None = None  # the state as GET /api/state sends it, until the next change
         # Digests of PRIMITIVE texts (Library.shapes) a whole library with them has compiled with.
         self._shapes_ok: set = set()
         self._warming: threading.Thread | None = None
@@ -113,6 +165,24 @@ class Session:
         self._warming.start()
 
     # ---------------------------------------------------------------- state
+    @property
+    def saved(self) -> bool:
+        """Whether the library on disk holds the kept poses as they are now."""
+        w = self._written
+        return w is not None and w.key == self._snapshot().key
+
+    @property
+    def has_saved(self) -> bool:
+        """Whether this session has written its library (``GET /library.lig`` then serves it)."""
+        return self._written is not None
+
+    def state_json(self) -> bytes:
+        """:meth:`state` with no message as UTF-8 JSON, made once per change (the page asks for it often)."""
+        with self.lock:
+            if self._state_json is None:
+                self._state_json = json.dumps(self.state(), allow_nan=False).encode("utf-8")
+            return self._state_json
+
     def state(self, message: str = "") -> dict:
         """The whole state as the page shows it (JSON-ready)."""
         g = self.generator
@@ -151,11 +221,14 @@ class Session:
         if not isinstance(body, dict):
             raise RequestError("the request must be a JSON object")
         action = body.get("action")
-        if action not in ACTIONS:
+        if not isinstance(action, str) or action not in ACTIONS:
             raise RequestError(f"unknown action {str(action)[:40]!r}; the actions are " + ", ".join(ACTIONS))
+        if action == "save":
+            return self.save()
         g = self.generator
         with self.lock:
             message = getattr(self, "_do_" + action)(g, body)
+            self._state_json = None
             state = self.state(message or "")
             if action == "play":
                 state["play"] = self.played()
@@ -192,9 +265,7 @@ class Session:
 
     def _settings(self, g, body) -> None:
         intensity, mode = body.get("intensity"), body.get("mode")
-        if intensity is not None and (
-            isinstance(intensity, bool) or not isinstance(intensity, (int, float)) or not 0 <= intensity <= 1
-        ):
+        if intensity is not None and (not _number(intensity) or not 0 <= intensity <= 1):
             raise RequestError("'intensity' must be a number from 0 to 1")
         if mode is not None and mode not in MODES:
             raise RequestError("'mode' must be 'flexion' or 'twist'")
@@ -239,11 +310,7 @@ class Session:
     def _do_set(self, g, body):
         joint, name = self._link_joint(g, body)
         angles = body.get("angles")
-        if (
-            not isinstance(angles, list)
-            or len(angles) != 3
-            or any(isinstance(a, bool) or not isinstance(a, (int, float)) or not np.isfinite(a) for a in angles)
-        ):
+        if not isinstance(angles, list) or len(angles) != 3 or not all(_number(a) for a in angles):
             raise RequestError("'angles' must be three numbers (degrees about X, Y and Z)")
         g.set_angles(joint, angles)
         a = g.current[joint]
@@ -262,13 +329,11 @@ class Session:
     def _do_delete(self, g, body):
         k = self._kept_index(g, body)
         g.delete_kept(k)
-        self.saved = False
         return f"deleted kept pose {k + 1}"
 
     def _do_move(self, g, body):
         k, to = self._kept_index(g, body), self._kept_index(g, body, "to")
         g.move_kept(k, to)
-        self.saved = False
         return f"kept pose {k + 1} moved to place {to + 1}"
 
     def _do_frame(self, g, body):
@@ -277,7 +342,6 @@ class Session:
             g.set_kept_frame(k, _int(body, "frame", 0, 10**6))
         except ValueError as exc:
             raise RequestError(str(exc)) from None
-        self.saved = False
         return f"kept pose {k + 1} at frame {g.kept_frames[k]}"
 
     def _do_interpolation(self, g, body):
@@ -285,15 +349,17 @@ class Session:
         if method not in interpolation_names():
             raise RequestError("'method' must be one of " + ", ".join(interpolation_names()))
         self.method = method
-        self.saved = False
         return f"the kept poses are joined by {method} interpolation"
 
     def _do_play(self, g, body):
         return "playing"  # the state answered carries the frames (see act)
 
     def _do_keep(self, g, body):
+        if len(g.kept) >= KEPT_MAX:
+            raise RequestError(
+                f"the studio keeps at most {KEPT_MAX} poses and {KEPT_MAX} are kept; delete one to keep another", 409
+            )
         g.keep(self.spacing)
-        self.saved = False
         return f"kept pose {len(g.kept)}"
 
     def _do_stand(self, g, body):
@@ -304,18 +370,75 @@ class Session:
         g.set_seed(_int(body, "seed", 0, SEED_MAX))
         return f"seed {g.seed}: generation 1"
 
-    def _do_save(self, g, body):
-        if not g.kept:
-            raise RequestError("keep a pose first: the saved motion is made of the kept poses")
+    # ----------------------------------------------------------------- save
+    def _snapshot(self) -> _Snapshot:
+        g = self.generator
+        return _Snapshot(tuple(g.kept), tuple(g.kept_frames), self.method, g.seed)
+
+    def ask_save(self) -> int:
+        """Ask for a Save: its ticket for :meth:`save`, or RequestError now if there is nothing to save.
+
+        A Save is done when a write that began after it was asked has
+        ended; so Saves asked while another is being written are written
+        once, together.
+        """
+        with self.lock:
+            if not self.generator.kept:
+                raise RequestError("keep a pose first: the saved motion is made of the kept poses")
+            self._saves_asked += 1
+            return self._saves_asked
+
+    def save(self, ticket: int | None = None) -> dict:
+        """Write the library (model and kept poses) and return the state; Saves asked at once write once.
+
+        The poses are copied under :attr:`lock`; the library is made,
+        compiled and written outside it, so the page's state and actions
+        go on meanwhile.  Saves asked while another writes wait for it;
+        then the first of them writes the poses as they are by then, and
+        the others find their Save done (they asked before it began).
+
+        Parameters
+        ----------
+        ticket : int, optional
+            From :meth:`ask_save` when the Save was asked earlier (the
+            server asks when the request comes, and saves in turn).
+
+        Raises
+        ------
+        RequestError
+            When no pose is kept.
+        LigDiagnostics
+            If the library does not compile (nothing is written then).
+        OSError
+            If it cannot be written (the old file stays).
+        """
+        if ticket is None:
+            ticket = self.ask_save()
+        with self._save_lock:
+            if self._saves_done < ticket:
+                with self.lock:
+                    snap, covers = self._snapshot(), self._saves_asked
+                if not snap.kept:
+                    raise RequestError("keep a pose first: the saved motion is made of the kept poses")
+                self._write(snap)
+                with self.lock:
+                    self._written, self._saves_done = snap, covers
+                    self._state_json = None
+            written = self._written
+        assert written is not None
+        with self.lock:
+            return self.state(f"saved {len(written.kept)} pose(s) to {self.save_path}")
+
+    def _write(self, snap: _Snapshot) -> None:
         lib = library(
-            g.figure,
+            self.generator.figure,
             self.model,
             self.motion,
-            g.kept,
+            list(snap.kept),
             self.spacing,
-            note=f"Seed {g.seed}, {len(g.kept)} pose(s) kept.",
-            frames=g.kept_frames,
-            method=self.method,
+            note=f"Seed {snap.seed}, {len(snap.kept)} pose(s) kept.",
+            frames=list(snap.frames),
+            method=snap.method,
         )
         if self._warming is not None:
             self._warming.join()  # at most once: the first Save waits for the check it would make itself
@@ -323,8 +446,6 @@ class Session:
         known = digest in self._shapes_ok
         write_library(self.save_path, lib.text, checked_as=lib.head + lib.skeleton + lib.body if known else None)
         self._shapes_ok.add(digest)
-        self.saved = True
-        return f"saved {len(g.kept)} pose(s) to {self.save_path}"
 
 
 def _digest(text: str) -> bytes:

@@ -62,6 +62,7 @@ def shot_scenes(path: str, doing: str) -> list:
 
     ``doing`` finishes the sentence "there is nothing to ..." (export, view).
     """
+    from liganimate.compiler import load_program
     from liganimate.runtime import exchange as X
     from liganimate.runtime.errors import LigError
 
@@ -73,13 +74,6 @@ def shot_scenes(path: str, doing: str) -> list:
     if not scenes:
         raise LigError(NO_SCENE.format(doing=doing), NO_SCENE_HINT)
     return scenes
-
-
-def load_program(path: str):
-    """Compile a .lig file in memory (the same lowering ``compile`` writes) and return (program, warnings)."""
-    from liganimate.compiler import load_program as _load
-
-    return _load(path)
 
 
 def _add_render_options(p: argparse.ArgumentParser) -> None:
@@ -124,6 +118,15 @@ def _add_render_options(p: argparse.ArgumentParser) -> None:
         help="draw the frames on this Dask cluster (default: $LIGANIMATE_SCHEDULER, else this machine)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_progress_option(p)
+
+
+def _add_progress_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--progress",
+        action="store_true",
+        help="show progress on stderr even when it is not a terminal (a line a second)",
+    )
 
 
 def _usage_checked(args, parser: argparse.ArgumentParser) -> None:
@@ -181,38 +184,58 @@ def _render_options(args, stem: str):
 
 
 class _CheckProgress:
-    """``checking scene 1: 40,960/10,000,000 ticks`` on a terminal, once a check has run for a second.
+    """``checking scene 1: 40,960/10,000,000 ticks`` once a check has run for a second.
 
     A check runs every tick of every scene; a scene of millions of ticks
-    would otherwise keep the terminal silent for minutes.
+    would otherwise keep the terminal silent for minutes. On a terminal the
+    line is redrawn in place; asked for elsewhere (``--progress`` into a log),
+    a line is written at most once a second.
     """
 
-    def __init__(self):
+    def __init__(self, in_place: bool = True):
         self.start = time.monotonic()
         self.width = 0
+        self.in_place = in_place
+        self.last = 0.0
 
     def __call__(self, scene_id, tick, length) -> None:
-        if not self.width and time.monotonic() - self.start < 1.0:
+        now = time.monotonic()
+        if not self.width and now - self.start < 1.0:
             return
         line = f"checking scene {scene_id}: {tick:,}/{length:,} ticks"
+        if not self.in_place:
+            if now - self.last >= 1.0 or tick == length:
+                self.last = now
+                self.width = max(self.width, 1)
+                sys.stderr.write(line + "\n")
+                sys.stderr.flush()
+            return
         self.width = max(self.width, len(line))
         sys.stderr.write("\r" + line.ljust(self.width))
         sys.stderr.flush()
 
     def done(self) -> None:
-        """Clear the line, if one was shown."""
-        if self.width:
+        """Clear the line, if one was shown in place."""
+        if self.width and self.in_place:
             sys.stderr.write("\r" + " " * self.width + "\r")
             sys.stderr.flush()
 
 
-def _checked(program, quiet: bool, stdout=None):
-    """Run every check (``Program.check``) with a progress line on a terminal; returns the runtime.
+def _progress_for(quiet: bool, asked: bool = False):
+    """The check's progress line: on a terminal unless ``quiet``, or wherever stderr goes when ``asked``."""
+    tty = sys.stderr.isatty()
+    if asked or (tty and not quiet):
+        return _CheckProgress(in_place=tty)
+    return None
+
+
+def _checked(program, quiet: bool, stdout=None, asked: bool = False):
+    """Run every check (``Program.check``) with a progress line on a terminal (or when ``asked``); returns the runtime.
 
     Its ``warnings`` are the run's warnings, its ``shot`` the number of
     scenes the program shot.
     """
-    progress = _CheckProgress() if not quiet and sys.stderr.isatty() else None
+    progress = _progress_for(quiet, asked)
     try:
         if stdout is None:
             # PRINT output is dropped: a run prints it once, when it renders.
@@ -229,11 +252,11 @@ NO_SCENE = "the program shoots no scene, so there is nothing to {doing}"
 NO_SCENE_HINT = "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES"
 
 
-def _render(program, warnings, options) -> int:
+def _render(program, warnings, options, asked: bool = False) -> int:
     from liganimate.runtime.render.options import MOVIES
 
     _print_diagnostics(warnings)
-    checked = _checked(program, options.quiet)
+    checked = _checked(program, options.quiet, asked=asked)
     _print_diagnostics(checked.warnings)
     if not checked.shot:
         # Nothing to draw: no empty folder, no "frames written".
@@ -241,7 +264,7 @@ def _render(program, warnings, options) -> int:
         sys.stderr.write(f"liganimate: warning: {NO_SCENE.format(doing='render')}; nothing was written\n")
         sys.stderr.write(f"  hint: {NO_SCENE_HINT}\n")
         return 0
-    program.render(checked=True, options=options)
+    program.render(checked=True, options=options, progress=True if asked else None)
     if not options.quiet:
         written = [f"frames written to {options.out}"] if options.out is not None else []
         written += [f"{m.label} written to {path}" for m in MOVIES if (path := getattr(options, m.name))]
@@ -331,17 +354,21 @@ def cmd_run(args) -> int:
         stem = os.path.splitext(os.path.basename(args.file))[0]
         _usage_checked(args, args.parser)
         options = _render_options(args, stem)
+        from liganimate.compiler import load_program
+
         program, warnings = load_program(args.file)
-        return _render(program, warnings, options)
+        return _render(program, warnings, options, asked=args.progress)
 
     return guarded(go)
 
 
 def cmd_check(args) -> int:
     def go():
+        from liganimate.compiler import load_program
+
         program, warnings = load_program(args.file)
         _print_diagnostics(warnings)
-        _print_diagnostics(_checked(program, False, stdout=sys.stdout).warnings)
+        _print_diagnostics(_checked(program, False, stdout=sys.stdout, asked=args.progress).warnings)
         return 0
 
     return guarded(go)
@@ -409,6 +436,7 @@ def cmd_lib(args) -> int:
 
 def cmd_plot(args) -> int:
     def go():
+        from liganimate.compiler import load_program
         from liganimate.runtime.render.plot import plot_motion
 
         program, warnings = load_program(args.file)
@@ -457,6 +485,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_run, parser=p)
     p = sub.add_parser("check", help="run every check without rendering")
     p.add_argument("file", help=PROGRAM_HELP)
+    _add_progress_option(p)
     p.set_defaults(func=cmd_check)
     p = sub.add_parser("compile", help="write the program as a standalone Python module")
     p.add_argument("file", help=PROGRAM_HELP)

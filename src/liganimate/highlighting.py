@@ -18,6 +18,7 @@ wherever it stands; the language server knows better, and says so on hover.
 
 from __future__ import annotations
 
+import functools
 import re
 
 from pygments.lexer import RegexLexer, bygroups, words
@@ -27,19 +28,10 @@ from pygments.token import Comment, Keyword, Name, Number, Operator, Punctuation
 CONTROL = ("AND", "BEGIN", "CONTINUE", "DO", "ELSE", "END", "IF", "NOT", "OR", "RETURN", "STOP", "THEN")
 #: The type names.
 TYPES = ("GRAPHICAL", "INTEGER", "MODEL", "MOTION", "REAL", "VECTOR")
-#: Every other keyword of the grammar (lang/lig.lark), spelling variants included.
-KEYWORDS = (
-    "ALONG", "ANIMATE", "AT", "AXIS", "BACKGROUND", "BY", "CHAIN", "COLOR", "COLOUR", "DRAW", "ENDJOINT",
-    "ENDMODEL", "ENDMOTION", "ENDREACH", "ENDSCENE", "EXTREME", "EXTREMES", "FIGURE", "FRAME", "FRAMES", "FROM",
-    "GOAL", "INITIALIZE", "INTERPOLATE", "INTERPOLATION", "INTO", "ITERATIONS", "JOINT", "JOINTS", "LENGTH",
-    "LIGHTNESS", "LINK", "LOAD", "MAIN", "MOVE", "NORMAL", "ON", "PLANE", "POINT", "POLY", "POSITION",
-    "PRIMITIVE", "PRINT", "REPEAT", "ROOT", "ROT", "SAMEFRAME", "SCALE", "SCENE", "SHOOTSCENE", "SHOOTSCENES",
-    "SLIDE",
-    "SOLVER", "STARTMODEL", "STARTMOTION", "STARTREACH", "STARTSCENE", "STRIP", "SYNCHRONISE", "SYNCHRONIZE",
-    "TABLE", "TO", "TOLERANCE", "TRANS", "TRANSLATE", "USING", "VIEW", "WEIGHT", "WIDTH", "WITH", "X", "Y", "Z",
-)  # fmt: skip
 #: The word operator.
 WORD_OPERATORS = ("MOD",)
+
+
 #: The built-in functions that are not also keywords (REAL, MOD, X, Y, Z are coloured as such).
 FUNCTIONS = (
     "ABS", "ACOS", "ASIN", "ATAN", "ATAN2", "COS", "CROSS", "DOT", "EXP", "FLOAT", "INT", "LEN", "LOG", "MAX",
@@ -52,6 +44,34 @@ CONSTANTS = ("ACCDCC", "ACCELERATE", "CCD", "DECELERATE", "DLS", "LINEAR", "TRAN
 
 _WORD_END = r"(?![A-Za-z0-9_])"
 _WORD_START = r"(?<![A-Za-z0-9_$])"
+
+
+@functools.cache
+def keywords() -> tuple[str, ...]:
+    """Every other keyword of the grammar (lang/lig.lark), spelling variants included.
+
+    Read from the parser's own terminals, so that a new statement's or
+    modifier's word is coloured without an edit here (only the TextMate
+    grammar is written again). Reading them loads the parser's tables, so
+    it is done when a lexer first needs them, not when this module is imported.
+    """
+    from liganimate.lang.lexer import GrammarTables
+    from liganimate.lang.parser import build_parser
+
+    tables = GrammarTables(build_parser().terminals)
+    found = frozenset(tables.plain) | frozenset(tables.strong)
+    return tuple(sorted(found - {*CONTROL, *TYPES, *WORD_OPERATORS}))
+
+
+class _Keywords(words):
+    """:func:`keywords` as a Pygments word list, read when Pygments first builds the lexer's patterns."""
+
+    def __init__(self) -> None:
+        super().__init__((), prefix=_WORD_START, suffix=_WORD_END)
+
+    def get(self) -> str:
+        self.words = keywords()
+        return super().get()
 
 
 class LigLexer(RegexLexer):
@@ -84,7 +104,7 @@ class LigLexer(RegexLexer):
             (words(CONTROL, prefix=_WORD_START, suffix=_WORD_END), Keyword),
             (words(TYPES, prefix=_WORD_START, suffix=_WORD_END), Keyword.Type),
             (words(WORD_OPERATORS, prefix=_WORD_START, suffix=_WORD_END), Operator.Word),
-            (words(KEYWORDS, prefix=_WORD_START, suffix=_WORD_END), Keyword),
+            (_Keywords(), Keyword),
             (words(FUNCTIONS + PRIMITIVES, prefix=_WORD_START, suffix=_WORD_END), Name.Builtin),
             (words(CONSTANTS, prefix=_WORD_START, suffix=_WORD_END), Name.Constant),
             (r"[A-Za-z][A-Za-z0-9_]*", Name),
@@ -149,7 +169,7 @@ def textmate_grammar() -> dict:
                     {"name": "keyword.control.lig", "match": _alternation(CONTROL)},
                     {"name": "storage.type.lig", "match": _alternation(TYPES)},
                     {"name": "keyword.operator.word.lig", "match": _alternation(WORD_OPERATORS)},
-                    {"name": "keyword.other.lig", "match": _alternation(KEYWORDS)},
+                    {"name": "keyword.other.lig", "match": _alternation(keywords())},
                     {"name": "support.function.builtin.lig", "match": _alternation(FUNCTIONS + PRIMITIVES)},
                     {"name": "support.constant.lig", "match": _alternation(CONSTANTS)},
                     {"name": "variable.language.dollar.lig", "match": r"\$[A-Za-z][A-Za-z0-9_]*"},
@@ -193,11 +213,11 @@ __all__ = [
     "CONSTANTS",
     "CONTROL",
     "FUNCTIONS",
-    "KEYWORDS",
     "LigLexer",
     "PRIMITIVES",
     "TYPES",
     "WORD_OPERATORS",
+    "keywords",
     "textmate_grammar",
     "textmate_json",
 ]

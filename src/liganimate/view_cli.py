@@ -148,6 +148,7 @@ def cmd_studio(args) -> int:
         from liganimate.runtime.errors import LigError
         from liganimate.runtime.studio import (
             Session,
+            StudioLimits,
             StudioServer,
             serve,
             studio_model,
@@ -166,9 +167,12 @@ def cmd_studio(args) -> int:
             )
         if not os.path.isdir(os.path.dirname(save)):
             raise LigError(f"there is no folder {os.path.dirname(save)} to save {os.path.basename(save)} in.")
+        limits = StudioLimits.from_environment()  # before anything starts: a bad variable is one line
         seed = args.seed if args.seed is not None else secrets.randbelow(2**32)
         session = Session(fig, model, args.motion, save, seed=seed, spacing=args.frames)
-        server = StudioServer(session, studio_page(session.generator, model), port=args.port, quiet=not args.verbose)
+        server = StudioServer(
+            session, studio_page(session.generator, model), port=args.port, quiet=not args.verbose, limits=limits
+        )
         print(f"liganimate studio: posing {model} from {source}, seed {seed}", flush=True)
         print(f"  open {server.url}  (127.0.0.1 only; Ctrl-C stops the server)", flush=True)
         print(f"  Save writes {save}", flush=True)

@@ -97,3 +97,16 @@ def test_fmt_keeps_a_table_and_its_rows_as_written():
     assert "\n  TABLE 1, ROOT, 2\n" in once
     assert "|  2.5 20 0 0   0.2 0 0   1 2 5" in once
     assert np.array_equal(_motion(once).evaluate(np.arange(3.0)), _motion(TABLE).evaluate(np.arange(3.0)))
+
+
+@pytest.mark.parametrize("blank", ["", "\f", "   "])
+def test_a_file_that_ends_inside_a_table_is_reported_after_its_last_row(blank):
+    # The rows are one token over several lines; the end of the file was placed by
+    # the column of the token's first line, past the end of that line.
+    text = f"MOTION W\nSTARTMOTION W TABLE 1 , ROOT |\n{blank} | ENDMOTION\n"
+    with pytest.raises(LigDiagnostics) as info:
+        load_program(text=text, name="t.lig")
+    d = info.value.diagnostics[0]
+    assert "ends too early" in d.message
+    last = text.split("\n")[2]
+    assert (d.pos.line, d.pos.column) == (3, len(last) + 1)

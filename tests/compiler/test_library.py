@@ -55,7 +55,7 @@ def write(folder: pathlib.Path, text: str, name: str = "prog.lig") -> str:
 
 
 def execute(path: str) -> dict:
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     program, _ = load_program(path)
     return program.execute("check").variables
@@ -125,7 +125,7 @@ def test_compiled_module_is_standalone(libs, tmp_path_factory):
 
 def test_error_inside_a_library_primitive_points_into_the_library(libs):
     path = write(libs, "LOAD PRISM FROM 'lib/shapes.lig'\nX :- PRISM SIZE 2\n")
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     program, _ = load_program(path)
     with pytest.raises(LigDiagnostics) as info:

@@ -203,7 +203,6 @@ _STATEMENTS = frozenset(
         A.Scene,
         A.Print,
         A.Background,
-        A.View,
         A.DrawWith,
         A.DrawPoly,
         A.PrimitiveDef,

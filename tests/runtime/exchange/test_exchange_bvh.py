@@ -15,7 +15,7 @@ from paths import ROOT_DIR
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.transform import Rotation
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime import exchange as X
 
 # bvhio imports PyGLM under its old name; not ours to fix.

@@ -293,7 +293,7 @@ PLAY_ARM = """\
 
 def test_nodes_take_the_link_and_joint_names_of_the_source(tmp_path):
     """A library's name table (a URDF robot's links and joints) names the bones and the nodes."""
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     (tmp_path / "arm.lig").write_text(NAMED_ARM)
     (tmp_path / "play.lig").write_text(PLAY_ARM)

@@ -182,7 +182,7 @@ STEPPING = """\
 def _check_step_scene(tmp_path, rig, expect_exact, fps=FPS):
     src = tmp_path / "step.lig"
     src.write_text(STEPPING)
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     program, _ = load_program(str(src))
     path = str(tmp_path / "step.glb")
@@ -297,7 +297,7 @@ def test_an_imported_capture_keeps_its_names_and_root_in_both_clients(tmp_path, 
     with open(src, encoding="utf-8") as fh:
         source_names = re.findall(r"(?:ROOT|JOINT)\s+(\S[^\r\n]*?)\s*$", fh.read().split("MOTION")[0], re.M)
     (tmp_path / "play.lig").write_text(CAPTURE_PLAY)
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     program, _ = load_program(str(tmp_path / "play.lig"))
     path = str(tmp_path / "film.glb")

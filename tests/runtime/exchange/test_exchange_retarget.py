@@ -18,7 +18,7 @@ import pytest
 from captures import capture
 from PIL import Image
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime import exchange as X
 from liganimate.runtime.figure.kinematics import pose_transforms
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from exchange_support import load_gltf, pose_records, sample_channels, segment_nodes, world_transforms
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime import exchange as X
 
 FPS = 24.0

@@ -18,7 +18,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.ik.reach import PointGoal, solve_pose
 

@@ -60,9 +60,9 @@ def test_an_unknown_link_is_refused_and_an_ambiguous_one_warned():
 
 
 def solve(fig, goals, start=None, **block):
-    kw = dict(movable=None, translate=False, solver="dls", tolerance=None, iterations=None)
-    kw.update(block)
-    return RL.reach_block(fig, goals, 6, "LINEAR", start=start, options=RL.block_options(**kw))
+    from liganimate.runtime.ik.options import ReachOptions
+
+    return RL.reach_block(fig, goals, 6, "LINEAR", start=start, options=ReachOptions(**block))
 
 
 def test_a_met_goal_gives_the_motion_and_no_warning():
@@ -76,15 +76,15 @@ def test_a_met_goal_gives_the_motion_and_no_warning():
 def test_move_chain_and_move_joints_choose_the_driven_joints():
     fig = model()
     goal, _ = RL.language_goal(fig, "point", "LOWER", None, (0, -1, 0), (1.5, -0.5, 0), None, None)
-    assert solve(fig, [goal], movable=("chain", 1)).motion.joints == (2,)
-    assert solve(fig, [goal], movable=("joints", (1,))).motion.joints == (1,)
+    assert solve(fig, [goal], movable=1).motion.joints == (2,)
+    assert solve(fig, [goal], movable=(1,)).motion.joints == (1,)
 
 
 def test_unmet_goals_and_the_iteration_limit_are_warnings_by_goal():
     fig = model()
     near, _ = RL.language_goal(fig, "point", "UPPER", None, None, (0, 0, 0), None, None)
     far, _ = RL.language_goal(fig, "point", "LOWER", None, (0, -1, 0), (5, 0, 0), None, None)
-    block = solve(fig, [near, far], iterations=1)
+    block = solve(fig, [near, far], max_iterations=1)
     assert [w.goal for w in block.warnings] == [1, None]
     assert "stays 3" in block.warnings[0].sentence and block.warnings[0].hint == RL.UNMET_HINT
     assert "iteration limit (1)" in block.warnings[1].sentence and block.warnings[1].hint is None
@@ -108,12 +108,26 @@ def test_a_translation_beyond_the_geometry_limit_is_refused(monkeypatch):
     assert "1E12" in info.value.hint
 
 
-def test_a_block_s_options_travel_as_one_reach_options():
+def test_a_block_s_options_travel_as_one_reach_options(monkeypatch):
+    from liganimate.compiler import compile_text
     from liganimate.runtime.ik.reach import ReachOptions, reach, reach_options
 
-    o = RL.block_options(("chain", 2), 1, "ccd", 0.01, 40)
-    assert o == ReachOptions(movable=2, translate=True, solver="ccd", tolerance=0.01, max_iterations=40)
-    assert RL.block_options(("joints", [2, 1]), False, "dls", None, None).movable == (2, 1)
+    # The generated module builds one ReachOptions: literals through repr(), the rest as expressions.
+    text = ARM + "N = 1\nSTARTREACH R MODEL ARM FRAME 6\nGOAL LOWER TO (1.2, -0.9, 0)\nMOVE CHAIN N + 1\n"
+    text += "TRANSLATE INTO T\nSOLVER CCD\nTOLERANCE 0.01\nITERATIONS 40\nENDREACH\nEND\n"
+    python = compile_text(text).python
+    built = "_host.ReachOptions(movable=_ck(N + 1, 'I+', "
+    assert built in python and "translate=True, solver='ccd', tolerance=0.01, max_iterations=40)" in python
+    # The host hands that very object to reach_block.
+    seen = []
+    real = RL.reach_block
+    monkeypatch.setattr(
+        RL, "reach_block", lambda *a, options, **k: seen.append(options) or real(*a, options=options, **k)
+    )
+    program, _ = load_program(text=text, name="arm.lig")
+    program.execute("check")
+    o = ReachOptions(movable=2, translate=True, solver="ccd", tolerance=0.01, max_iterations=40)
+    assert seen == [o]
     with pytest.raises(AttributeError):
         o.solver = "dls"  # type: ignore[misc]
     fig = model()

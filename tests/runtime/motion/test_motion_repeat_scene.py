@@ -6,7 +6,7 @@ import pathlib
 
 from exchange_support import pose_records
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 
 PROGRAM = """\
       GRAPHICAL ARM, BODY

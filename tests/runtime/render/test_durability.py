@@ -6,7 +6,7 @@ import os
 
 from test_render import pngs, program
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime import files
 from liganimate.runtime.render import frames
 

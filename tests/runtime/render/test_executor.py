@@ -14,7 +14,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render import frames
 from liganimate.runtime.render.options import RenderOptions

@@ -355,7 +355,7 @@ def test_a_second_signal_during_cleanup_is_only_noted():
 
 def test_the_library_still_makes_the_pose_records_folder(tmp_path):
     # Program.render(poses=...) has always created the record's folder; the command line refuses a missing one.
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     prog, _ = load_program(str(program(tmp_path, 3)))
     prog.render(str(tmp_path / "frames"), size=(8, 6), poses=str(tmp_path / "new" / "p.jsonl"), quiet=True, workers=1)

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from paths import ROOT_DIR, TESTS_DIR
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.render.imagefiles import read_png
 
 EXAMPLES = pathlib.Path(ROOT_DIR) / "examples"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from paths import ROOT_DIR
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.figure.pose import joint_angles
 from liganimate.runtime.render import frames as R
 from liganimate.runtime.render.options import RenderOptions

@@ -22,7 +22,7 @@ from commands import liganimate as run
 from paths import ROOT_DIR
 from PIL import Image
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render import imagefiles, video
 from liganimate.runtime.render.imagefiles import read_png

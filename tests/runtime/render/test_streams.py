@@ -72,7 +72,7 @@ def test_gif_alone_is_streamed_and_exact(tmp_path):
 
 
 def test_the_library_writes_a_movie_without_a_frames_folder(tmp_path):
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
 
     prog, _ = load_program(str(program(tmp_path, 12)))
     prog.render(None, gif=str(tmp_path / "a.gif"), size=(32, 24), quiet=True)
@@ -83,7 +83,7 @@ def test_the_library_writes_a_movie_without_a_frames_folder(tmp_path):
 
 def test_frames_are_not_read_back(tmp_path, monkeypatch):
     # The movies take the images from memory: reading a PNG back would fail here.
-    from liganimate.cli import load_program
+    from liganimate.compiler import load_program
     from liganimate.runtime.render import imagefiles
 
     def refuse(*args, **kw):
@@ -110,7 +110,7 @@ def test_the_same_program_gives_the_same_mp4_bytes(tmp_path):
         if workers:
             # One process: the images come in another rhythm, the bytes must not change.
             code = (
-                "import sys; from liganimate.cli import load_program; p, _ = load_program(sys.argv[1]); "
+                "import sys; from liganimate.compiler import load_program; p, _ = load_program(sys.argv[1]); "
                 "p.render(None, mp4=sys.argv[2], size=(96, 72), quiet=True, workers=1)"
             )
             r = python("-c", code, str(src), f"{name}.mp4", cwd=tmp_path)

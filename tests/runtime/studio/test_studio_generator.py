@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime.studio import (
     POPULATION,
     Generator,

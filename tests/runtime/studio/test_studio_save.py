@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from commands import liganimate
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.lang.diagnostics import LigDiagnostics
 from liganimate.runtime import exchange as X
 from liganimate.runtime.figure.pose import mesh_table, world_transforms, world_triangles

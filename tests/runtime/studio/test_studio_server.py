@@ -143,7 +143,7 @@ def test_paths_outside_its_files_are_404(server, path):
         (json.dumps({"action": "seed", "seed": 1.5}), "seed"),
         (json.dumps({"action": "next", "intensity": 7}), "intensity"),
         (json.dumps({"action": "next", "mode": "sideways"}), "mode"),
-        ('{"action": "next", "intensity": NaN}', "intensity"),
+        ('{"action": "next", "intensity": NaN}', "NaN"),
         (b"\xff\xfe{}", "not JSON"),
         ("[" * 60_000, "not JSON"),  # issue 24: a RecursionError was a 500
     ],
