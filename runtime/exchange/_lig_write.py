@@ -36,6 +36,7 @@ from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
 from ._clip import clip_pose, clip_size
+from ._heading import split_heading
 from ._numbers import format_rows
 
 __all__ = [
@@ -168,8 +169,11 @@ def import_library(clip, options: ImportOptions) -> tuple:
         name_table.format_table(options.model, _name_rows(clip, links)),
     ]
     head = ("\n".join(parts) + "\n").encode("utf-8")
-    keep = reduce_keyframes(pose.angles, options.tolerance) if options.tolerance > 0 else None
-    return head + _motion_text(options.motion, pose.angles, pose.rotating, keep, pose.path), list(pose.notes)
+    # The hips' turn about up is the motion's ROOT ORIENTATION, so that + continues it.
+    angles, orientation = split_heading(clip.parents, pose.angles)
+    keep = reduce_keyframes(angles, options.tolerance) if options.tolerance > 0 else None
+    body = _motion_text(options.motion, angles, pose.rotating, keep, pose.path, orientation=orientation)
+    return head + body, list(pose.notes)
 
 
 def _header(clip, options: ImportOptions, links: list, src: str) -> list:
@@ -188,7 +192,8 @@ def _header(clip, options: ImportOptions, links: list, src: str) -> list:
         "C real time render with --fps matching the capture.",
         "C",
         "C The ROOT's path is the motion's ROOT track: ANIMATE carries the figure along it, in",
-        "C the model's own frame, after the placement (see docs/exchange.md). The {@names}",
+        "C the model's own frame, after the placement (see docs/exchange.md); the ROOT's turn",
+        "C about Y, from the first frame's, is its ROOT ORIENTATION, and JOINT 1 the rest. The {@names}",
         "C table after the model keeps the BVH names and channels for export.",
         "C",
         "C   joint  segment            BVH joint (channels)",

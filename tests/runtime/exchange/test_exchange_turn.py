@@ -21,7 +21,7 @@ import pytest
 from captures import capture
 from PIL import Image
 
-from liganimate.cli import load_program
+from liganimate.compiler import load_program
 from liganimate.runtime import exchange as X
 from liganimate.runtime.exchange._clip import clip_pose
 from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx, pose_transforms
@@ -198,3 +198,50 @@ def test_poses_record_the_turned_placement(tmp_path):
     first = next(seg for seg in records[0]["segments"] if seg["joint"] is None)
     d0 = np.array(first["matrix"], dtype=float).reshape(4, 4)[:3, :3] @ [1.0, 0.0, 0.0]
     np.testing.assert_allclose(d0 / np.linalg.norm(d0), [1, 0, 0], atol=1e-9)
+
+
+def test_a_plain_import_gives_the_actor_s_turn_to_the_root_orientation(tmp_path):
+    """Without --onto the capture's own skeleton turns by ROOT ORIENTATION; the joints are where they were."""
+    lib = tmp_path / "cap.lig"
+    r = _cli("import", capture("mixamo"), "-o", str(lib), "--model", "FIG", "--motion", "TAKE")
+    assert r.returncode == 0, r.stderr
+    assert "ROOT ORIENTATION" in lib.read_text()
+    program = (
+        f"      LOAD FIG, TAKE FROM '{lib.name}'\n"
+        "      MOTION TWICE\n"
+        "      TWICE = TAKE + TAKE\n"
+        "      INITIALIZE SCENE 1\n"
+        "      STARTSCENE LENGTH 69\n"
+        "        ANIMATE FIG FROM 0 TO 68 USING TAKE\n"
+        "      ENDSCENE\n"
+        "      SHOOTSCENES\n"
+        "      END\n"
+    )
+    play = tmp_path / "play.lig"
+    play.write_text(program)
+    compiled = load_program(str(play))[0]
+    take = X.collect(compiled)[0].models[0]
+    clip = X.read_bvh(capture("mixamo"))
+    want = capture_heading(clip)
+    played = _yaw(take.placements[:, :3, :3])
+    assert abs((played[-1] - played[0]) - (want[-1] - want[0])) < 1.0
+    # The joints are where the file has them: world positions from the BVH's own numbers.
+    from liganimate.runtime.exchange._retarget import _Source
+
+    src = _Source(clip, "drop")
+    X_ = pose_transforms(take.figure, take.angles)
+    world = np.einsum("tij,tnjk->tnik", take.placements, X_)[:, :, :3, 3]
+    compared = 0
+    for j, name in enumerate(clip.names):
+        links = take.figure.links_named(name.replace(":", "_").upper())
+        if links:
+            # A link's origin is its BVH joint's position (the importer's segments start at their joint).
+            np.testing.assert_allclose(world[:, links[0]], src.P[:, j], atol=1e-6 * 200)
+            compared += 1
+    assert compared >= 20
+    # TAKE + TAKE: the second copy starts facing where the first ended.
+    twice = compiled.execute("check").variables["TWICE"]
+    assert twice.length == 136.0  # 69 frames are 68 frames long
+    h = twice.root_orientation([0.0, 68.0, 136.0])[:, 1]
+    assert h[1] - h[0] == pytest.approx(want[-1] - want[0], abs=1.0)
+    assert h[2] - h[0] == pytest.approx(2 * (want[-1] - want[0]), abs=2.0)
