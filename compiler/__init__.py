@@ -81,14 +81,16 @@ def check_source(source: Source, *, path: str | None = None, stack: tuple = ()) 
         return check(program, path=path if path is not None else source.filename, stack=stack, opened=opened)
 
 
-def parse_program(source: Source, *, path: str | None = None, stack: tuple = ()) -> tuple:
+def parse_program(source: Source, *, path: str | None = None, stack: tuple = (), reparser=None) -> tuple:
     """Open the libraries a source LOADs and parse it: ``(Program, opened)``, for :func:`check`.
 
     ``opened`` holds the libraries opened for the parse (library name ->
     Library, or the exception it failed with), which :func:`check` takes
     so that a library is opened once. The language server calls this and
     :func:`check` apart, to keep the syntax tree of a program that parses
-    but fails its checks.
+    but fails its checks; it passes the ``reparser`` of the document
+    (:func:`liganimate.lang.parser.reparser`), so that only the part of
+    the text around a change is parsed again.
 
     Raises
     ------
@@ -99,7 +101,7 @@ def parse_program(source: Source, *, path: str | None = None, stack: tuple = ())
     opened: dict = {}  # library name -> Library or its failure, for this compile (library.open_library)
     names, failed = _scan_loads(source, path, stack, opened)
     try:
-        program = parse_source(source, names)
+        program = parse_source(source, names, reparser=reparser)
     except LigDiagnostics as exc:
         raise NotParsed(_load_failures(source, failed), exc.diagnostics) from None
     return program, opened

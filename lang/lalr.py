@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 from operator import itemgetter
+from typing import NamedTuple
 
 from lark import Lark
 from lark.exceptions import UnexpectedToken
@@ -46,6 +47,11 @@ _new_tuple = tuple.__new__
 
 def _inline(children: list) -> _Inlined:
     return _new_tuple(_Inlined, (children,))
+
+
+def _unwatched(stack: list, values: list, line: int, line_start: int) -> bool:
+    """The ``watch`` of a parse nobody watches: go on."""
+    return False
 
 
 def _inlined(callback):
@@ -125,19 +131,17 @@ class Driver:
             callback = _inlined(callback)
         return size, rule.origin.name, callback
 
-    def parse(self, text: str, primitives: frozenset, tokens: list | None = None):
+    def parse(self, text: str, primitives: frozenset, tokens: list | None = None, resume=None, watch=_unwatched):
         """Parse ``text``; a NAME in ``primitives`` is a PRIM_NAME. Returns the start rule's value.
 
-        ``tokens``, if given, receives every :class:`~.lexer.Tok`, typed as the parser took it (lang/formatter.py).
+        ``tokens``, if given, receives every :class:`~.lexer.Tok`, typed as the parser took it (lang/formatter.py);
+        ``resume`` and ``watch`` go on from, and stop at, a :class:`Mark` (see there).
         """
         actions, rules, chains, scanner, accept = self.actions, self.rules, self._chains, self.scanner, self.end
         keywords, clause_states, choice = scanner.tables.keywords, scanner.clause_states, scanner._choice
-        word_type = self._keyword_type
-        values: list = []
-        state, spellings = self.start, _Spellings()
-        stack = [state]
+        word_type, spellings = self._keyword_type, _Spellings()
+        stack, values, state, pos, line, line_start, tok = _begin(self.start, resume)
         push_state, push_value, scan, count = stack.append, values.append, SCAN.match, text.count
-        pos, line, line_start, tok = 0, 1, 0, None
         ttype: str | None  # None only between a missed operator choice and _operator
         end_tok: Token | None = None  # set once the text has ended
         while True:
@@ -188,6 +192,8 @@ class Driver:
                     push_state(code)
                     push_value(tok)
                     state = code
+                    if len(stack) == 3 and watch(stack, values, line, line_start):
+                        return watch.result
                     break
                 size, origin, callback = rules[~code]
                 if callback is None:
@@ -229,7 +235,41 @@ class Driver:
         return UnexpectedToken(token, expected, state=state)
 
 
-#: The token types of the scanner's groups that need no decision.
+class Mark(NamedTuple):
+    """The driver just after it shifted the first token of a top-level statement (not the first one).
+
+    Then the stack is the start state, the state after the statements so
+    far, and the token's state: what follows depends only on those three
+    states and the text after the token, so a parse can go on from here,
+    and a parse that reaches the same states at the same token of the same
+    remaining text would do what an earlier one did from here.
+
+    :meth:`Driver.parse` goes on from a Mark when given ``resume=(mark,
+    statements)``, the list of the statements before it (its ``preceding``
+    first ones). Its ``watch(stack, values, line, line_start)`` is called
+    whenever the stack is three states deep after a shift (at every Mark,
+    and a few other places: a Mark's ``values[0]`` is an :class:`_Inlined`
+    list of statements and its ``stack[1]`` the state after statements);
+    when it returns True, the parse stops and returns ``watch.result``.
+    lang/incremental.py does both.
+    """
+
+    stack: tuple  # the three states
+    preceding: int  # statements before the token (the length of the list of statements so far)
+    tok: Tok  # the token
+    line: int  # the line the driver is on after the token
+    line_start: int  # the offset where that line starts
+
+
+def _begin(start: int, resume) -> tuple:
+    """``(stack, values, state, offset, line, line_start, last token)`` to start a parse with: afresh, or at a Mark."""
+    if resume is None:
+        return [start], [], start, 0, 1, 0, None
+    mark, statements = resume
+    tok = mark.tok
+    return list(mark.stack), [_inline(statements), tok], mark.stack[-1], tok[6], mark.line, mark.line_start, tok
+
+
 def _past_rows(text: str, start: int, end: int, line: int, line_start: int) -> tuple:
     """``(line, line_start)`` after a keyframe table's rows, the only token that spans lines."""
     nl = text.count("\n", start, end)

@@ -18,6 +18,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedTok
 from . import ast as A
 from . import collector, tables
 from .diagnostics import Diagnostic, LigDiagnostics
+from .incremental import Reparser
 from .lalr import Driver
 from .lexer import TablesOnly
 from .messages import did_you_mean
@@ -56,11 +57,18 @@ def _driver() -> Driver:
     return Driver(build_parser())
 
 
-def parse_source(source: Source, primitives: frozenset | set = frozenset(), tokens: list | None = None) -> A.Program:
+def parse_source(
+    source: Source,
+    primitives: frozenset | set = frozenset(),
+    tokens: list | None = None,
+    reparser: Reparser | None = None,
+) -> A.Program:
     """Parse a prepared source; ``primitives`` are extra primitive names (e.g. from a library).
 
     ``tokens``, when given, receives the tokens in order, each typed as the
-    parser took it (see :meth:`.lalr.Driver.parse`).
+    parser took it (see :meth:`.lalr.Driver.parse`). ``reparser`` (from
+    :func:`reparser`), when given, parses only what changed since the text
+    it parsed last (:mod:`.incremental`): the same tree, sooner.
     """
     names = frozenset(set(BUILTIN_PRIMITIVES) | set(primitives) | source.primitive_names())
     # The parse makes trees, never cycles: the cyclic collector would walk
@@ -68,12 +76,24 @@ def parse_source(source: Source, primitives: frozenset | set = frozenset(), toke
     # program, a third of the time).
     with collector.paused():
         try:
-            body = _driver().parse(source.lexed, names, tokens)
+            if reparser is not None:
+                body = reparser.parse(source.lexed, names)
+            else:
+                body = _driver().parse(source.lexed, names, tokens)
         except UnexpectedInput as exc:
             raise LigDiagnostics([_syntax_diagnostic(exc, source)]) from None
-        body = group_blocks(body, source)
+        if reparser is None:
+            body = group_blocks(body, source)
+        else:
+            body = group_blocks(body, source, reparser.fresh)
+            reparser.passed()
     prims = [s for s in body if isinstance(s, A.PrimitiveDef)]
     return A.Program(A.Pos(1, 1, 1, 1), source.filename, source.text, body, prims)
+
+
+def reparser() -> Reparser:
+    """A parser for the successive versions of one text (a document being edited): see :mod:`.incremental`."""
+    return Reparser(_driver(), ToAst().start)
 
 
 def parse(text: str, filename: str = "<string>", primitives: frozenset | set = frozenset()) -> A.Program:

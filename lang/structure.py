@@ -65,9 +65,15 @@ def check_depth(roots: list, source) -> None:
 MAX_BLOCKS = 15
 
 
-def group_blocks(body: list, source) -> list:
-    """Check nesting depth, then nest DO loops in every statement list."""
-    check_depth(body, source)
+def group_blocks(body: list, source, fresh: list | None = None) -> list:
+    """Check nesting depth, then nest DO loops in every statement list.
+
+    ``fresh``, when given, are the only statements of ``body`` whose depth
+    is checked: the others are known to pass (lang/incremental.py). The
+    error is the same, since a statement that passes holds no node the
+    check could report.
+    """
+    check_depth(body if fresh is None else fresh, source)
     grouped = _group_list(body, source)
     _check_blocks(grouped, source)
     return grouped

@@ -9,6 +9,7 @@ below, and pose records come from ``Program.render(poses=...)``, as
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -260,8 +261,45 @@ SHOOTSCENES
 """
 
 
+# A figure built from a re-rooted submodel (thesis 3.3 and 3.5): the arm, re-rooted at its HAND,
+# is attached to the body by the hand, so its wrist (an inverted slide about its own AXIS) and
+# elbow are walked from their secondaries; a mirrored copy is re-rooted again at the UPPER arm.
+GRAFTED = """\
+GRAPHICAL BODY, UPPER, LOWER, HAND
+MODEL ARM, BOT, SPUN
+MOTION WAVE
+BODY :- BOX WIDTH 0.6, HEIGHT 1.0, DEPTH 0.4, LIGHTNESS 30.0
+UPPER :- BOX AT (0.0, -0.3, 0.0), WIDTH 0.15, HEIGHT 0.6, DEPTH 0.15
+LOWER :- BOX AT (0.0, -0.25, 0.0), WIDTH 0.12, HEIGHT 0.5, DEPTH 0.12, LIGHTNESS 60.0
+HAND :- BOX WIDTH 0.2, HEIGHT 0.1, DEPTH 0.2, LIGHTNESS 80.0
+STARTMODEL ARM
+  JOINT 1, UPPER, (0.0, -0.6, 0.0), LOWER, (0.0, 0.0, 0.0), (-10.0, 120.0), (-30.0, 30.0), (-45.0, 45.0)
+  JOINT 2, LOWER, (0.0, -0.5, 0.0), HAND, (0.0, 0.05, 0.0), SLIDE (-0.1, 0.1), (0.0, 0.0), (-0.1, 0.1) AXIS (1.0, 1.0, 0.0)
+ENDMODEL
+FIGURE ARM MAIN LINK HAND
+BOT :- JOINT 3, BODY, (0.3, 0.5, 0.0), ARM, (0.0, -0.05, 0.0), (-90.0, 90.0), (-180.0, 180.0), (-60.0, 60.0) AXIS (0.0, 1.0, 1.0)
+SPUN :- BOT <SCALE MODEL -0.5>
+FIGURE SPUN MAIN LINK UPPER
+STARTMOTION WAVE
+  JOINT 1 POSITION 10.0, 0.0, 0.0
+    FRAME 10 POSITION 100.0, 20.0, -30.0 INTERPOLATE ACCDCC
+  JOINT 2 POSITION 0.0, 0.0, 0.0
+    FRAME 10 POSITION 0.08, 0.0, -0.05
+  JOINT 3 POSITION 0.0, 0.0, 0.0
+    FRAME 10 POSITION 60.0, 150.0, -40.0
+ENDMOTION
+INITIALIZE SCENE 1
+STARTSCENE LENGTH 11
+  ANIMATE BOT FROM 0 TO 10 USING WAVE
+  ANIMATE SPUN FROM 0 TO 10 USING WAVE
+  SPUN :- SPUN <ROT Y 30.0> <TRANS (1.5, 0.5, 0.0)>
+ENDSCENE
+SHOOTSCENES
+"""
+
+
 def program_named(tmp_path, name):
-    """A compiled program: ``edges``, ``crane`` or ``walking_humanoid`` (above), or an example's name."""
+    """A compiled program: ``edges``, ``crane``, ``grafted`` or ``walking_humanoid`` (above), or an example's name."""
     from paths import ROOT_DIR
 
     from liganimate.compiler import load_program
@@ -272,6 +310,9 @@ def program_named(tmp_path, name):
     elif name == "crane":
         path = tmp_path / "crane.lig"
         path.write_text(CRANE)
+    elif name == "grafted":
+        path = tmp_path / "grafted.lig"
+        path.write_text(GRAFTED)
     elif name == "walking_humanoid":
         path = tmp_path / "walk.lig"
         path.write_text(WALKING_HUMANOID)
@@ -281,7 +322,16 @@ def program_named(tmp_path, name):
     return program
 
 
-PROGRAMS = ["edges", "walking_humanoid", "crane", "appendix_a", "rerooting", "big_and_small_robot", "there_and_back"]
+PROGRAMS = [
+    "edges",
+    "walking_humanoid",
+    "crane",
+    "grafted",
+    "appendix_a",
+    "rerooting",
+    "big_and_small_robot",
+    "there_and_back",
+]
 
 
 # -- real clients: three.js in node, Blender's bpy ---------------------------------
@@ -393,3 +443,31 @@ def blender_pose(path: str, fps: float, frames) -> dict:
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     with open(out, encoding="utf-8") as fh:
         return json.load(fh)
+
+
+# -- pinocchio: an independent URDF reader (the robotics library, `pin` on PyPI) ------------
+
+
+def pinocchio_links(path, q_by_joint: dict) -> dict:
+    """Each URDF link's placement in the root link's frame, by pinocchio's forward kinematics.
+
+    ``q_by_joint`` gives a joint's position (radians or metres) by URDF joint
+    name; joints not in it stay at zero.  A continuous joint is pinocchio's
+    unbounded revolute (``cos q, sin q``); a mimic joint is read as a joint
+    of its own, so the caller gives its value (the URDF's formula).
+    """
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    q = pin.neutral(model)
+    for jid in range(1, model.njoints):
+        joint = model.joints[jid]
+        value = float(q_by_joint.get(model.names[jid], 0.0))
+        if joint.nq == 2:  # continuous: a point on the unit circle
+            q[joint.idx_q], q[joint.idx_q + 1] = math.cos(value), math.sin(value)
+        else:
+            q[joint.idx_q] = value
+    pin.forwardKinematics(model, data, q)
+    pin.updateFramePlacements(model, data)
+    return {f.name: data.oMf[i].homogeneous.copy() for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY}

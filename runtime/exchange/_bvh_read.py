@@ -12,13 +12,14 @@ error at its ``file:line:col``, never a Python exception.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import NoReturn
 
 import numpy as np
 
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
+from liganimate.lang.numbers import GEOMETRY_MAX, MAX_ANGLE, magnitude
 
 __all__ = ["CHANNEL_NAMES", "BvhClip", "parse_bvh", "read_bvh"]
 
@@ -49,6 +50,8 @@ class BvhClip:
         Each joint's End Site offset.
     channel_pos : list of Pos
         Where each joint's CHANNELS line is.
+    offset_pos : list of Pos
+        Where each joint's OFFSET keyword is (empty for a clip not read from a file).
     frame_time : float
         Seconds per frame.
     data : ndarray, shape (F, C)
@@ -66,6 +69,7 @@ class BvhClip:
     channel_pos: list
     frame_time: float
     data: np.ndarray
+    offset_pos: list = field(default_factory=list)
 
     def error(self, pos: Pos, message: str, hint: str | None = None) -> LigDiagnostics:
         """A diagnostic about this file (the caller raises it)."""
@@ -145,6 +149,10 @@ class _Tokens:
         return rest
 
     def number(self, what: str) -> float:
+        """The next token, which must be a finite number (``what`` names it in the error)."""
+        return self._number(what)[0]
+
+    def _number(self, what: str) -> tuple[float, str, Pos]:
         tok, pos = self.next(what)
         try:
             value = float(tok)
@@ -152,6 +160,17 @@ class _Tokens:
             self.fail(pos, f"'{tok}' is not a number; {what} should be one")
         if not np.isfinite(value):
             self.fail(pos, f"{what} must be a finite number, not '{tok}'")
+        return value, tok, pos
+
+    def length(self, what: str) -> float:
+        """A number that is a distance (an offset): finite and within the geometry limit."""
+        value, tok, pos = self._number(what)
+        if abs(value) > GEOMETRY_MAX:
+            self.fail(
+                pos,
+                f"{what} is {tok}, beyond the limit of {magnitude(GEOMETRY_MAX)} units for anything drawn",
+                "everything drawn must stay within 1E12 units of the origin along each axis",
+            )
         return value
 
     def expect(self, word: str, what: str | None = None):
@@ -178,6 +197,7 @@ def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
     counts = np.array([len(c) for c in h.channels], dtype=np.int64)
     first_col = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
     data = _frames(tk, tk.line, n_frames, int(counts.sum()))
+    _within_limits(tk, data, h)
     return BvhClip(
         filename=filename,
         source=text,
@@ -190,6 +210,7 @@ def parse_bvh(text: str, filename: str = "<bvh>") -> BvhClip:
         channel_pos=h.channel_pos,
         frame_time=frame_time,
         data=data,
+        offset_pos=h.offset_pos,
     )
 
 
@@ -203,10 +224,34 @@ class _Hierarchy:
         self.offsets: list = []
         self.channels: list = []
         self.channel_pos: list = []
+        self.offset_pos: list = []
         self.end_sites: list[np.ndarray | None] = []
 
     def joint(self, parent: int, keyword_pos: Pos) -> None:
-        """One ROOT or JOINT, its keyword just read, to its closing brace."""
+        """One ROOT or JOINT, its keyword just read, to its closing brace, with every joint inside it.
+
+        Iterative, with a stack of the open joints: a chain of 10,000 joints
+        is as legal as a skeleton of 20 (Python's recursion stops near 1,000).
+        """
+        tk = self.tk
+        open_joints = [self._open(parent, keyword_pos)]
+        while open_joints:
+            me = open_joints[-1]
+            name = self.names[me]
+            tok, pos = tk.next(f"'}}' to close joint {name}")
+            if tok == "JOINT":
+                open_joints.append(self._open(me, pos))
+            elif tok == "End":
+                self._end_site(me)
+            elif tok == "}":
+                open_joints.pop()
+            elif tok in ("MOTION", "ROOT"):
+                tk.fail(pos, f"joint {name} is never closed with '}}' before {tok}")
+            else:
+                tk.fail(pos, f"expected JOINT, End Site or '}}' in joint {name}, found '{tok}'")
+
+    def _open(self, parent: int, keyword_pos: Pos) -> int:
+        """A joint's name, '{', OFFSET and CHANNELS, its keyword just read: its index."""
         tk = self.tk
         rest = tk.rest_of_line()
         if not rest:
@@ -219,21 +264,11 @@ class _Hierarchy:
         tok, pos = tk.next(f"OFFSET of joint {name}")
         if tok != "OFFSET":
             tk.fail(pos, f"expected OFFSET in joint {name}, found '{tok}'")
-        self.offsets.append([tk.number(f"the {a} offset of joint {name}") for a in "XYZ"])
+        self.offset_pos.append(pos)
+        self.offsets.append([tk.length(f"the {a} offset of joint {name}") for a in "XYZ"])
         self.end_sites.append(None)
         self._channels(name)
-        while True:
-            tok, pos = tk.next(f"'}}' to close joint {name}")
-            if tok == "JOINT":
-                self.joint(me, pos)
-            elif tok == "End":
-                self._end_site(me)
-            elif tok == "}":
-                return
-            elif tok in ("MOTION", "ROOT"):
-                tk.fail(pos, f"joint {name} is never closed with '}}' before {tok}")
-            else:
-                tk.fail(pos, f"expected JOINT, End Site or '}}' in joint {name}, found '{tok}'")
+        return me
 
     def _channels(self, name: str) -> None:
         tk = self.tk
@@ -270,7 +305,7 @@ class _Hierarchy:
             tk.fail(spos, f"expected 'End Site', found 'End {site}'")
         tk.expect("{", "to open the End Site")
         tk.expect("OFFSET", "in the End Site")
-        self.end_sites[me] = np.array([tk.number(f"the {a} offset of an End Site") for a in "XYZ"])
+        self.end_sites[me] = np.array([tk.length(f"the {a} offset of an End Site") for a in "XYZ"])
         tk.expect("}", "to close the End Site")
 
 
@@ -376,3 +411,32 @@ def _frames(tk: _Tokens, start: int, n_frames: int, n_channels: int) -> np.ndarr
                     )
         raise AssertionError("a frame value is not a finite number, yet every token is one")
     return values.reshape(n_frames, n_channels)
+
+
+def _within_limits(tk: _Tokens, data: np.ndarray, h: _Hierarchy) -> None:
+    """Refuse, at its line and column, a frame value a model cannot hold.
+
+    A position channel moves the skeleton, so it is held to the geometry
+    limit (1E12 units from the origin); a rotation channel becomes a keyframe
+    angle, held to the largest angle (1E9 degrees). A value near 1E308 used
+    to overflow while the library was written, and LOAD refused the library.
+    """
+    kinds = [(c, name) for name, channels in zip(h.names, h.channels) for c in channels]
+    if not kinds:
+        return
+    caps = np.array([GEOMETRY_MAX if c.endswith("position") else MAX_ANGLE for c, _ in kinds])
+    over = np.abs(data) > caps
+    if not over.any():
+        return
+    k, n = (int(i) for i in np.argwhere(over)[0])
+    channel, joint = kinds[n]
+    rows = [(i, line) for i, line in enumerate(tk.lines[tk.line :], tk.line) if line.strip()]
+    i, line = rows[k]
+    m = list(_TOKEN.finditer(line))[n]
+    unit = "units from the origin" if channel.endswith("position") else "degrees"
+    tk.fail(
+        Pos(i + 1, m.start() + 1, i + 1, m.end() + 1),
+        f"'{m.group()}' in frame {k + 1} ({channel} of joint {joint}) is beyond the limit of "
+        f"{magnitude(caps[n])} {unit}",
+        "a position must stay within 1E12 units of the origin and an angle within 1E9 degrees",
+    )

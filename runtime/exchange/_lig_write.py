@@ -32,6 +32,7 @@ import numpy as np
 
 from liganimate.compiler.names import reserved
 from liganimate.lang import name_table
+from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
 from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
@@ -160,6 +161,7 @@ def import_library(clip, options: ImportOptions) -> tuple:
         From :func:`._clip.clip_pose` (a sliding joint, with ``error``).
     """
     pose = clip_pose(clip, options.joint_translation)
+    _refuse_beyond_reach(clip, pose.offsets)
     taken = {options.model.upper(), options.motion.upper()}
     links = [_identifier(n, taken) for n in clip.names]
     src = comment_text(options.source_name or os.path.basename(clip.filename))
@@ -174,6 +176,32 @@ def import_library(clip, options: ImportOptions) -> tuple:
     keep = reduce_keyframes(angles, options.tolerance) if options.tolerance > 0 else None
     body = _motion_text(options.motion, angles, pose.rotating, keep, pose.path, orientation=orientation)
     return head + body, list(pose.notes)
+
+
+def _refuse_beyond_reach(clip, offsets: np.ndarray) -> None:
+    """Refuse, at the BVH OFFSET that passes it, a skeleton the model could not hold.
+
+    A model is measured as LOAD measures it (``runtime/limits.py``): every
+    joint location at full length, as if in one straight line, plus the
+    largest segment, within the geometry limit; the segments here are the
+    bones :func:`_model_text` draws (no longer than a tip plus its width).
+    Refused here, a library that LOAD would refuse is never written.
+    """
+    with np.errstate(all="ignore"):
+        size = clip_size(clip.parents, offsets)
+        tips = [np.asarray(t, dtype=np.float64) for t in offsets[1:]]
+        tips += [np.asarray(e, dtype=np.float64) for e in clip.end_sites if e is not None]
+        bone = max((1.06 * float(np.linalg.norm(t)) + 0.01 * size for t in tips), default=0.0)
+        running = math.sqrt(3.0) * bone
+        for j in range(1, len(offsets)):
+            running += math.sqrt(3.0) * float(np.max(np.abs(offsets[j])))
+            if not running <= GEOMETRY_MAX and j < len(clip.offset_pos):
+                raise clip.error(
+                    clip.offset_pos[j],
+                    f"the skeleton reaches {magnitude(running)} units at joint {clip.names[j]}, counting its "
+                    f"offsets end to end, beyond the limit of {magnitude(GEOMETRY_MAX)} units for a model",
+                    "a model must stay within 1E12 units of the origin in every pose; scale the capture down",
+                )
 
 
 def _header(clip, options: ImportOptions, links: list, src: str) -> list:

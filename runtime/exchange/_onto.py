@@ -95,7 +95,7 @@ def _names(fig) -> tuple:
     for l in fig.links:
         own = l.name or ""
         names.append([own] + ([l.source.name] if l.source is not None else []))
-    with_joint = sorted(j.secondary for j in fig.joints)
+    with_joint = sorted(fig.child_of(j) for j in fig.joints)
     return names, with_joint
 
 

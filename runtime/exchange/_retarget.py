@@ -143,9 +143,12 @@ class _Target:
     """The figure at neutral: each link's parent, joint, and rest joint position, walked from the main link."""
 
     def __init__(self, fig):
-        if fig.main != fig.root:
+        if fig.main != fig.root or fig.inverted.any():
+            # A joint walked from its secondary turns its link the other way,
+            # which the retargeting's rest offsets (loc1 - loc2) do not follow.
             raise LigError(
-                "the figure is re-rooted (FIGURE ... MAIN), which retargeting does not follow.",
+                "the figure is re-rooted (FIGURE ... MAIN, or a submodel attached by the main link FIGURE chose), "
+                "which retargeting does not follow.",
                 "retarget onto the model as its library defines it",
             )
         self.fig = fig

@@ -23,8 +23,9 @@ The mapping (``docs/exchange.md``, "URDF export"):
 
 The model's current main link, placement and motions are not part of a
 URDF: the description is of the model as built, rooted at its original main
-link.  Lengths are the model's units; LIG has no effort or velocity limits
-(written as 0).
+link (a joint of a submodel attached by a re-rooted main link is written from
+its secondary to its primary, as the inverse of its turn).  Lengths are the
+model's units; LIG has no effort or velocity limits (written as 0).
 """
 
 from __future__ import annotations
@@ -111,12 +112,27 @@ def joint_columns(fig: F.Figure) -> list:
     for k, joint in enumerate(fig.joints):
         base = _joint_name(fig, joint)
         first = True
-        for kind, axis, _, _ in _pieces(joint):
+        for kind, axis, _, _ in _hung_pieces(fig, k):
             if kind != "move":
                 continue
             out.append((base if first else f"{base}__{'xyz'[axis]}", k, axis, joint.slide))
             first = False
     return out
+
+
+def _hung_pieces(fig: F.Figure, k: int) -> list:
+    """:func:`_pieces` of joint ``k`` in the order URDF hangs them, parent to child.
+
+    A joint of a submodel attached by a re-rooted main link is walked from
+    its secondary (``Figure.inverted``): its transform is the inverse,
+    ``F Rx(-ax) Ry(-ay) Rz(-az) F^T``, so the pieces come in reverse order
+    about (along) the opposite vectors, each still moved by the joint's own
+    value, within the same limits.
+    """
+    pieces = _pieces(fig.joints[k])
+    if not fig.inverted[k]:
+        return pieces
+    return [(kind, axis, -vector, value) for kind, axis, vector, value in reversed(pieces)]
 
 
 def _joint_name(fig: F.Figure, joint: F.Joint) -> str:
@@ -156,20 +172,24 @@ def _joint_xml(name, kind, parent, child, origin, axis=None, limits=None, mimic=
 def _chain(fig: F.Figure, k: int, names: list) -> list:
     """The URDF joints (and empty links) of LIG joint ``k``."""
     joint = fig.joints[k]
-    parent, child = names[joint.primary], names[joint.secondary]
-    Pp, Pc = _frame(fig.links[joint.primary]), _frame(fig.links[joint.secondary])
+    # URDF hangs the child from the parent: for an inverted joint (see
+    # _hung_pieces) the parent is the defined secondary, and L1 and L2 swap.
+    up, down = fig.parent_of(joint), fig.child_of(joint)
+    near, far = (joint.loc1, joint.loc2) if up == joint.primary else (joint.loc2, joint.loc1)
+    parent, child = names[up], names[down]
+    Pp, Pc = _frame(fig.links[up]), _frame(fig.links[down])
     base = _joint_name(fig, joint)
-    pieces = _pieces(joint)
+    pieces = _hung_pieces(fig, k)
     # The chain applies, in the parent's URDF frame: Pp^T, Trans(L1), the pieces, Trans(-L2), Pc.
     start = np.eye(4)
     start[:3, :3] = Pp.T
-    start[:3, 3] = Pp.T @ joint.loc1
+    start[:3, 3] = Pp.T @ near
     tail: np.ndarray | None = np.eye(4)
     assert tail is not None
     tail[:3, :3] = Pc
-    tail[:3, 3] = -joint.loc2
+    tail[:3, 3] = -far
     moving = [p for p in pieces if p[0] == "move"]
-    if not joint.loc2.any():
+    if not far.any():
         # Fold Pc back through the pieces (Rot(a) Pc = Pc Rot(Pc^T a)): no fixed joint at the end.
         start[:3, :3] = start[:3, :3] @ Pc
         pieces = [(kind, axis, Pc.T @ v, value) for kind, axis, v, value in pieces]

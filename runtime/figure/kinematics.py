@@ -214,7 +214,7 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     return _folded.placed_long(figure, angles, root)
 
 
-SHORT = 64
+SHORT = 256
 """Batches shorter than this take the short-batch walk: there the number of numpy calls is the cost."""
 
 

@@ -477,7 +477,6 @@ class Figure:
         if len(self.joints) != n - 1:
             raise FigureError(f"a tree of {n} links needs {n - 1} joints, not {len(self.joints)}.")
         seen_ids: dict[int, int] = {}
-        parent = [-1] * n
         for k, j in enumerate(self.joints):
             if j.id in seen_ids:
                 raise FigureError(
@@ -487,13 +486,10 @@ class Figure:
             seen_ids[j.id] = k
             if not (0 <= j.primary < n and 0 <= j.secondary < n) or j.primary == j.secondary:
                 raise FigureError(f"joint {j.id} must join two different links of the figure.")
-            if j.secondary == self.root:
-                raise FigureError(f"joint {j.id} makes the main link a secondary segment.")
-            if parent[j.secondary] != -1:
-                raise FigureError(f"link {self.links[j.secondary].label} is the secondary of two joints.")
-            parent[j.secondary] = k
-        # Each non-root link has exactly one parent; reaching them all from the
-        # root rules out cycles and disconnected pieces.
+        # n - 1 joints that reach every link from the root form one tree: no
+        # cycle and no loose piece.  A joint may point either way along it (a
+        # submodel attached by the main link FIGURE chose keeps its joints as
+        # they were defined), so the walk ignores the joints' directions.
         if len(self.preorder) != n:
             raise FigureError("the joints do not connect every link to the main link in one tree.")
 
@@ -565,42 +561,108 @@ class Figure:
         return self.joints[self.joint_index(joint_id)]
 
     @cached_property
-    def _parent_joint(self) -> tuple[int, ...]:
-        parent = [-1] * len(self.links)
-        for k, j in enumerate(self.joints):
-            parent[j.secondary] = k
-        return tuple(parent)
+    def _rooted(self) -> tuple[tuple[int, ...], tuple[tuple[int, ...], ...], tuple[int, ...]]:
+        """The tree hung from the root: parent joint per link, child joints per link, pre-order.
 
-    @cached_property
-    def _child_joints(self) -> tuple[tuple[int, ...], ...]:
-        children: list[list[int]] = [[] for _ in self.links]
+        The joints are walked as undirected arcs (the thesis' nodes hold each
+        arc at both ends), so a joint whose defined secondary is nearer the
+        root (see :attr:`inverted`) is a child arc of that secondary.  One
+        walk, linear in the number of links.
+        """
+        n = len(self.links)
+        incident: list[list[int]] = [[] for _ in range(n)]
         for k, j in enumerate(self.joints):
-            children[j.primary].append(k)
-        return tuple(tuple(c) for c in children)
+            if 0 <= j.primary < n and 0 <= j.secondary < n:
+                incident[j.primary].append(k)
+                incident[j.secondary].append(k)
+        parent = [-1] * n
+        children: list[list[int]] = [[] for _ in range(n)]
+        order: list[int] = []
+        seen = [False] * n
+        seen[self.root] = True
+        stack = [self.root]
+        while stack:
+            link = stack.pop()
+            order.append(link)
+            for k in incident[link]:
+                j = self.joints[k]
+                other = j.secondary if j.primary == link else j.primary
+                if not seen[other]:  # in a malformed joint list an arc may close a cycle
+                    seen[other] = True
+                    parent[other] = k
+                    children[link].append(k)
+            stack.extend(self._far_end(k, link) for k in reversed(children[link]))
+        return tuple(parent), tuple(tuple(c) for c in children), tuple(order)
+
+    def _far_end(self, k: int, link: int) -> int:
+        j = self.joints[k]
+        return j.secondary if j.primary == link else j.primary
+
+    @property
+    def _parent_joint(self) -> tuple[int, ...]:
+        return self._rooted[0]
+
+    @property
+    def _child_joints(self) -> tuple[tuple[int, ...], ...]:
+        return self._rooted[1]
 
     def parent_joint_of(self, link: int) -> Joint | None:
-        """The joint whose secondary is ``link`` in the ORIGINAL structure (None for the root)."""
+        """The joint that hangs ``link`` from the ORIGINAL structure's root side (None for the root).
+
+        ``link`` is that joint's secondary unless the joint is :attr:`inverted`.
+        """
         k = self._parent_joint[link]
         return None if k < 0 else self.joints[k]
 
     def child_joints_of(self, link: int) -> tuple[Joint, ...]:
-        """Joints in which ``link`` is the primary in the ORIGINAL structure, in joint order."""
+        """The joints that hang links from ``link`` in the ORIGINAL structure, in joint order.
+
+        ``link`` is their primary unless a joint is :attr:`inverted`.
+        """
         return tuple(self.joints[k] for k in self._child_joints[link])
 
+    def child_of(self, joint: Joint) -> int:
+        """The link ``joint`` hangs from the root's side: its secondary, or its primary if inverted."""
+        k = self.joint_index(joint.id)
+        return joint.primary if self.inverted[k] else joint.secondary
+
+    def parent_of(self, joint: Joint) -> int:
+        """The link ``joint`` hangs from on the root's side: its primary, or its secondary if inverted."""
+        k = self.joint_index(joint.id)
+        return joint.secondary if self.inverted[k] else joint.primary
+
     @cached_property
+    def inverted(self) -> np.ndarray:
+        """Per joint, whether its defined secondary is on the root's side, shape ``(n_joints,)``, read-only.
+
+        Only a submodel attached by the main link FIGURE chose for it has
+        such joints: the ones between that link and the submodel's original
+        main link.  They keep their definition (the motions' angles mean
+        what they meant), and a walk from the root takes them backwards,
+        as FIGURE ... MAIN makes a walk from the current main link do.
+        """
+        out = np.zeros(len(self.joints), dtype=bool)
+        parent = self._parent_joint
+        for k, j in enumerate(self.joints):
+            out[k] = parent[j.primary] == k
+        out.setflags(write=False)
+        return out
+
+    def joint_naming(self, link: int) -> Joint | None:
+        """A joint whose defined secondary is ``link`` (what FIGURE m MAIN JOINT needs), or None.
+
+        The parent joint when it is not inverted; else another joint of the
+        link's, if one has it as its secondary.
+        """
+        up = self.parent_joint_of(link)
+        if up is not None and up.secondary == link:
+            return up
+        return next((j for j in self.child_joints_of(link) if j.secondary == link), None)
+
+    @property
     def preorder(self) -> tuple[int, ...]:
         """Link indices depth first from the root, children in joint order."""
-        order: list[int] = []
-        stack = [self.root]
-        seen = set()
-        while stack:
-            link = stack.pop()
-            if link in seen:  # only possible in a malformed joint list
-                continue
-            seen.add(link)
-            order.append(link)
-            stack.extend(self.joints[k].secondary for k in reversed(self._child_joints[link]))
-        return tuple(order)
+        return self._rooted[2]
 
     def links_named(self, name: str) -> tuple[int, ...]:
         """Indices of the links called ``name`` (case-insensitive), in :attr:`preorder`."""
@@ -847,13 +909,18 @@ class Figure:
             m = model_name or "m"
             parent = self.parent_joint_of(chosen)
             which = "the original main link itself" if parent is None else f"the one attached by joint {parent.id}"
-            # found[1:] are never the root (it comes first in pre-order), so each has a joint.
-            alts = [str(j.id) for i in found[1:] if (j := self.parent_joint_of(i)) is not None]
+            # MAIN JOINT j chooses j's defined secondary; a link that is no
+            # joint's secondary (a re-rooted submodel's old main link) has none.
+            alts = [str(j.id) for i in found[1:] if (j := self.joint_naming(i)) is not None]
             more = f" (or {', '.join(alts[1:])})" if len(alts) > 1 else ""
+            advice = (
+                f"write FIGURE {m} MAIN JOINT {alts[0]}{more} to choose another."
+                if alts
+                else "no FIGURE MAIN JOINT chooses the others: rename a segment to tell them apart."
+            )
             warning = (
                 f"{len(found)} links are named {name}; FIGURE {m} MAIN LINK {name} uses {which} "
-                f"(the first met depth first from the original main link {self.links[self.root].label}); "
-                f"write FIGURE {m} MAIN JOINT {alts[0]}{more} to choose another."
+                f"(the first met depth first from the original main link {self.links[self.root].label}); " + advice
             )
         return self.with_main(chosen), warning
 
@@ -863,10 +930,11 @@ class Figure:
         """The model's internal node relationships, as PRINT m shows them (thesis Figure 6).
 
         One block per link in :attr:`preorder`: the link's graphical object,
-        scale and number of subjoints, then its arcs: row 0 is the joint in
-        which it is the secondary (the upward arc), rows 1..n the joints in
-        which it is the primary, each with the joint id, the node at the other
-        end and the joint's location on THIS link.
+        scale and number of subjoints, then its arcs: row 0 is the joint that
+        hangs it from the root's side (the upward arc), rows 1..n the joints
+        that hang links from it, each with the joint id (marked ``reversed``
+        where the joint's defined secondary is on the root's side), the node
+        at the other end and the joint's location on THIS link.
         """
         head = f"MODEL {name}: " if name else "MODEL: "
         lines = [
@@ -890,12 +958,23 @@ class Figure:
             )
             rows = [("No.", "Joint #", "Node", "Joint location")]
             up = self.parent_joint_of(i)
+            arcs = [] if up is None else [(0, up)]
             if up is None:
                 rows.append(("0", "-", "-", "-"))
-            else:
-                rows.append(("0", str(up.id), f"{up.primary} {self.links[up.primary].label}", _vec(up.loc2)))
-            for n, j in enumerate(children, start=1):
-                rows.append((str(n), str(j.id), f"{j.secondary} {self.links[j.secondary].label}", _vec(j.loc1)))
+            arcs += list(enumerate(children, start=1))
+            for n, j in arcs:
+                # An arc taken against its definition (a re-rooted submodel's)
+                # says so: its angles turn this link's other end the other way.
+                other, here = (j.primary, j.loc2) if j.secondary == i else (j.secondary, j.loc1)
+                flipped = self.inverted[self.joint_index(j.id)]
+                rows.append(
+                    (
+                        str(n),
+                        str(j.id) + (" reversed" if flipped else ""),
+                        f"{other} {self.links[other].label}",
+                        _vec(here),
+                    )
+                )
             lines.extend(_table(rows, indent="    "))
         return "\n".join(lines)
 
@@ -971,13 +1050,29 @@ def _as_figure(operand, role: str) -> Figure:
     raise FigureError(f"the {role} of a JOINT must be a graphical object or a model, not {type(operand).__name__}.")
 
 
+def _rehung(sub: Figure) -> Figure:
+    """``sub`` as a JOINT takes it: hung from its CURRENT main link, placement dropped.
+
+    The thesis gives a submodel's joint location "with respect to the main
+    link in the submodel", and FIGURE "assigns a new link as the model's main
+    link", so the submodel joins by the link FIGURE chose.  Its joints keep
+    their definitions; those between that link and the old main link are
+    then walked backwards from the new root (:attr:`Figure.inverted`).
+    """
+    if sub.main == sub.root:
+        return sub  # its placement and main are never read by the callers
+    return _canonical(list(sub.links), list(sub.joints), sub.main)
+
+
 def _graft(base: Figure, at: int, joint_id, loc1, sub: Figure, loc2, extremes, kind: JointKind) -> Figure:
-    """Attach ``sub`` by its ORIGINAL main link to link ``at`` of ``base``.
+    """Attach ``sub`` by its CURRENT main link to link ``at`` of ``base``.
 
     Keeps ``base``'s root, current main and placement.  If ``at`` is the root
-    (as in :func:`join`) and both operands are in pre-order, so is the result:
-    the new joint is the root's last child and ``sub``'s links follow.
+    (as in :func:`join`) and ``base`` is in pre-order, so is the result: the
+    new joint is the root's last child and ``sub``'s links follow, in
+    pre-order from the link it is attached by.
     """
+    sub = _rehung(sub)
     new = Joint(joint_id, at, len(base.links) + sub.root, loc1, loc2, extremes, **kind.fields(joint_id))
     # The result's identifier index is the base's, copied at C speed, plus the
     # new joint and sub's: Python-level work is O(1 + sub's joints), so a model
@@ -1008,10 +1103,15 @@ def join(joint_id: int, primary, loc1, secondary, loc2, extremes, kind: JointKin
     joint_id : int
         The new joint's identifier.
     primary, secondary : Link or Figure
-        A Figure is attached by its ORIGINAL main link (FIGURE changes how a
-        model is animated, not how it joins) and copied (value semantics).
+        Copied (value semantics).  A primary Figure is joined at its
+        ORIGINAL main link; a secondary Figure is attached by its CURRENT
+        main link, the one ``FIGURE s MAIN ...`` chose (the thesis: the
+        location is "with respect to the main link in the submodel"), and the
+        joints between that link and its original main link are then walked
+        backwards, as re-rooting walks them.
     loc1, loc2 : array_like, shape (3,)
-        The joint's location on the primary's and the secondary's main link.
+        The joint's location on the primary's original main link and on the
+        secondary's current main link.
     extremes : array_like, shape (k, 2), k in 1..3
         ``(min, max)`` degrees (lengths for a slide); omitted trailing axes
         are locked at ``(0, 0)``.
@@ -1023,7 +1123,7 @@ def join(joint_id: int, primary, loc1, secondary, loc2, extremes, kind: JointKin
     Figure
         Its original main link is the primary's original main link, its
         current main link and placement are the primary's; the secondary's
-        placement and FIGURE choice are dropped.
+        placement is dropped.
 
     Raises
     ------
@@ -1036,19 +1136,33 @@ def join(joint_id: int, primary, loc1, secondary, loc2, extremes, kind: JointKin
 
 
 def _canonical(links: list[Link], joints: list[Joint], root: int) -> Figure:
-    """A figure with links and joints renumbered into pre-order (children in list order)."""
-    children: list[list[int]] = [[] for _ in links]
+    """A figure rooted at ``root``, links and joints renumbered into pre-order (children in list order).
+
+    Joints are walked as undirected arcs, so ``root`` may be any link: a
+    joint met from its secondary keeps its definition and is inverted in the
+    result.
+    """
+    incident: list[list[int]] = [[] for _ in links]
     for k, j in enumerate(joints):
-        children[j.primary].append(k)
+        incident[j.primary].append(k)
+        incident[j.secondary].append(k)
     order: list[int] = []
     joint_order: list[int] = []
+    seen = [False] * len(links)
+    seen[root] = True
     stack: list[tuple[int, int]] = [(root, -1)]
     while stack:
         link, via = stack.pop()
         order.append(link)
         if via >= 0:
             joint_order.append(via)
-        stack.extend((joints[k].secondary, k) for k in reversed(children[link]))
+        below = []
+        for k in incident[link]:
+            other = joints[k].secondary if joints[k].primary == link else joints[k].primary
+            if not seen[other]:
+                seen[other] = True
+                below.append((other, k))
+        stack.extend(reversed(below))
     where = {old: new for new, old in enumerate(order)}
     new_joints = tuple(
         dataclasses.replace(joints[k], primary=where[joints[k].primary], secondary=where[joints[k].secondary])
@@ -1067,7 +1181,8 @@ def assemble(specs: Sequence, shapes: dict) -> tuple[Figure, list[tuple[int, str
         extremes, statement_index)`` in textual order.  ``secondary`` is a
         graphical object's name (its shape in ``secondary_shape``; when that
         is None, ``shapes[secondary]``), a :class:`Figure` submodel, attached
-        by its original main link and copied, or a ready :class:`Link`.
+        by its current main link (as :func:`join` does) and copied, or a
+        ready :class:`Link`.
     shapes : dict of str to object
         Shapes of the graphical objects named as primaries (only the main
         link's is needed: every other primary is a link some statement made).
@@ -1116,9 +1231,8 @@ def _pieces(specs: list[JointSpec], shapes: dict) -> list[Figure]:
     pieces: list[Figure] = []
     for s in specs:
         if isinstance(s.secondary, Figure):
-            sub = s.secondary
-            # FIGURE and placement choices of a submodel do not travel with it.
-            pieces.append(Figure(sub.links, sub.joints, root=sub.root))
+            # Attached by the main link FIGURE chose (as in JOINT); its placement stays behind.
+            pieces.append(_rehung(s.secondary))
         elif isinstance(s.secondary, str):
             shape = s.secondary_shape if s.secondary_shape is not None else _lookup_shape(shapes, s.secondary)
             pieces.append(Figure.from_link(Link(s.secondary, shape)))
@@ -1197,13 +1311,20 @@ def _attachments(specs: list[JointSpec], pieces: list[Figure], root_name: str):
 
 def _refuse_cycles(specs: list[JointSpec], attach: list[tuple[int, int]]) -> None:
     """Step 4 of :func:`assemble`: each statement, followed up through the statements that made
-    its primary, must reach the main link without meeting itself."""
+    its primary, must reach the main link without meeting itself.
+
+    Linear in the statements: a statement whose walk reached the main link
+    is marked, and a later walk stops there (a chain of 10,000 JOINTs used
+    to be walked from each of its statements, each step searching a list).
+    """
+    reaches_main = [False] * len(specs)
     for pos in range(len(specs)):
-        chain = [pos]
-        cur = attach[pos][0]
-        while cur >= 0:
-            if cur in chain:
-                loop = chain[chain.index(cur) :]
+        chain: list[int] = []
+        on_chain: dict[int, int] = {}
+        cur = pos
+        while cur >= 0 and not reaches_main[cur]:
+            if cur in on_chain:
+                loop = chain[on_chain[cur] :]
                 ids = ", ".join(f"JOINT {specs[c].joint_id}" for c in loop)
                 raise FigureError(
                     f"the model has a cycle: {ids} each hang from a segment made by the next"
@@ -1212,8 +1333,11 @@ def _refuse_cycles(specs: list[JointSpec], attach: list[tuple[int, int]]) -> Non
                     f"{specs[cur].primary_name} from its own secondary.",
                     hint="a segment cannot be both above and below itself",
                 )
+            on_chain[cur] = len(chain)
             chain.append(cur)
             cur = attach[cur][0]
+        for c in chain:
+            reaches_main[c] = True
 
 
 def _refuse_repeated_ids(specs: list[JointSpec], pieces: list[Figure]) -> None:

@@ -62,19 +62,18 @@ class Walk:
     """
 
     order: np.ndarray  # (J,) the figure's joint index of each walked joint
-    order_yzx: np.ndarray  # (J, 1) the same, a column
     links: np.ndarray  # (L,) the figure's link at each breadth-first place; links[0] is the main link
     where: np.ndarray  # (L,) the breadth-first place of each of the figure's links
     levels: tuple  # per depth level: (first child place, end, parent places (n,), first joint, end joint)
-    gather_t: np.ndarray  # (J, 16) the entries of E forming each joint's 4x4
-    columns_t: np.ndarray  # (J, 1) 0 .. J-1
-    near: np.ndarray  # (J, 3)
-    minus_far: np.ndarray  # (J, 1, 3)
+    gather: np.ndarray  # (16, J) the rows of E forming each joint's 4x4
+    columns: np.ndarray  # (1, J) 0 .. J-1
+    near: np.ndarray  # (3, J, 1)
+    minus_far: np.ndarray  # (1, 3, J, 1): -far[m] for the sum over m
     framed: np.ndarray  # (f,) walk numbers of joints with an AXIS
-    frames: np.ndarray  # (f, 3, 3) their axes F
+    frames: np.ndarray  # (3, 3, f, 1) their axes F, F[i, a]
     framed_reversed_in_framed: np.ndarray  # (g,) which of those are walked backwards
     slides: np.ndarray  # (s,) walk numbers of slides
-    slide_axes: np.ndarray  # (s, 3, 3)
+    slide_axes: np.ndarray  # (3, 3, s, 1) their axes F, F[i, a]
     slide_gain: np.ndarray  # (s, 1)
     # For the long-batch walk (.folded), per walked joint, as Python values:
     parent_link: tuple  # the link it hangs from
@@ -126,19 +125,18 @@ def _prepare(figure: Figure) -> Walk:
     k = order[slides]
     return Walk(
         order=order,
-        order_yzx=order[:, None],
         links=links,
         where=where,
         levels=tuple(levels),
-        gather_t=np.ascontiguousarray(gather.T),
-        columns_t=np.arange(J)[:, None],
-        near=np.ascontiguousarray(near),
-        minus_far=np.ascontiguousarray(-far)[:, None, :],
+        gather=gather,
+        columns=np.arange(J)[None, :],
+        near=np.ascontiguousarray(near.T[:, :, None]),
+        minus_far=np.ascontiguousarray(-far.T)[None, :, :, None],
         framed=np.flatnonzero(framed),
-        frames=np.ascontiguousarray(F[framed]),
+        frames=np.ascontiguousarray(F[framed].transpose(1, 2, 0)[:, :, :, None]),
         framed_reversed_in_framed=np.flatnonzero(rev[framed]),
         slides=np.flatnonzero(slides),
-        slide_axes=figure.frames[k],
+        slide_axes=np.ascontiguousarray(figure.frames[k].transpose(1, 2, 0)[:, :, :, None]),
         slide_gain=(figure.slide_scales[k] * np.where(rev[slides], -1.0, 1.0))[:, None],
         parent_link=tuple(int(p) for level in figure.traversal for p in level.parents),
         child_link=tuple(int(c) for level in figure.traversal for c in level.children),
@@ -151,84 +149,83 @@ def _prepare(figure: Figure) -> Walk:
 def placed(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     """Link transforms ``root @ pose`` (B, n_links, 4, 4) for angles (B, n_joints, 3); see ``placed_transforms``.
 
-    The result is a transposed view of storage that holds each transform
-    transposed (what the products below write), not C-contiguous.
+    A transposed view of component-major storage, not C-contiguous.
     """
     walk = walk_of(figure)
     B = angles.shape[0]
     if root is not None:
         root = np.asarray(root, dtype=np.float64)
+    values = angles.take(walk.order, axis=1).transpose(2, 1, 0)  # (3, J, B): axis, joint in walk order, frame
     if B <= BLOCK:
-        return _block(walk, angles, root)[:, walk.where].transpose(0, 1, 3, 2)
-    out = np.empty((B, figure.n_links, 4, 4))
+        return _block(walk, values, root)[:, :, walk.where].transpose(3, 2, 0, 1)
+    out = np.empty((4, 4, figure.n_links, B))
     for lo in range(0, B, BLOCK):
         hi = min(lo + BLOCK, B)
-        out[lo:hi] = _block(walk, angles[lo:hi], None if root is None else root[lo:hi])[:, walk.where]
-    return out.transpose(0, 1, 3, 2)
+        X = _block(walk, values[:, :, lo:hi], None if root is None else root[lo:hi])
+        out[:, :, :, lo:hi] = X[:, :, walk.where]
+    return out.transpose(3, 2, 0, 1)
 
 
-def _block(walk: Walk, angles: np.ndarray, root) -> np.ndarray:
-    """Link transforms, each TRANSPOSED, (b, n_links, 4, 4) in breadth-first order, for one block of poses."""
-    b = angles.shape[0]
-    XT = np.empty((b, len(walk.links), 4, 4))
-    XT[:, :, :, 3] = _BOTTOM
+def _block(walk: Walk, values: np.ndarray, root) -> np.ndarray:
+    """Link transforms ``X[i, j, link, frame]`` in breadth-first order for one block of poses."""
+    b = values.shape[2]
+    X = np.empty((4, 4, len(walk.links), b))
+    X[3, :3] = 0.0
+    X[3, 3] = 1.0
     if root is None:
-        XT[:, 0, :, :3] = _EYE43
+        X[:3, :, 0] = _EYE34
     else:
-        XT[:, 0, :, :3] = root[:, :3].transpose(0, 2, 1)
+        X[:3, :, 0] = root[:, :3].transpose(1, 2, 0)
     if b and len(walk.order):
-        A = _local(walk, angles)[:, :, :, :, None]  # (b, J, 4, 4, 1): A[m, j]
+        A = _local(walk, values)[None]  # (1, 4, 4, J, b)
+        X3 = X[:3]
         for first, end, parents, jl, jh in walk.levels:
-            # child[i, j] = sum_m parent[i, m] A[m, j], m = 0..3 in order; stored as child^T[j, i].
-            PT = XT[:, parents, :, None, :3]  # (b, n, 4, 1, 3): parent^T[m, i]
-            np.add.reduce(A[:, jl:jh] * PT, axis=2, out=XT[:, first:end, :, :3])
-    return XT
+            # child[i, j] = sum_m parent[i, m] A[m, j], m = 0..3 in order.
+            P = X3.take(parents, axis=2)[:, :, None]  # (3, 4, 1, n, b): each child's parent's [R | t]
+            np.add.reduce(P * A[:, :, :, jl:jh], axis=1, out=X3[:, :, first:end])
+    return X
 
 
-_BOTTOM = np.array([0.0, 0.0, 0.0, 1.0])
-_EYE43 = np.eye(4)[:, :3]
+_EYE34 = np.eye(4)[:3, :, None]
 
 
-def _local(walk: Walk, angles: np.ndarray) -> np.ndarray:
-    """Every joint's 4x4 ``A[frame, joint, i, j]`` (walk order) from the angles (b, n_joints, 3) in degrees."""
-    b, J = angles.shape[0], len(walk.order)
+def _local(walk: Walk, values: np.ndarray) -> np.ndarray:
+    """Every joint's 4x4 ``A[i, j, joint, frame]`` (walk order) from its angles ``values`` (3, J, b) in degrees."""
+    J, b = values.shape[1:]
     # cs rows: cy, sy, cz, sz, cx, sx, so that every group used below is a slice.
-    a = np.deg2rad(angles[:, walk.order_yzx, _YZX].transpose(2, 0, 1))
-    cs = np.empty((6, b, J))
+    a = np.deg2rad(values.take(_YZX, axis=0))
+    cs = np.empty((6, J, b))
     np.cos(a, out=cs[0::2])
     np.sin(a, out=cs[1::2])
-    E = np.empty((b, J, 11))
-    Et = E.transpose(2, 0, 1)
-    np.multiply(cs[0], cs[2:6], out=Et[0:4])  # cy*cz, cy*sz, cy*cx, cy*sx
+    E = np.empty((11, J, b))
+    np.multiply(cs[0], cs[2:6], out=E[0:4])  # cy*cz, cy*sz, cy*cx, cy*sx
     U = cs[2:4, None] * cs[1]  # (cz*sy, sz*sy)
     U = U * cs[4:6][None]  # [[czsy*cx, czsy*sx], [szsy*cx, szsy*sx]]
     V = cs[3:1:-1, None] * cs[None, 5:3:-1]  # [[sz*sx, sz*cx], [cz*sx, cz*cx]]
-    np.add(U, V * _SIGN, out=Et[4:8].reshape(2, 2, b, J))
-    np.negative(cs[1], out=Et[8])
-    E[:, :, 9] = 0.0
-    E[:, :, 10] = 1.0
-    A4 = E[:, walk.columns_t, walk.gather_t].reshape(b, J, 4, 4)
+    np.add(U, V * _SIGN, out=E[4:8].reshape(2, 2, J, b))
+    np.negative(cs[1], out=E[8])
+    E[9] = 0.0
+    E[10] = 1.0
+    A = E[walk.gather, walk.columns].reshape(4, 4, J, b)
     if len(walk.framed):
         # AXIS: the angles turn about the joint's own axes, F R F^T (then R^T if walked backwards).
         f = walk.framed
-        R = A4[:, f, :3, :3]  # (b, f, 3, 3)
-        F = walk.frames  # (f, 3, 3)
-        FR = np.add.reduce(F[None, :, :, :, None] * R[:, :, None, :, :], axis=3)  # sum_a F[i, a] R[a, j]
-        R = np.add.reduce(FR[:, :, :, None, :] * F[None, :, None, :, :], axis=4)  # sum_k FR[i, k] F[j, k]
+        F = walk.frames  # (3, 3, f, 1): F[i, a] per framed joint
+        FR = np.add.reduce(F[:, :, None] * A[None, :3, :3, f], axis=1)  # sum_a F[i, a] R[a, j]
+        R = np.add.reduce(FR[:, None] * F[None], axis=2)  # sum_k FR[i, k] F[j, k]
         g = walk.framed_reversed_in_framed
         if len(g):
-            R[:, g] = R[:, g].transpose(0, 1, 3, 2)
-        A4[:, f, :3, :3] = R
+            R[:, :, g] = R[:, :, g].transpose(1, 0, 2, 3)
+        A[:3, :3, f] = R
     # t = near - R far, as sum_m R[:, m] (-far[m]) + near: the same number.
-    np.add.reduce(A4[:, :, :3, :3] * walk.minus_far, axis=3, out=A4[:, :, :3, 3])
-    A4[:, :, :3, 3] += walk.near
+    np.add.reduce(A[:3, :3] * walk.minus_far, axis=1, out=A[:3, 3])
+    A[:3, 3] += walk.near
     if len(walk.slides):
         # A slide moves S by k F d along its axes; walked backwards, P moves by -k F d.
         s = walk.slides
-        values = angles[:, walk.order[s], None, :]  # (b, s, 1, 3)
-        shift = np.add.reduce(walk.slide_axes * values, axis=3) * walk.slide_gain  # sum_a F[i, a] d[a], (b, s, 3)
-        A4[:, s, :3, 3] += shift.transpose(1, 0, 2)  # the index s and the 3 put the slides first
-    return A4
+        shift = np.add.reduce(walk.slide_axes * values[None, :, s], axis=1)  # sum_a F[i, a] d[a], (3, s, b)
+        A[:3, 3, s] += shift * walk.slide_gain
+    return A
 
 
-_YZX = np.array([1, 2, 0])[None, :]
+_YZX = np.array([1, 2, 0])

@@ -17,6 +17,12 @@ Faults:
   ``distributed.scheduler.allowed-failures`` times per task.  A task may
   therefore run more than once: it only computes, and the same draw list
   gives the same bytes, so that is harmless;
+- a task that has not answered ``task_timeout`` seconds after it was
+  handed to the cluster (``$LIGANIMATE_DASK_TASK_TIMEOUT``, default 600: a
+  worker that hangs, a scheduler that stopped answering) fails with a
+  :class:`RenderError` in one sentence, and is cancelled on the cluster;
+  the renderer keeps about twice as many tasks in flight as the workers
+  have threads, so a task waits for at most one other before it starts;
 - a scheduler that cannot be reached, that has no worker, or whose workers
   cannot import liganimate (or run other versions of what decides a
   frame's bytes) is a :class:`RenderError` before any frame is drawn.
@@ -28,10 +34,12 @@ import concurrent.futures as cf
 import contextlib
 import itertools
 import logging
+import math
 import os
 import secrets
 import socket
 import threading
+import time
 
 import distributed
 
@@ -44,6 +52,10 @@ CONNECT_TIMEOUT = 10.0
 WORKER_WAIT = 30.0
 # Seconds shutdown waits for the tasks being drawn before it lets them finish on their own.
 CLOSE_WAIT = 30.0
+#: The environment variable that sets the seconds one task may take, from being handed to the cluster.
+TASK_TIMEOUT_ENV = "LIGANIMATE_DASK_TASK_TIMEOUT"
+#: The default: ten minutes for one batch of images (a 640x480 image takes some milliseconds).
+TASK_TIMEOUT = 600.0
 _HINT = (
     "check the address (--scheduler or LIGANIMATE_SCHEDULER) and that a scheduler runs there "
     "('dask scheduler', with workers started by 'dask worker ADDRESS')"
@@ -66,6 +78,9 @@ class DaskExecutor:
     connect_timeout, worker_wait, close_wait : float, optional
         Seconds to reach the scheduler, to wait for a worker to join it,
         and for :meth:`shutdown` to wait for the tasks being drawn.
+    task_timeout : float, optional
+        Seconds a task may take from :meth:`submit` to its answer (default
+        ``$LIGANIMATE_DASK_TASK_TIMEOUT``, else 600).
     silence_logs : bool, optional
         Keep Dask's log lines (reconnection attempts, with tracebacks) off
         stderr while the executor is open; what goes wrong reaches the
@@ -95,8 +110,10 @@ class DaskExecutor:
         worker_wait: float = WORKER_WAIT,
         close_wait: float = CLOSE_WAIT,
         silence_logs: bool = True,
+        task_timeout: float | None = None,
     ):
         self.retries = int(retries)
+        self.task_timeout = task_timeout_from_env() if task_timeout is None else float(task_timeout)
         self.close_wait = float(close_wait)
         self._levels = _silence() if silence_logs else {}
         try:
@@ -115,7 +132,10 @@ class DaskExecutor:
         self._count = itertools.count()
         self._lock = threading.Lock()
         self._pending: dict = {}  # task key -> (Dask future, concurrent future)
+        self._deadlines: dict = {}  # task key -> time.monotonic() by which it must have answered
         self._closed = False
+        self._watch = threading.Thread(target=self._watchdog, name="liganimate-dask-deadlines", daemon=True)
+        self._watch.start()
 
     @property
     def client(self) -> distributed.Client:
@@ -139,13 +159,42 @@ class DaskExecutor:
         dask_future = self._client.submit(_call, fn, *args, key=key, pure=False, retries=self.retries)
         with self._lock:
             self._pending[key] = (dask_future, future)
+            self._deadlines[key] = time.monotonic() + self.task_timeout
         dask_future.add_done_callback(self._done)
         return future
+
+    def _watchdog(self) -> None:
+        """Fail every task that has not answered by its deadline (in a thread of its own)."""
+        step = min(1.0, max(0.05, self.task_timeout / 10))
+        while not self._closed:
+            time.sleep(step)
+            now = time.monotonic()
+            with self._lock:
+                late = [k for k, when in self._deadlines.items() if when <= now]
+                entries = [self._pending.pop(k, None) for k in late]
+                for k in late:
+                    del self._deadlines[k]
+            for entry in entries:
+                if entry is None:
+                    continue
+                dask_future, future = entry
+                with contextlib.suppress(Exception):
+                    self._client.cancel([dask_future])
+                if not future.done():
+                    future.set_exception(
+                        RenderError(
+                            f"a task on the Dask cluster at {self.address} did not answer in "
+                            f"{self.task_timeout:g} s (a worker hangs, or the scheduler stopped answering); "
+                            "the frames written before are complete",
+                            f"see the workers' logs; for very large images raise {TASK_TIMEOUT_ENV} (seconds)",
+                        )
+                    )
 
     def _done(self, dask_future) -> None:
         """Hand a finished task's outcome to its concurrent future (in Dask's callback thread)."""
         with self._lock:
             entry = self._pending.pop(dask_future.key, None)
+            self._deadlines.pop(dask_future.key, None)
         if entry is None:
             return
         future = entry[1]
@@ -206,7 +255,7 @@ class DaskExecutor:
             self._close_client()
             # Callbacks that will never come now (the client is gone): nobody waits forever.
             with self._lock:
-                left, self._pending = list(self._pending.values()), {}
+                left, self._pending, self._deadlines = list(self._pending.values()), {}, {}
             for _, future in left:
                 if not future.done():
                     future.set_exception(cf.CancelledError())
@@ -224,6 +273,26 @@ class DaskExecutor:
 
 # Loggers that print Dask's own troubles (with tracebacks) on stderr, and their children.
 _LOGGERS = ("distributed", "tornado")
+
+
+def task_timeout_from_env() -> float:
+    """Seconds one task may take: ``$LIGANIMATE_DASK_TASK_TIMEOUT``, else :data:`TASK_TIMEOUT`.
+
+    Raises
+    ------
+    RenderError
+        When the variable is set but is not a positive number of seconds.
+    """
+    text = os.environ.get(TASK_TIMEOUT_ENV, "").strip()
+    if not text:
+        return TASK_TIMEOUT
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (0 < value < math.inf):
+        raise RenderError(f"{TASK_TIMEOUT_ENV}={text!r} is not a number of seconds; give one such as 600")
+    return value
 
 
 def _silence() -> dict:
@@ -266,6 +335,11 @@ def _connect(address, timeout: float):
             client.close(timeout=1)
         client.status = "closed"
         raise RenderError(f"cannot reach the Dask scheduler at {shown}: {_why(exc)}", _HINT) from None
+    except BaseException:  # Ctrl-C while connecting: closed now, or Dask prints a traceback at exit
+        with contextlib.suppress(Exception):
+            client.close(timeout=1)
+        client.status = "closed"
+        raise
     return client, True
 
 

@@ -182,12 +182,14 @@ def library(
     segs = _segment_names(fig, taken)
     ext = widened_extremes(fig, kept)
     head = _header(fig, model, motion, kept, spacing, note, ext, frames)
+    kept, ext = _in_model_units(fig, kept, ext)
     shapes, skeleton, assign = _shapes(fig, segs, taken)
     body = []
     for k in range(0, len(segs), 6):
         body.append("      GRAPHICAL " + ", ".join(segs[k : k + 6]))
-    body += [f"      MODEL {model}", f"      MOTION {motion}", ""] + assign + [""]
-    body += _startmodel(fig, model, segs, ext) + [""] + _motion(fig, motion, kept, frames, method)
+    pieces, build = _model(fig, model, segs, ext, taken)
+    body += [f"      MODEL {', '.join([model, *pieces])}", f"      MOTION {motion}", ""] + assign + [""]
+    body += build + [""] + _motion(fig, motion, kept, frames, method)
     return Library("\n".join(head) + "\n", "\n".join(shapes) + "\n", "\n".join(skeleton) + "\n", "\n".join(body) + "\n")
 
 
@@ -254,12 +256,113 @@ def _shapes(fig, segs: list, taken: set) -> tuple:
     return full, skeleton, assign
 
 
+def _in_model_units(fig, kept: np.ndarray, ext: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Slides' displacements and extremes times their SCALE MODEL factor (the library's model has scale 1).
+
+    A negative factor (a mirrored model) turns each pair round, so it stays ``(min, max)``.
+    """
+    gain = np.where(fig.slides, fig.slide_scales, 1.0)
+    if np.all(gain == 1.0):
+        return kept, ext
+    kept = kept * gain[None, :, None]
+    ext = ext * gain[:, None, None]
+    ext = np.where((gain < 0)[:, None, None], ext[..., ::-1], ext)
+    return kept, ext
+
+
+def _model(fig, model: str, segs: list, ext, taken: set) -> tuple[list, list]:
+    """(the MODEL variables it needs besides ``model``, the statements that build ``model``)."""
+    if fig.inverted.any():
+        return _grafted(fig, model, segs, ext, taken)
+    return [], _startmodel(fig, model, segs, ext)
+
+
+def _extremes(j, ext_k) -> str:
+    """A joint's extremes as a JOINT writes them, with its SLIDE and AXIS words."""
+    pairs = ", ".join(f"({_num(a)}, {_num(b)})" for a, b in ext_k)
+    slide = "SLIDE " if j.slide else ""
+    axis = "" if j.axes is None else f" AXIS {_vec(j.axes[:, 0])}"
+    return f"              {slide}{pairs}{axis}"
+
+
+def _joint_line(target: str, j, primary: str, secondary: str, ext_k) -> list:
+    return [
+        f"      {target} :- JOINT {j.id}, {primary}, {_vec(j.loc1)}, {secondary}, {_vec(j.loc2)},",
+        _extremes(j, ext_k),
+    ]
+
+
+def _grafted(fig, model: str, segs: list, ext, taken: set) -> tuple[list, list]:
+    """A figure with inverted joints as the JOINTs and FIGUREs that build it.
+
+    A model block cannot say it: its secondaries are always new links.  So
+    each piece is built from a link no joint of the piece has as its
+    secondary (one always exists: the joints cannot make a cycle), joining
+    at it, as a primary, the pieces beyond each of its joints, each a
+    submodel re-rooted (``FIGURE ... MAIN LINK``) at the joint's secondary,
+    which is where a JOINT takes a submodel (thesis 3.3).  Pieces are found
+    with a work list, not recursion, so a long chain cannot overflow.
+    """
+    joints = fig.joints
+    incident: list[list[int]] = [[] for _ in fig.links]
+    for k, j in enumerate(joints):
+        incident[j.primary].append(k)
+        incident[j.secondary].append(k)
+    # A piece: (the link it must be held by, the joint it hangs from), its variable, its root and joints.
+    pieces: list = []
+    cut: set = set()  # joints already written: a piece never reaches across one
+    work = [(fig.root, -1, model)]
+    while work:
+        want, _, name = work.pop()
+        links, inner = [want], []
+        seen = {want}
+        for x in links:  # the piece's links: everything reached from ``want`` without crossing a cut
+            for k in incident[x]:
+                other = joints[k].secondary if joints[k].primary == x else joints[k].primary
+                if k not in cut and other not in seen:
+                    seen.add(other)
+                    links.append(other)
+                    inner.append(k)
+        heads = {joints[k].secondary for k in inner}
+        root = want if want not in heads else next(x for x in links if x not in heads)
+        parts = []
+        for k in sorted(k for k in incident[root] if k not in cut):
+            cut.add(k)
+            child = joints[k].secondary
+            sub = segs[child]
+            if any(j not in cut for j in incident[child]):  # joints beyond it: a submodel
+                sub = _fresh(f"{model}_{joints[k].id}", taken)
+                work.append((child, k, sub))
+            parts.append((k, sub))
+        pieces.append((name, want, root, parts))
+    extra = [name for name, *_ in pieces if name != model]
+    out: list = []
+    for name, want, root, parts in reversed(pieces):  # a piece after the pieces it joins
+        primary = segs[root]
+        for k, sub in parts:
+            out += _joint_line(name, joints[k], primary, sub, ext[k])
+            primary = name
+        if want != root:
+            out.append(f"      FIGURE {name} MAIN LINK {segs[want]}")
+    if fig.main != fig.root:
+        out.append(f"      FIGURE {model} MAIN LINK {segs[fig.main]}")
+    return extra, out
+
+
+def _fresh(base: str, taken: set) -> str:
+    name, n = base, 1
+    while name in taken:
+        n += 1
+        name = f"{base}_{n}"
+    taken.add(name)
+    return name
+
+
 def _startmodel(fig, model: str, segs: list, ext) -> list:
     out = [f"      STARTMODEL {model}"]
     for k, j in enumerate(fig.joints):
-        pairs = ", ".join(f"({_num(a)}, {_num(b)})" for a, b in ext[k])
         out.append(f"        JOINT {j.id}, {segs[j.primary]}, {_vec(j.loc1)}, {segs[j.secondary]}, {_vec(j.loc2)},")
-        out.append(f"              {pairs}")
+        out.append(_extremes(j, ext[k]))
     out.append("      ENDMODEL")
     if fig.main is not None and fig.main != fig.root:
         parent = fig.parent_joint_of(fig.main)

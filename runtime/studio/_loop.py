@@ -253,7 +253,9 @@ class ConnectionLoop:
 
     def _stop_threads(self) -> None:
         for _ in range(self.limits.workers):
-            self._jobs.put((-1, -1, None, b""))  # may wait for room: the workers are draining the queue
+            # First in the queue (and never compared past the order), so the workers stop before what is left;
+            # put may wait for room, while the workers drain the queue.
+            self._jobs.put((-1, next(self._order), None, b""))
         self._slow.put(None)
         for t in self._threads:
             t.join(timeout=30)

@@ -230,12 +230,18 @@ class Session:
             message = getattr(self, "_do_" + action)(g, body)
             self._state_json = None
             state = self.state(message or "")
-            if action == "play":
-                state["play"] = self.played()
-            return state
+            snap = self._snapshot()
+        if action == "play":
+            state["play"] = self.played(snap)  # outside the lock: up to 2,400 frames take a tenth of a second
+        return state
 
-    def played(self) -> dict:
+    def played(self, snap: _Snapshot | None = None) -> dict:
         """The kept poses as the saved motion plays them: segment matrices for every frame from 0 to the last.
+
+        Parameters
+        ----------
+        snap : optional
+            The kept poses to play, copied under :attr:`lock` (default: as they are now).
 
         Raises
         ------
@@ -246,17 +252,20 @@ class Session:
         from liganimate.runtime.motion.keyframe import Keyframe
 
         g = self.generator
-        if not g.kept:
+        if snap is None:
+            with self.lock:
+                snap = self._snapshot()
+        kept, frames, method = snap.kept, snap.frames, snap.method
+        if not kept:
             raise RequestError("keep a pose first: the motion is made of the kept poses")
-        frames = g.kept_frames
         if frames[-1] + 1 > MAX_PLAY_FRAMES:
             raise RequestError(
                 f"the motion is {frames[-1] + 1} frames long; the studio plays at most {MAX_PLAY_FRAMES}"
             )
         spec = {}
         for k, j in enumerate(g.figure.joints):
-            start = tuple(float(a) for a in g.kept[0][k])
-            keys = [Keyframe(frames[n], _three(g.kept[n][k]), self.method) for n in range(1, len(frames))]
+            start = tuple(float(a) for a in kept[0][k])
+            keys = [Keyframe(frames[n], _three(kept[n][k]), method) for n in range(1, len(frames))]
             spec[j.id] = (start, keys)
         motion = M.Motion.from_tracks(spec)
         times = np.arange(frames[-1] + 1, dtype=np.float64)

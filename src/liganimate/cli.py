@@ -454,7 +454,7 @@ def cmd_lsp(args) -> int:
     """``liganimate lsp``: the language server, over stdin and stdout, until the editor says exit."""
     from liganimate.lsp import main as serve
 
-    return serve()
+    return serve(whole_parse=args.whole_parse)
 
 
 def suffixed(suffix: str, what: str):
@@ -524,6 +524,11 @@ def build_parser() -> argparse.ArgumentParser:
     view_cli.add_commands(sub)
     fmt_cli.add_commands(sub)
     p = sub.add_parser("lsp", help="serve the LIG language to an editor (the Language Server Protocol, over stdio)")
+    p.add_argument(
+        "--whole-parse",
+        action="store_true",
+        help="parse the whole text after every change instead of only the part around it (slower; for comparison)",
+    )
     p.set_defaults(func=cmd_lsp)
     p = sub.add_parser(
         "completion",

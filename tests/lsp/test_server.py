@@ -419,6 +419,42 @@ async def test_broken_text_keeps_answering(client: LanguageClient, folder: pathl
     assert list(await diagnostics_for(client, uri, 3)) == []
 
 
+async def test_typing_in_a_big_program_ends_with_the_diagnostics_of_the_last_text(
+    client: LanguageClient, folder: pathlib.Path
+):
+    """Keystrokes sent one right after the other, while earlier texts are still analysed (and indexed).
+
+    The server parses only the text around each change (lang/incremental.py);
+    the last text's diagnostics must come, and be those of the whole text as
+    ``liganimate check`` finds them, here a syntax error in a block and then
+    its repair.
+    """
+    body = PROGRAM[PROGRAM.index("      STARTMODEL ARM") : PROGRAM.index("      SHOOTSCENES")]
+    copies = [body.replace("ARM", f"ARM{i}").replace("BEND", f"BEND{i}").replace("BOTH", f"BOTH{i}") for i in range(60)]
+    big = PROGRAM.replace(body, "".join(copies))
+    path = folder / "keystrokes.lig"
+    path.write_text(big)
+    uri = await open_doc(client, path, big)
+    assert list(PUBLISHED[(uri, 1)]) == []
+    at = big.index("FRAME 12 POSITION 90.0", len(big) // 2) + len("FRAME 12 POSITION 9")
+    text, version = big, 1
+    for typed in ", ,":  # 90.0 -> 9, ,0.0: a comma where a number must be
+        text = text[:at] + typed + text[at:]
+        at += 1
+        version += 1
+        change(client, uri, version, text)
+    found = await diagnostics_for(client, uri, version)
+    path.write_text(text)
+    printed = check_output(path)
+    assert len(found) == 1 and found[0].severity == T.DiagnosticSeverity.Error
+    first = found[0]
+    assert f"{path}:{first.range.start.line + 1}:{first.range.start.character + 1}: error: " in printed
+    assert first.message.split("\n")[0] in printed
+    version += 1
+    change(client, uri, version, big)
+    assert list(await diagnostics_for(client, uri, version)) == []
+
+
 async def test_the_command_is_installed():
     """``liganimate lsp`` is a subcommand of the installed command (its help names it)."""
     done = subprocess.run(

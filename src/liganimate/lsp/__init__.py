@@ -18,11 +18,11 @@ them. One module a job:
 from __future__ import annotations
 
 
-def main() -> int:
-    """Run the server over stdio (``liganimate lsp``)."""
+def main(*, whole_parse: bool = False) -> int:
+    """Run the server over stdio (``liganimate lsp``); ``whole_parse`` parses the whole text after every change."""
     from .server import main as serve
 
-    return serve()
+    return serve(whole_parse=whole_parse)
 
 
 __all__ = ["main"]

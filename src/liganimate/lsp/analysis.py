@@ -20,6 +20,7 @@ from liganimate.compiler.check import Checked, check
 from liganimate.lang import ast as A
 from liganimate.lang import collector
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
+from liganimate.lang.incremental import Reparser
 from liganimate.lang.source import MAX_SOURCE_BYTES, prepare
 
 from . import index as I
@@ -61,7 +62,13 @@ def _too_large(filename: str) -> Diagnostic:
 
 
 def analyse(
-    source: str, path: str | None, version: int | None = None, encoding: str | None = None, *, whole: bool = True
+    source: str,
+    path: str | None,
+    version: int | None = None,
+    encoding: str | None = None,
+    *,
+    whole: bool = True,
+    reparser: Reparser | None = None,
 ) -> Analysis:
     """Analyse document text.
 
@@ -79,15 +86,21 @@ def analyse(
         False stops once the diagnostics are known (the server publishes
         them, then calls :func:`complete`); True also builds the index and
         the values.
+    reparser : liganimate.lang.incremental.Reparser, optional
+        The document's parser (:func:`liganimate.lang.parser.reparser`),
+        which parses again only the part of the text around a change: the
+        same tree and diagnostics as a whole parse, sooner.
     """
     # The stages build trees, not cycles: the cyclic collector is paused while
     # they run, as the compiler pauses it (lang/collector.py), so that the
     # trees of earlier analyses the server still holds are not walked again and again.
     with COMPILER_LOCK, collector.paused():
-        return _analyse(source, path, version, encoding, whole)
+        return _analyse(source, path, version, encoding, whole, reparser)
 
 
-def _analyse(source: str, path: str | None, version: int | None, encoding: str | None, whole: bool) -> Analysis:
+def _analyse(
+    source: str, path: str | None, version: int | None, encoding: str | None, whole: bool, reparser: Reparser | None
+) -> Analysis:
     text = Text(source) if encoding is None else Text(source, encoding)
     filename = path or "<untitled>"
     if len(source) > MAX_SOURCE_BYTES or len(source.encode("utf-8", errors="replace")) > MAX_SOURCE_BYTES:
@@ -95,7 +108,7 @@ def _analyse(source: str, path: str | None, version: int | None, encoding: str |
     prepared = prepare(source, filename)
     where = path if path is not None else os.path.join(os.getcwd(), "<untitled>")
     try:
-        program, opened = parse_program(prepared, path=where)
+        program, opened = parse_program(prepared, path=where, reparser=reparser)
     except NotParsed as exc:
         return Analysis(text, version, path, list(exc.diagnostics))
     result = Analysis(text, version, path, [], program)
@@ -112,7 +125,7 @@ def complete(a: Analysis) -> Analysis:
     if a.program is None or a.index is not None:
         return a
     where = a.path if a.path is not None else os.path.join(os.getcwd(), "<untitled>")
-    with COMPILER_LOCK:
+    with COMPILER_LOCK, collector.paused():  # as in analyse
         a.index = I.build(a.program, a.text)
         a.libraries = libraries.libraries_of(a.program, where)
         a.env = statics.evaluate(a.program, libraries.loaded_values(a.program, where))

@@ -1,7 +1,9 @@
 """``liganimate lsp``: the language server, over stdio, built on pygls.
 
 This module only wires the protocol to the modules that do the work: the
-analysis of a change runs in one worker thread (:mod:`.analysis`), and
+analysis of a change runs in one worker thread (:mod:`.analysis`), the
+index and values built after its diagnostics are published in another
+(the two never run at once: they share the compiler's lock), and
 every request is answered at once from the latest analysis, the last one
 whose text parsed, and the tolerant scan of the text as it is now, never
 waiting for an analysis to finish. A change is analysed at once; changes
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import sys
 from concurrent.futures import ThreadPoolExecutor
 
 from lsprotocol import types as lsp
@@ -23,13 +26,14 @@ from pygls.uris import from_fs_path, to_fs_path
 
 from liganimate import __version__
 from liganimate.lang.parser import BUILTIN_PRIMITIVES
+from liganimate.lang.parser import reparser as reparser_for_document
 from liganimate.lang.source import prepare
 
 from . import completion as C
 from . import hover as H
 from . import navigation as N
 from . import outline, scan
-from .analysis import COMPILER_LOCK, Analysis, analyse
+from .analysis import COMPILER_LOCK, Analysis, analyse, complete
 from .lookup import target
 from .text import Text
 
@@ -49,7 +53,10 @@ class LigServer(LanguageServer):
         self.latest: dict = {}  # uri -> Analysis of some version (maybe not the newest)
         self.good: dict = {}  # uri -> the last Analysis whose text parsed
         self.pending: dict = {}  # uri -> the asyncio task that will analyse it
-        self.worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="liganimate-analysis")
+        self.reparsers: dict = {}  # uri -> its Reparser (lang/incremental.py), used only by the worker
+        self.whole_parse = False  # True: no Reparser, every change parses the whole text (liganimate lsp --whole-parse)
+        self.worker = _named_worker("lig-analysis")
+        self.indexer = _named_worker("lig-index")
 
     def encoding(self) -> str:
         """The position encoding agreed with the client."""
@@ -62,6 +69,21 @@ class LigServer(LanguageServer):
     def text(self, uri: str) -> Text:
         """The document's text now, with its positions."""
         return Text(self.source(uri), self.encoding())
+
+
+def _named_worker(name: str) -> ThreadPoolExecutor:
+    """A one-thread pool whose thread the system knows by ``name`` (``top -H``; benchmarks/lsp.py reads it)."""
+    return ThreadPoolExecutor(max_workers=1, thread_name_prefix=name, initializer=_name_thread, initargs=(name,))
+
+
+def _name_thread(name: str) -> None:
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            ctypes.CDLL(None).prctl(15, name.encode("ascii")[:15], 0, 0, 0)  # PR_SET_NAME
+        except (OSError, AttributeError):
+            pass  # the name is for people watching the process; the server works without it
 
 
 server = LigServer()
@@ -84,32 +106,53 @@ async def _analyse_until_current(ls: LigServer, uri: str) -> None:
     A change that arrives while an analysis runs is not analysed on its
     own: the next round takes the text as it is then, so a burst of
     keystrokes costs one analysis more than the one running, and a single
-    change is analysed at once, with no pause.
+    change is analysed at once, with no pause. The diagnostics go out as
+    soon as they are known, before the index and the values that requests
+    use are built (until then requests are answered from the last analysis),
+    and those are built only for a text that is still current.
     """
     loop = asyncio.get_running_loop()
     await asyncio.sleep(0)  # the change's own handler first
+    reparser = None if ls.whole_parse else ls.reparsers.setdefault(uri, reparser_for_document())
     while uri in ls.workspace.text_documents:
         doc = ls.workspace.get_text_document(uri)
         version, source = doc.version, doc.source
-        result = await loop.run_in_executor(ls.worker, _analyse_safely, source, _path(uri), version, ls.encoding())
+        result = await loop.run_in_executor(
+            ls.worker, _analyse_safely, source, _path(uri), version, ls.encoding(), reparser
+        )
         if uri not in ls.workspace.text_documents:
             return  # closed meanwhile
+        if ls.workspace.get_text_document(uri).version != version:
+            continue  # changed meanwhile: the newer text next, at once
+        ls.text_document_publish_diagnostics(
+            lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
+        )
+        result = await loop.run_in_executor(ls.indexer, _complete_safely, result)
+        if uri not in ls.workspace.text_documents:
+            return
         ls.latest[uri] = result
         if result.parsed:
             ls.good[uri] = result
         if ls.workspace.get_text_document(uri).version == version:
-            ls.text_document_publish_diagnostics(
-                lsp.PublishDiagnosticsParams(uri=uri, version=version, diagnostics=_diagnostics(result))
-            )
-            return
+            return  # else a change came meanwhile, which _schedule left to this task
 
 
-def _analyse_safely(source: str, path: str | None, version, encoding: str) -> Analysis:
+def _analyse_safely(source: str, path: str | None, version, encoding: str, reparser) -> Analysis:
     try:
-        return analyse(source, path, version, encoding)
+        return analyse(source, path, version, encoding, whole=False, reparser=reparser)
     except Exception:  # noqa: BLE001 - a bug must cost one analysis, not the editor's server
         log.exception("the analysis failed")
+        if reparser is not None:
+            reparser.forget()  # the next analysis parses the whole text
         return Analysis(Text(source, encoding), version, path, [])
+
+
+def _complete_safely(a: Analysis) -> Analysis:
+    try:
+        return complete(a)
+    except Exception:  # noqa: BLE001 - as in _analyse_safely
+        log.exception("the analysis failed")
+        return Analysis(a.text, a.version, a.path, a.diagnostics)
 
 
 _SEVERITY = {"error": lsp.DiagnosticSeverity.Error, "warning": lsp.DiagnosticSeverity.Warning}
@@ -188,6 +231,7 @@ async def did_close(ls: LigServer, params: lsp.DidCloseTextDocumentParams) -> No
         task.cancel()
     ls.latest.pop(uri, None)
     ls.good.pop(uri, None)
+    ls.reparsers.pop(uri, None)
     ls.text_document_publish_diagnostics(lsp.PublishDiagnosticsParams(uri=uri, diagnostics=[]))
 
 
@@ -449,8 +493,9 @@ def on_folding(ls: LigServer, params: lsp.FoldingRangeParams) -> list:
     ]
 
 
-def main() -> int:
-    """Serve over stdin and stdout until the client says exit."""
+def main(*, whole_parse: bool = False) -> int:
+    """Serve over stdin and stdout until the client says exit; ``whole_parse``: see :class:`LigServer`."""
+    server.whole_parse = whole_parse
     server.start_io()
     return 0
 

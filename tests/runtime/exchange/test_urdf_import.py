@@ -180,3 +180,37 @@ def test_a_joint_axis_is_any_unit_direction(tmp_path):
     # Turning by 90 degrees about (0, 1, 1) takes the arm's X axis to (0, 1, -1) / sqrt 2.
     X_ = K.pose_transforms(fig, np.array([[[90.0, 0, 0]]]))[0, 1]
     np.testing.assert_allclose(X_[:3, :3] @ [1, 0, 0], [0, 2**-0.5, -(2**-0.5)], atol=1e-12)
+
+
+# pinocchio's own URDF parser and forward kinematics, a second independent reader.
+PINOCCHIO_ROBOTS = ROBOTS + ["racecar/racecar.urdf", "pendulum5.urdf", "quadruped/minitaur.urdf"]
+
+
+@pytest.mark.parametrize("name", PINOCCHIO_ROBOTS)
+def test_forward_kinematics_agree_with_pinocchio_at_random_joint_values(name, tmp_path):
+    from exchange_support import pinocchio_links
+
+    path = os.path.join(DATA, name)
+    fig, robot = imported(path, tmp_path)
+    rng = np.random.default_rng(31)
+    movable = [j for j in robot.joints if j.type != "fixed" and j.mimic is None]
+    checked = 0
+    for _ in range(5):
+        cfg = {
+            j.name: float(rng.uniform(j.lower, j.upper) if j.type != "continuous" else rng.uniform(-math.pi, math.pi))
+            for j in movable
+        }
+        # pinocchio reads a mimic joint as a joint of its own: give it the URDF's formula.
+        full = dict(cfg)
+        for j in robot.joints:
+            if j.mimic is not None:
+                full[j.name] = j.mimic[1] * cfg[j.mimic[0]] + j.mimic[2]
+        ref = pinocchio_links(path, full)
+        X_lig = K.pose_transforms(fig, lig_values(fig, robot, cfg)[None])[0]
+        for i, link in enumerate(fig.links):
+            T = ref[link.source.name]
+            R0 = rpy_matrix(link.source.rpy) if link.source.rpy is not None else np.eye(3)
+            np.testing.assert_allclose(X_lig[i, :3, 3], T[:3, 3], rtol=0, atol=1e-9, err_msg=link.source.name)
+            np.testing.assert_allclose(X_lig[i, :3, :3] @ R0, T[:3, :3], rtol=0, atol=1e-9, err_msg=link.source.name)
+            checked += 1
+    assert checked == 5 * fig.n_links

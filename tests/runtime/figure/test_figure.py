@@ -174,7 +174,7 @@ def test_extremes_malformed(bad):
 # ----------------------------------------------------------------- JOINT and figures
 
 
-def test_join_attaches_figures_by_original_main_and_keeps_primary_state():
+def test_join_attaches_a_submodel_by_its_current_main_and_keeps_primary_state():
     a, b, c, d = (Link(n, n.lower()) for n in "ABCD")
     sub = join(2, c, (1, 0, 0), d, (0, 1, 0), FREE).with_main(1).with_placement(np.diag([1, 1, 1, 1.0]) * 3)
     M = transform_from(np.eye(3), [1, 2, 3])
@@ -182,10 +182,17 @@ def test_join_attaches_figures_by_original_main_and_keeps_primary_state():
     f = join(3, prim, (5, 5, 5), sub, (6, 6, 6), FREE)
     j3 = f.joint(3)
     assert f.links[j3.primary].name == "A"  # the primary's ORIGINAL main link
-    assert f.links[j3.secondary].name == "C"  # the submodel's ORIGINAL main link, not D
+    # The thesis (3.3): a submodel's location is "with respect to the main link in the
+    # submodel", the one FIGURE chose (D), not its original main link C.
+    assert f.links[j3.secondary].name == "D"
     assert f.root == 0 and f.links[f.main].name == "B"  # primary's current main
     np.testing.assert_array_equal(f.placement, M)  # the primary's; the secondary's is dropped
     assert f.joint_ids == (1, 3, 2)
+    # Joint 2 keeps its definition (C primary, D secondary); hung from A it is walked backwards.
+    j2 = f.joint(2)
+    assert (f.links[j2.primary].name, f.links[j2.secondary].name) == ("C", "D")
+    assert list(f.inverted) == [False, False, True]
+    assert [f.links[i].name for i in f.preorder] == ["A", "B", "D", "C"]
     # Value semantics: the operands are untouched.
     assert prim.n_links == 2 and sub.n_links == 2 and sub.main == 1
 
@@ -242,10 +249,12 @@ def test_figure_constructor_rejects_non_trees():
     J = lambda i, p, s: Joint(i, p, s, (0, 0, 0), (0, 0, 0), FREE)
     with pytest.raises(FigureError, match="needs 2 joints"):
         Figure((a, b, c), (J(1, 0, 1),))
-    with pytest.raises(FigureError, match="main link a secondary"):
-        Figure((a, b), (J(1, 1, 0),), root=0)
-    with pytest.raises(FigureError, match="secondary of two joints"):
-        Figure((a, b, c), (J(1, 0, 1), J(2, 2, 1)))
+    with pytest.raises(FigureError, match="one tree"):
+        Figure((a, b, c), (J(1, 0, 1), J(2, 1, 0)))  # two joints between a and b, c alone
+    # A joint may point towards the root (a re-rooted submodel's): still one tree.
+    rooted_at_a = Figure((a, b, c), (J(1, 0, 1), J(2, 2, 1)))
+    assert rooted_at_a.preorder == (0, 1, 2) and list(rooted_at_a.inverted) == [False, True]
+    assert rooted_at_a.parent_joint_of(2).id == 2 and rooted_at_a.child_of(rooted_at_a.joint(2)) == 2
     with pytest.raises(FigureError, match="one tree"):
         Figure((a, b, c), (J(1, 1, 2), J(2, 2, 1)))  # b and c in a loop, a alone
     with pytest.raises(FigureError, match="used twice"):

@@ -60,7 +60,7 @@ def roots(rng: np.random.Generator, frames: int):
 
 
 @pytest.mark.parametrize("seed", range(12))
-@pytest.mark.parametrize("frames", [0, 1, 3, 63, 64, 300])
+@pytest.mark.parametrize("frames", [0, 1, 3, 64, 255, 256, 300])
 def test_both_walks_give_the_previous_numbers(seed, frames):
     rng = np.random.default_rng(seed)
     fig = hinges(rng, 8) if seed % 2 else random_robot(rng, 7)

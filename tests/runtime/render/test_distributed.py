@@ -408,3 +408,134 @@ def test_dask_logging_is_silenced_while_the_executor_is_open_and_restored_after(
     assert client_log.level == before
     DaskExecutor(cluster, silence_logs=False).shutdown()
     assert client_log.level == before
+
+
+# --------------------------------------------------------------------------
+# Issue 24: every wait bounded, a task too
+
+
+@pytest.fixture(scope="module")
+def thread_cluster():
+    """One in-process worker thread: a task that hangs there hangs as on any worker."""
+    with distributed.LocalCluster(
+        n_workers=1, processes=False, threads_per_worker=2, dashboard_address=":0", silence_logs=40
+    ) as c:
+        yield c
+
+
+def _hang(gate: str, seconds: float) -> str:
+    """A task that hangs until ``gate`` exists (or ``seconds`` pass), as a stuck worker would."""
+    deadline = time.monotonic() + seconds
+    while not os.path.exists(gate) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return "late"
+
+
+def test_a_task_that_hangs_fails_after_the_task_timeout_in_one_sentence(thread_cluster, tmp_path):
+    ex = DaskExecutor(thread_cluster, task_timeout=1.5)
+    try:
+        start = time.monotonic()
+        hung = ex.submit(_hang, str(tmp_path / "gate"), 120)
+        quick = ex.submit(abs, -4)
+        assert quick.result(timeout=60) == 4  # the deadline is per task
+        with pytest.raises(RenderError) as info:
+            hung.result(timeout=60)
+        assert time.monotonic() - start < 30
+        assert info.value.message == (
+            f"a task on the Dask cluster at {ex.address} did not answer in 1.5 s (a worker hangs, or the "
+            "scheduler stopped answering); the frames written before are complete"
+        )
+        assert dask_render.TASK_TIMEOUT_ENV in info.value.hint
+    finally:
+        (tmp_path / "gate").write_text("")
+        ex.shutdown(wait=False)
+
+
+def test_the_task_timeout_comes_from_its_environment_variable(monkeypatch):
+    monkeypatch.setenv(dask_render.TASK_TIMEOUT_ENV, "2.5")
+    assert dask_render.task_timeout_from_env() == 2.5
+    monkeypatch.delenv(dask_render.TASK_TIMEOUT_ENV)
+    assert dask_render.task_timeout_from_env() == dask_render.TASK_TIMEOUT == 600
+    for bad in ("0", "-1", "soon", "inf", "nan"):
+        monkeypatch.setenv(dask_render.TASK_TIMEOUT_ENV, bad)
+        with pytest.raises(RenderError, match=f"{dask_render.TASK_TIMEOUT_ENV}='{bad}' is not a number of seconds"):
+            dask_render.task_timeout_from_env()
+
+
+def test_a_render_whose_task_hangs_stops_with_one_sentence_and_whole_files(thread_cluster, tmp_path, monkeypatch):
+    gate = tmp_path / "gate"
+    real = dask_render._call
+
+    def stuck(fn, *args):  # every drawing task hangs, as on a worker stuck in C code
+        _hang(str(gate), 120)
+        return real(fn, *args)
+
+    monkeypatch.setattr(dask_render, "_call", stuck)
+    ex = DaskExecutor(thread_cluster, task_timeout=1.0, close_wait=1.0)
+    try:
+        with pytest.raises(RenderError, match="did not answer in 1 s"):
+            render(tmp_path, tmp_path / "frames", executor=ex)
+    finally:
+        gate.write_text("")
+        ex.shutdown(wait=False)
+    assert not [p for p in tmp_path.rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_ctrl_c_while_waiting_on_the_scheduler_stops_at_once_without_a_traceback(tmp_path):
+    """A real scheduler without workers: the run waits for one; Ctrl-C ends it with status 130 and one sentence."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    scheduler = subprocess.Popen(
+        [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port)]
+        + ["--dashboard-address", ":0"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        _wait_for(lambda: _listening(port))
+        swing(tmp_path)
+        run = subprocess.Popen(
+            [sys.executable, "-m", "liganimate", "run", "swing.lig", "--size", "16x12", "-o", "out"]
+            + ["--scheduler", f"tcp://127.0.0.1:{port}"],
+            cwd=tmp_path,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+            # A background shell's children inherit SIGINT ignored; Ctrl-C at a terminal is not.
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        )
+        _wait_for(lambda: _connected_to(run.pid, port))  # the run has reached the scheduler and waits for a worker
+        os.killpg(run.pid, signal.SIGINT)
+        stopped = time.monotonic()
+        _, err = run.communicate(timeout=60)
+        assert time.monotonic() - stopped < 5
+        assert run.returncode == 130
+        assert err == "\nliganimate: interrupted; every file already written is complete\n"
+        assert not (tmp_path / "out").exists() or not list((tmp_path / "out").rglob("*.png"))
+    finally:
+        scheduler.kill()
+        scheduler.wait()
+
+
+def _listening(port: int) -> bool:
+    try:
+        socket.create_connection(("127.0.0.1", port), timeout=1).close()
+    except OSError:
+        return False
+    return True
+
+
+def _connected_to(pid: int, port: int) -> bool:
+    """Whether process ``pid`` holds an established TCP connection to ``port`` on this machine (Linux /proc)."""
+    inodes = set()
+    for fd in os.listdir(f"/proc/{pid}/fd"):
+        try:
+            target = os.readlink(f"/proc/{pid}/fd/{fd}")
+        except OSError:
+            continue
+        if target.startswith("socket:["):
+            inodes.add(target[8:-1])
+    with open("/proc/net/tcp") as f:
+        rows = [line.split() for line in f.readlines()[1:]]
+    return any(r[9] in inodes and int(r[2].split(":")[1], 16) == port and r[3] == "01" for r in rows)

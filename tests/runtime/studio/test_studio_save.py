@@ -154,3 +154,54 @@ def test_save_after_the_warm_up_still_refuses_a_library_that_would_not_compile(t
     with pytest.raises(LigDiagnostics):
         s.act({"action": "save"})
     assert not (tmp_path / "poses.lig").exists()
+
+
+STANDING = """\
+      LOAD HUMANOID FROM 'humanoid'
+      GRAPHICAL PLINTH
+      MODEL STATUE
+      PLINTH :- BOX WIDTH 1.0, HEIGHT 0.4, DEPTH 1.0
+      FIGURE HUMANOID MAIN LINK R_FOOT
+      STATUE :- JOINT 99, PLINTH, (0.0, 0.2, 0.0), HUMANOID, (0.0, -0.05, 0.0), (-30.0, 30.0)
+      FIGURE STATUE MAIN LINK L_FOOT
+"""
+
+
+@pytest.mark.parametrize("which", ["STATUE", "BOT", "SPUN"])
+def test_a_model_built_from_a_re_rooted_submodel_is_saved_as_the_joints_and_figures_that_build_it(tmp_path, which):
+    """A model block cannot hold a joint walked from its secondary: the library builds the model
+    piece by piece, each piece re-rooted where the thesis' JOINT takes it, and replays the poses."""
+    from exchange_support import GRAFTED
+
+    from liganimate.compiler import load_program as compile_text
+
+    text = STANDING if which == "STATUE" else GRAFTED
+    program, _ = compile_text(text=text, name="graft.lig")
+    fig = program.execute("check").variables[which]
+    assert fig.inverted.any()
+    g = _posed(fig)
+    kept = np.array(g.kept)
+    lib = tmp_path / "posed.lig"
+    saved = library_text(fig, "POSED", "POSES", g.kept, spacing=10)
+    assert "FIGURE" in saved and "STARTMODEL" not in saved
+    write_library(str(lib), saved)
+    _, take = _play(tmp_path, lib, "POSED", "POSES", 10 * (len(kept) - 1) + 1)
+    at = np.arange(len(kept)) * 10
+    got = take.figure
+    assert sorted(got.joint_ids) == sorted(fig.joint_ids)
+    # The same joints walked backwards, the same original and current main links.
+    assert {j.id: bool(r) for j, r in zip(got.joints, got.inverted)} == {
+        j.id: bool(r) for j, r in zip(fig.joints, fig.inverted)
+    }
+    assert got.links[got.root].name == fig.links[fig.root].name
+    assert got.links[got.main].name == fig.links[fig.main].name
+    order = [got.joint_index(j) for j in fig.joint_ids]
+    # The library's model has scale 1: a slide's displacement is written times its SCALE MODEL factor.
+    written = kept * np.where(fig.slides, fig.slide_scales, 1.0)[None, :, None]
+    assert np.allclose(take.angles[at][:, order], written, rtol=0, atol=1e-12)
+    mine = world_triangles(mesh_table(fig), g.transforms(kept))
+    theirs = world_triangles(
+        mesh_table(take.figure), world_transforms(take.figure, take.angles[at], take.placements[at])
+    )
+    assert mine.shape == theirs.shape
+    assert np.allclose(mine, theirs, atol=1e-7)
