@@ -247,10 +247,10 @@ def morphed(fig: F.Figure, motion: Motion | None, frames, X: np.ndarray) -> tupl
     morphs = None if motion is None else motion.morphs
     if morphs is None:
         return X, None
-    return MO.apply(_binding(fig, morphs), morphs, frames, X, mesh_table(fig))
+    return MO.apply(morph_binding(fig, morphs), morphs, frames, X, mesh_table(fig))
 
 
-def _binding(fig: F.Figure, morphs) -> MO.Binding:
+def morph_binding(fig: F.Figure, morphs) -> MO.Binding:
     """A motion's morphs bound to a model's links, remembered per (links, morphs)."""
     key = (id(fig.links), id(morphs))
     hit = _bindings.get(key)
@@ -267,7 +267,7 @@ def morph_record(fig: F.Figure, motion: Motion | None, frames) -> list[dict]:
     morphs = None if motion is None else motion.morphs
     if morphs is None:
         return [{} for _ in range(n)]
-    return MO.record(_binding(fig, morphs), morphs, frames)
+    return MO.record(morph_binding(fig, morphs), morphs, frames)
 
 
 def static_triangles(fig: F.Figure):
