@@ -156,17 +156,26 @@ class Program:
         return self._positions
 
     def execute(
-        self, mode: str = "check", renderer=None, stdout=None, echo_print: bool = False, progress=None
+        self,
+        mode: str = "check",
+        renderer=None,
+        stdout=None,
+        echo_print: bool = False,
+        progress=None,
+        drawing: bool = False,
     ) -> Runtime:
         """Run the program; return the runtime, whose ``variables`` hold its final values.
 
-        In ``"check"`` mode PRINT only checks its items unless ``echo_print``.
+        In ``"check"`` mode PRINT only checks its items unless ``echo_print``;
+        ``drawing`` says that a render follows, so a scene over the frames
+        budget is refused by the check, before any folder is made.
         ``progress(scene_id, tick, length)``, if given, is called every
         :data:`PROGRESS_TICKS` ticks of a scene, so a long check is not silent.
         """
         rt = Runtime(self, mode, renderer, stdout)
         rt.echo_print = echo_print
         rt.progress = progress
+        rt.drawing = drawing or renderer is not None
         try:
             rt.variables = self.main(rt) or {}
         except _StopProgram:
@@ -244,7 +253,7 @@ class Program:
             unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(RenderOptions)})
             raise TypeError(f"render() got unknown options: {', '.join(unknown)}") from None
         if not checked:
-            self.check()
+            self.execute("check", stdout=io.StringIO(), drawing=True)
         renderer = Renderer(chosen, progress=progress, executor=executor)
         try:
             rt = self.execute("render", renderer=renderer, stdout=stdout)
@@ -277,6 +286,7 @@ class Runtime(Arithmetic):
         self.renderer = renderer
         self.out = stdout if stdout is not None else sys.stdout
         self.progress = None  # see Program.execute
+        self.drawing = False  # a render follows (or this is it): the frames budget applies
         self.warnings: list = []
         self._warned: set = set()
         self.scenes: dict = {}
@@ -711,7 +721,7 @@ class Runtime(Arithmetic):
             self.fail(at if sameframe_at is None else sameframe_at, f"SAMEFRAME must be at least 1, not {sameframe}")
         state = self.scene
         state.length, state.sameframe = length, sameframe
-        if self.renderer is not None:
+        if self.drawing:
             self._guard(at, budgets.check_frames, length, sameframe)
         progress = self.progress
         mark = (0, 0)  # (tick, work done) at the last estimate
