@@ -318,3 +318,26 @@ def bvh_files(scenes, path: str, fps: float) -> list:
         suffix = f"-{seen[key]}" if seen[key] > 1 else ""
         out.append((f"{stem}-scene{scene_id}-{m.name}{suffix}{ext or '.bvh'}", bvh_text(m, fps, scene_id)))
     return out
+
+
+def bvh_notes(scenes) -> tuple[str, ...]:
+    """What BVH cannot carry and the files leave out: a motion's SCALE LINK and SHAPE LINK tracks, per model.
+
+    BVH has joint channels only (offsets, positions, rotations); a segment
+    that changes size or shape (morphing segments) has nothing to say it in.
+    """
+    notes = []
+    for take in scenes:
+        for m in take.models:
+            morphed = [motion.morphs for _rows, _fig, motion, _frames in m.sources if motion.morphs is not None]
+            if not morphed:
+                continue
+            kinds = sorted({k[0] for morphs in morphed for k in morphs.channels()})
+            links = sorted({k[1] for morphs in morphed for k in morphs.channels()})
+            tracks = " and ".join(f"{kind} LINK" for kind in kinds)
+            notes.append(
+                f"model {m.name} in scene {take.id} morphs its segments ({tracks} tracks of "
+                f"{', '.join(links)}), which BVH cannot carry: the file has its joints' motion only, "
+                "every segment at its own size and shape (export glTF to keep them)"
+            )
+    return tuple(notes)

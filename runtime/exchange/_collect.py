@@ -85,6 +85,11 @@ class SceneTake:
     viewed : bool
         Whether a VIEW statement ran before or during the scene (else the
         modern look frames it: docs/semantics-render.md, "Default framing").
+    framing : (ndarray (3,), ndarray (3,)) or None
+        For a scene without VIEW, the world box ``(lo, hi)`` of what it
+        draws, measured at the ticks ``liganimate run``'s default framing
+        measures (:mod:`liganimate.runtime.render.framing`); None when the
+        scene sets VIEW or draws nothing.
     """
 
     id: int
@@ -94,6 +99,7 @@ class SceneTake:
     models: list = field(default_factory=list)
     backgrounds: list = field(default_factory=list)
     viewed: bool = False
+    framing: tuple | None = None
 
 
 class _Drawn:
@@ -218,11 +224,13 @@ def collect(program, warnings: list | None = None) -> list:
     rt = program.execute("check", renderer=collector)
     if warnings is not None:
         warnings.extend(rt.warnings)
-    return [_take(rec) for rec in collector.records]
+    # The check run measured each VIEW-less scene's drawing, as it does before `liganimate run` draws.
+    framings = rt.program.framings
+    return [_take(rec, None if rec.viewed else framings.get(rec.id)) for rec in collector.records]
 
 
-def _take(rec: _SceneRecord) -> SceneTake:
-    take = SceneTake(rec.id, rec.length, rec.sameframe, rec.cameras, viewed=rec.viewed)
+def _take(rec: _SceneRecord, framing) -> SceneTake:
+    take = SceneTake(rec.id, rec.length, rec.sameframe, rec.cameras, viewed=rec.viewed, framing=framing)
     for d in rec.drawn.values():
         take.models.append(_model_take(d))
     take.backgrounds = [(obj, np.asarray(ticks, dtype=np.int64)) for obj, ticks in rec.background.values()]

@@ -193,9 +193,9 @@ def _write_gltf(scenes: Sequence[SceneTake], path: str, *, fps: float, size: tup
 
 
 def _write_bvh(scenes: Sequence[SceneTake], path: str, *, fps: float) -> Export:
-    from ._bvh_write import bvh_files
+    from ._bvh_write import bvh_files, bvh_notes
 
-    return Export(tuple(bvh_files(scenes, path, fps)))
+    return Export(tuple(bvh_files(scenes, path, fps)), bvh_notes(scenes))
 
 
 def _write_urdf(scenes: Sequence[SceneTake], path: str) -> Export:

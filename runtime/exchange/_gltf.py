@@ -258,7 +258,9 @@ class Builder:
         if len(ticks) and ticks[-1] == self.length - 1:
             ticks = np.append(ticks, self.length)
             values = np.concatenate([values, values[-1:]])
-        kind = {"translation": G.VEC3, "rotation": G.VEC4, "scale": G.VEC3}[path]
+        kind = {"translation": G.VEC3, "rotation": G.VEC4, "scale": G.VEC3, "weights": G.SCALAR}[path]
+        if path == "weights":  # (T, N) morph target weights: N scalars per key, key after key
+            values = values.reshape(-1, 1)
         sampler = G.AnimationSampler(
             input=self._times(ticks), output=self.accessor(values.astype(np.float32), kind), interpolation=interp
         )
@@ -291,10 +293,12 @@ class Builder:
             hit = self.materials[key] = len(self.doc.materials) - 1
         return hit
 
-    def mesh_by_colour(self, key, name, triangles, shade, closed):
+    def mesh_by_colour(self, key, name, triangles, shade, closed, targets=None):
         """A mesh of flat triangles, one primitive per material (colour and sidedness); None when empty.
 
-        ``shade`` is per triangle: grey levels (M,) or RGB levels (M, 3).
+        ``shade`` is per triangle: grey levels (M,) or RGB levels (M, 3);
+        ``targets`` (N, M, 3, 3), displacements of the triangles' corners, become
+        the mesh's morph targets.
         """
         if key is not None and key in self.meshes:
             return self.meshes[key]
@@ -309,16 +313,33 @@ class Builder:
                 acc = self.accessor(tris, G.VEC3, "vertex", minmax=True)
                 prims.append(
                     G.Primitive(
-                        attributes=G.Attributes(POSITION=acc), material=self.material(int(m // 2), bool(m % 2)), mode=4
+                        attributes=G.Attributes(POSITION=acc),
+                        material=self.material(int(m // 2), bool(m % 2)),
+                        mode=4,
+                        targets=self._targets(targets, mat == m),
                     )
                 )
-            self.doc.meshes.append(G.Mesh(name=name, primitives=prims))
+            self.doc.meshes.append(G.Mesh(name=name, primitives=prims, weights=self._rest_weights(targets)))
             index = len(self.doc.meshes) - 1
         if key is not None:
             self.meshes[key] = index
         return index
 
-    def mesh_by_vertex_colour(self, key, name, triangles, shade, closed, joints=None):
+    def _targets(self, targets, sel) -> list | None:
+        """The morph targets of one primitive, its triangles ``sel`` of ``targets`` (N, M, 3, 3)."""
+        if targets is None or not len(targets):
+            return None
+        out = []
+        for d in np.asarray(targets):
+            acc = self.accessor(d[sel].reshape(-1, 3).astype(np.float32), G.VEC3, "vertex", minmax=True)
+            out.append(G.Attributes(POSITION=acc))
+        return out
+
+    @staticmethod
+    def _rest_weights(targets) -> list | None:
+        return None if targets is None or not len(targets) else [0.0] * len(targets)
+
+    def mesh_by_vertex_colour(self, key, name, triangles, shade, closed, joints=None, targets=None):
         """A mesh whose triangles carry their colour as ``COLOR_0``: one primitive per sidedness.
 
         Parameters
@@ -331,6 +352,8 @@ class Builder:
         joints : ndarray of int, shape (M,), optional
             The skin joint that carries each triangle (weight 1), for a
             skinned mesh.
+        targets : ndarray, shape (N, M, 3, 3), optional
+            Morph targets: displacements of the triangles' corners.
 
         Returns
         -------
@@ -355,8 +378,10 @@ class Builder:
                 )
                 if joints is not None:
                     self._skin_attributes(attrs, np.repeat(np.asarray(joints)[sel], 3))
-                prims.append(G.Primitive(attributes=attrs, material=self.material(None, double), mode=4))
-            self.doc.meshes.append(G.Mesh(name=name, primitives=prims))
+                prim = G.Primitive(attributes=attrs, material=self.material(None, double), mode=4)
+                prim.targets = self._targets(targets, sel)
+                prims.append(prim)
+            self.doc.meshes.append(G.Mesh(name=name, primitives=prims, weights=self._rest_weights(targets)))
             index = len(self.doc.meshes) - 1
         if key is not None:
             self.meshes[key] = index

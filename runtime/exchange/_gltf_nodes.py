@@ -11,9 +11,12 @@ node's world transform is exactly the ``--poses`` matrix of that segment,
 
 from __future__ import annotations
 
+import numpy as np
+
 from liganimate.runtime.values import Graphical
 
 from ._gltf import joint_motion, moving_joints
+from ._gltf_morph import link_morphs
 from ._names import joint_names, link_names
 
 __all__ = ["node_rig"]
@@ -30,7 +33,10 @@ def node_rig(b, take, model, anim, interp) -> list[int]:
     sourced = joint_names(fig)
     scales = fig.link_scales
     loc1, loc2 = fig.locations
-    seg = {fig.main: _segment(b, take, model, f"{label} {names[fig.main]}", fig.main, root)}
+    morphs = link_morphs(model)
+    seg = {
+        fig.main: _segment(b, take, model, f"{label} {names[fig.main]}", fig.main, root, morphs=(morphs, anim, interp))
+    }
     for level in fig.traversal:
         for k, p, c, r in zip(level.joints, level.parents, level.children, level.reversed):
             near, far = (loc2[k], loc1[k]) if r else (loc1[k], loc2[k])
@@ -50,17 +56,19 @@ def node_rig(b, take, model, anim, interp) -> list[int]:
                 b.channel(anim, jn, "rotation", model.ticks, qj[:, k], interp)
             if sliding[k]:
                 b.channel(anim, jn, "translation", model.ticks, place, interp)
-            seg[c] = _segment(b, take, model, f"{label} {names[c]}", c, jn, offset=-far)
+            seg[c] = _segment(b, take, model, f"{label} {names[c]}", c, jn, offset=-far, morphs=(morphs, anim, interp))
     return [root]
 
 
-def _segment(b, take, model, name, i, parent, offset=None) -> int:
+def _segment(b, take, model, name, i, parent, offset=None, morphs=({}, None, None)) -> int:
+    """A segment's node (with its mesh; a morphed segment's mesh on a shape node under it)."""
     fig = model.figure
     link = fig.links[i]
     up = fig.parent_joint_of(i)
     g = link.shape
     mesh = None
-    if isinstance(g, Graphical) and len(g):
+    morph = morphs[0].get(i)
+    if isinstance(g, Graphical) and len(g) and morph is None:
         mesh = b.mesh_by_colour(("link", id(g)), link.label, g.triangles, g.shades(), g.closed)
     n = b.node(
         name=name,
@@ -81,4 +89,25 @@ def _segment(b, take, model, name, i, parent, offset=None) -> int:
     if link.scale != 1.0:
         node.scale = [link.scale] * 3
     b.doc.nodes[parent].children.append(n)
+    if morph is not None and isinstance(g, Graphical) and len(g):
+        _shape_node(b, model, (name, n), g, morph, link.scale < 0, morphs[1:])
     return n
+
+
+def _shape_node(b, model, where, g, morph, mirrored, animation) -> None:
+    """A morphed segment's mesh on a node of its own: its SCALE track as a scale channel, its SHAPE track as morph targets."""
+    name, segment = where
+    anim, interp = animation
+    # The morphs' targets follow the renderer's table, which rewinds a mirrored link's triangles.
+    targets = [t[:, ::-1, :] if mirrored else t for t in morph.targets]
+    deltas = np.array([t - g.triangles for t in targets]).reshape(-1, len(g), 3, 3)
+    mesh = b.mesh_by_colour(None, f"{name} shape", g.triangles, g.shades(), g.closed, targets=deltas)
+    n = b.node(name=f"{name} shape", mesh=mesh, extras={"liganimate": {"model": model.name, "morph": True}})
+    b.doc.nodes[segment].children.append(n)
+    node = b.doc.nodes[n]
+    if morph.scale is not None:
+        node.scale = [float(v) for v in morph.scale[0]]
+        b.channel(anim, n, "scale", model.ticks, morph.scale, interp)
+    if len(targets):
+        node.weights = [float(v) for v in morph.weights[0]]
+        b.channel(anim, n, "weights", model.ticks, morph.weights, interp)

@@ -34,6 +34,7 @@ import pygltflib as G
 from liganimate.runtime.figure.pose import mesh_table
 
 from ._gltf import joint_motion, moving_joints
+from ._gltf_morph import link_morphs, skin_targets
 from ._names import added_origin, joint_names, link_names
 
 __all__ = ["skin_rig"]
@@ -80,7 +81,9 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
         inverseBindMatrices=b.accessor(ibm.reshape(len(order), 16), G.MAT4, "ibm"),
     )
     b.doc.skins.append(skin)
-    mesh = _skinned_mesh(b, model, order, rest, pivot)
+    morphs = link_morphs(model)
+    targets, weights = skin_targets(morphs, mesh_table(fig), fig.link_scales) if morphs else (None, None)
+    mesh = _skinned_mesh(b, model, order, rest, pivot, morphs, targets)
     if mesh is None:
         return [root]
     node = b.node(
@@ -89,6 +92,9 @@ def skin_rig(b, take, model, anim, interp) -> list[int]:
         skin=len(b.doc.skins) - 1,
         extras={"liganimate": {"scene": take.id, "model": model.name}},
     )
+    if weights is not None and weights.size:
+        b.doc.nodes[node].weights = [float(v) for v in weights[0]]
+        b.channel(anim, node, "weights", model.ticks, weights, interp)
     return [root, node]
 
 
@@ -115,7 +121,7 @@ def _bone(b, take, model, names, i: int, joint, parent: int) -> int:
     return n
 
 
-def _skinned_mesh(b, model, order, rest, pivot):
+def _skinned_mesh(b, model, order, rest, pivot, morphs=None, targets=None):
     """The figure's segments as one mesh in the rest pose, each vertex bound to its segment's bone."""
     fig = model.figure
     table = mesh_table(fig)  # link coordinates; a mirrored link's triangles already rewound
@@ -124,7 +130,7 @@ def _skinned_mesh(b, model, order, rest, pivot):
     # The renderer culls nothing of a model its placement mirrors; neither does the export.
     mirrored = bool((np.linalg.det(model.placements[:, :3, :3]) < 0).any())
     key = ("skin", id(fig.links), id(fig.joints), fig.main, mirrored)
-    if key in b.meshes:
+    if key in b.meshes and not morphs:
         return b.meshes[key]
     scale = fig.link_scales[table.link]
     shift = rest[table.link] - pivot[table.link]
@@ -132,4 +138,6 @@ def _skinned_mesh(b, model, order, rest, pivot):
     joint_of = np.zeros(fig.n_links, dtype=np.int64)
     joint_of[order] = np.arange(len(order))
     closed = table.closed & (not mirrored)
+    if morphs:  # its SCALE and SHAPE tracks: morph targets of this take's own mesh
+        return b.mesh_by_vertex_colour(None, model.name, tris, table.shade, closed, joint_of[table.link], targets)
     return b.mesh_by_vertex_colour(key, model.name, tris, table.shade, closed, joints=joint_of[table.link])

@@ -86,7 +86,12 @@ class JointAxes:
 def _limb_axis(fig, k: int) -> np.ndarray:
     joint = fig.joints[k]
     link = joint.secondary
-    ends = [c.loc1 for c in fig.child_joints_of(link)]
+    # The link's other joints, wherever they sit in the tree (a re-rooted
+    # submodel's joints may hang the link's own primary from it), each at
+    # its location on this link.
+    up = fig.parent_joint_of(link)
+    others = [c for c in ((up,) if up is not None else ()) + fig.child_joints_of(link) if c is not joint]
+    ends = [c.loc1 if c.primary == link else c.loc2 for c in others]
     if ends:
         u = np.mean(ends, axis=0) - joint.loc2
     else:

@@ -1,7 +1,7 @@
 """The studio page: built once when the server starts, the model's triangles inlined.
 
-The page is ``studio.html`` with ``studio.css``, the viewer's ``gl.js`` and
-``studio.js`` inlined, and the model's segments (triangles in segment
+The page is ``studio.html`` with ``studio.css``, the viewer's drawing code
+(``shadow.js`` and ``gl.js``) and ``studio.js`` inlined, and the model's segments (triangles in segment
 coordinates, grey levels, names, joints) in the same compact form the
 viewer uses.  The poses themselves come from the server as segment
 matrices.
@@ -18,7 +18,7 @@ import numpy as np
 from liganimate import __version__
 from liganimate.runtime.figure.pose import mesh_table
 from liganimate.runtime.values import rgb_levels
-from liganimate.runtime.view import Blob, asset, fill, inline_code, json_for_script
+from liganimate.runtime.view import Blob, fill, gl_script, inline_code, json_for_script
 
 from ._generator import POPULATION
 
@@ -87,7 +87,7 @@ def studio_page(generator, title: str) -> str:
             "CSS": inline_code(_own("studio.css")),
             "MANIFEST": json_for_script(manifest),
             "BLOB": base64.b64encode(blob.tobytes()).decode("ascii"),
-            "GLJS": inline_code(asset("gl.js")),
+            "GLJS": gl_script(),
             "STUDIOJS": inline_code(_own("studio.js")),
         },
     )

@@ -82,8 +82,10 @@
       if (tint) { r = (r + tint[0]) >> 1; gg = (gg + tint[1]) >> 1; b = (b + tint[2]) >> 1; }
       for (var k = 0; k < 3; k++) { col[o++] = r; col[o++] = gg; col[o++] = b; }
     }
-    v.renderer.draw({ pos: v.pos, col: v.col, ranges: [{ first: 0, count: NV + (withFloor ? 6 : 0), cam: v.cam }] },
-      v.bounds);
+    // The figure casts the contact shadow, the floor receives it.
+    var objects = [{ first: 0, count: NV }].concat(withFloor ? [{ first: NV, count: 6 }] : []);
+    v.renderer.draw({ pos: v.pos, col: v.col, ranges: [{ first: 0, count: NV + (withFloor ? 6 : 0), cam: v.cam }],
+      objects: objects }, v.bounds);
   }
   function paintAll() { views.forEach(function (v) { paint(v); }); }
 

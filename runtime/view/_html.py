@@ -1,6 +1,6 @@
 """The viewer's page: one self-contained HTML file, its script and style inlined.
 
-The JavaScript and CSS are package data files (``gl.js``, ``viewer.js``,
+The JavaScript and CSS are package data files (``shadow.js``, ``gl.js``, ``viewer.js``,
 ``viewer.css``, the ``viewer.html`` template) read when a page is built.
 Nothing in the page refers to anything outside it: a Content-Security-Policy
 of ``default-src 'none'`` forbids every request, so a page opened from a
@@ -21,7 +21,7 @@ from liganimate import __version__
 
 from ._scene_data import Blob, scene_manifest
 
-__all__ = ["asset", "fill", "iframe", "json_for_script", "viewer_html"]
+__all__ = ["asset", "fill", "gl_script", "iframe", "json_for_script", "viewer_html"]
 
 _SLOT = re.compile(r"\{\{([A-Z]+)\}\}")
 _CLOSERS = re.compile(r"</(script|style)", re.IGNORECASE)
@@ -50,6 +50,11 @@ def inline_code(text: str) -> str:
     if _CLOSERS.search(text):
         raise ValueError("inlined code must not hold a </script or </style")
     return text
+
+
+def gl_script() -> str:
+    """The drawing code the viewer and the studio share: ``shadow.js`` (the contact shadow) and ``gl.js``."""
+    return inline_code(asset("shadow.js") + "\n" + asset("gl.js"))
 
 
 def json_for_script(value) -> str:
@@ -83,7 +88,7 @@ def viewer_html(scenes, title: str) -> str:
             "CSS": inline_code(asset("viewer.css")),
             "MANIFEST": json_for_script(manifest),
             "BLOB": base64.b64encode(blob.tobytes()).decode("ascii"),
-            "GLJS": inline_code(asset("gl.js")),
+            "GLJS": gl_script(),
             "VIEWERJS": inline_code(asset("viewer.js")),
         },
     )

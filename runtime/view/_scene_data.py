@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from liganimate.runtime.figure.pose import mesh_table, static_triangles, world_transforms
+from liganimate.runtime.figure.pose import mesh_table, morphed, static_triangles, world_transforms, world_triangles
 from liganimate.runtime.render.framing import framing_view
 from liganimate.runtime.values import Graphical, rgb_levels
 
@@ -92,11 +92,25 @@ def _link_boxes(table, n_links: int) -> np.ndarray:
     return np.where(sel[None], hi[:, None, :], lo[:, None, :])
 
 
+def _morphs(take, X: np.ndarray, table) -> tuple[np.ndarray, np.ndarray | None]:
+    """The take's SCALE tracks folded into ``X``, and its SHAPE tracks' triangles per tick (None without)."""
+    local = None
+    for rows, fig, motion, frames in take.sources:
+        if motion.morphs is None:
+            continue
+        X[rows], shaped = morphed(fig, motion, frames, X[rows])
+        if shaped is not None:
+            if local is None:
+                local = np.broadcast_to(table.triangles, (len(X), *table.triangles.shape)).copy()
+            local[rows] = shaped
+    return X, local
+
+
 def _model_entry(take, blob: Blob, extent: list) -> dict:
     fig = take.figure
     L = fig.n_links
-    X = world_transforms(fig, take.angles, take.placements)  # (T, L, 4, 4)
     table = mesh_table(fig)
+    X, local = _morphs(take, world_transforms(fig, take.angles, take.placements), table)  # (T, L, 4, 4)
     boxes = _link_boxes(table, L)  # (L, 8, 3)
     world = np.einsum("tlij,lkj->tlki", X[..., :3, :3], boxes) + X[:, :, None, :3, 3]
     extent.append(world.reshape(-1, 3))
@@ -113,7 +127,17 @@ def _model_entry(take, blob: Blob, extent: list) -> dict:
                 "slide": bool(j.slide),  # its values are a displacement, not degrees
             }
         )
+    morph = None
+    if local is not None:
+        moving = np.flatnonzero((local != table.triangles[None]).any(axis=(0, 2, 3)))
+        # (the boxes above are the links' own: a morphed shape that reaches further is still framed by them)
+        extent.append(world_triangles(table, X, local).reshape(-1, 3))
+        morph = {
+            "rows": blob.add(moving, np.uint32),
+            "pos": blob.add(local[:, moving].reshape(-1), np.float32),
+        }
     return {
+        "morph": morph,
         "name": take.name,
         "links": [link.name if link.name is not None else "<anonymous>" for link in fig.links],
         "jointOfLink": joint_of_link,
@@ -162,9 +186,10 @@ def scene_manifest(scenes, blob: Blob) -> list:
         One JSON-ready entry per scene: ``id``, ``length``, ``sameframe``,
         ``cameras`` (per tick: eye x, y, z and VIEW WIDTH, float32),
         ``bounds`` (centre x, y, z and radius of everything drawn),
-        ``framing`` (for a scene that sets no VIEW: the modern look's
-        camera, ``eye``, ``target`` and ``k``, the view width over the
-        distance, framing everything drawn in a 4:3 picture; else None),
+        ``framing`` (for a scene that sets no VIEW: the camera
+        ``liganimate run`` uses for it in the modern look at 640x480,
+        ``eye``, ``target``, ``width`` and ``k``, the view width over the
+        distance, from the box the program's check measured; else None),
         ``models`` and ``backgrounds``.
     """
     out = []
@@ -176,11 +201,11 @@ def scene_manifest(scenes, blob: Blob) -> list:
         pts = np.concatenate(extent)
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         framing = None
-        if not take.viewed and len(pts) > 1:
-            drawn = pts[1:]  # without the origin that seeds the extent
-            eye, width, target = framing_view((drawn.min(axis=0), drawn.max(axis=0)), (640, 480))
+        if take.framing is not None:
+            # The camera `liganimate run` uses for this scene at the viewer's 4:3 shape.
+            eye, width, target = framing_view(take.framing, (640, 480))
             distance = float(np.linalg.norm(np.subtract(eye, target)))
-            framing = {"eye": list(eye), "target": list(target), "k": width / distance}
+            framing = {"eye": list(eye), "target": list(target), "k": width / distance, "width": width}
         centre = (lo + hi) / 2
         radius = float(np.linalg.norm(hi - lo) / 2) or 1.0
         out.append(

@@ -7,8 +7,9 @@
  * 'modern' (the default), each face lit by the same key light and ambient
  * term as the rasterizer's modern look, outlines along silhouettes,
  * creases (normals over 50 degrees apart) and changes of colour, the
- * same grey background, and edges smoothed by the browser's multisampling
- * (the contact shadow is the rasterizer's alone);
+ * same grey background, edges smoothed by the browser's multisampling, and
+ * the same soft contact shadow (shadow.js, computed from each picture's
+ * pose);
  * segment matrices come from the runtime, one 3x4 row-major block per
  * segment.  This file only multiplies vertices by those matrices: it never
  * turns joint angles into transforms.
@@ -23,6 +24,12 @@ var LigGL = (function () {
   var VS = 'attribute vec3 p; attribute vec3 c; uniform mat4 mvp; varying vec3 vc;' +
     'void main() { vc = c; gl_Position = mvp * vec4(p, 1.0); }';
   var FS = 'precision highp float; varying vec3 vc; void main() { gl_FragColor = vec4(vc, 1.0); }';
+  /* The contact shadow: a square on the ground whose texture (shadow.js) multiplies the colour under it. */
+  var SHADOW_VS = 'attribute vec3 p; uniform mat4 mvp; uniform vec3 map; varying vec2 uv;' +
+    'void main() { uv = vec2(0.5 - (p.x - map.x) * map.z, 0.5 + (p.z - map.y) * map.z);' +
+    ' gl_Position = mvp * vec4(p, 1.0); }';
+  var SHADOW_FS = 'precision mediump float; uniform sampler2D keep; varying vec2 uv;' +
+    'void main() { gl_FragColor = vec4(texture2D(keep, uv).rrr, 1.0); }';
   var PARALLEL_SINE = 1e-9;
 
   function sub(a, b) { return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]; }
@@ -117,16 +124,7 @@ var LigGL = (function () {
     if (!gl) throw new Error('this browser has no WebGL, which the viewer needs');
     this.gl = gl;
     this.canvas = canvas;
-    var prog = gl.createProgram();
-    [[gl.VERTEX_SHADER, VS], [gl.FRAGMENT_SHADER, FS]].forEach(function (s) {
-      var sh = gl.createShader(s[0]);
-      gl.shaderSource(sh, s[1]);
-      gl.compileShader(sh);
-      if (!gl.getShaderParameter(sh, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(sh));
-      gl.attachShader(prog, sh);
-    });
-    gl.linkProgram(prog);
-    if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+    var prog = program(gl, VS, FS);
     this.prog = prog;
     this.aP = gl.getAttribLocation(prog, 'p');
     this.aC = gl.getAttribLocation(prog, 'c');
@@ -136,6 +134,34 @@ var LigGL = (function () {
     this.linePos = gl.createBuffer();
     this.lineCol = gl.createBuffer();
     this.capacity = 0;
+    if (modern) {
+      var sp = this.shadowProg = program(gl, SHADOW_VS, SHADOW_FS);
+      this.sP = gl.getAttribLocation(sp, 'p');
+      this.sM = gl.getUniformLocation(sp, 'mvp');
+      this.sMap = gl.getUniformLocation(sp, 'map');
+      this.sKeep = gl.getUniformLocation(sp, 'keep');
+      this.shadowQuad = gl.createBuffer();
+      this.shadowTex = gl.createTexture();
+      gl.bindTexture(gl.TEXTURE_2D, this.shadowTex);
+      // The renderer looks up the texel a point falls in: nearest, no mipmaps.
+      [[gl.TEXTURE_MIN_FILTER, gl.NEAREST], [gl.TEXTURE_MAG_FILTER, gl.NEAREST], [gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE],
+        [gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE]].forEach(function (p) { gl.texParameteri(gl.TEXTURE_2D, p[0], p[1]); });
+    }
+  }
+
+  /* A linked shader program, or an Error with the compiler's log. */
+  function program(gl, vs, fs) {
+    var prog = gl.createProgram();
+    [[gl.VERTEX_SHADER, vs], [gl.FRAGMENT_SHADER, fs]].forEach(function (s) {
+      var sh = gl.createShader(s[0]);
+      gl.shaderSource(sh, s[1]);
+      gl.compileShader(sh);
+      if (!gl.getShaderParameter(sh, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(sh));
+      gl.attachShader(prog, sh);
+    });
+    gl.linkProgram(prog);
+    if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+    return prog;
   }
 
   /* Lit colours (modern look): each triangle's colour times ambient + key * max(0, n . L),
@@ -200,8 +226,52 @@ var LigGL = (function () {
     });
   }
 
+  /* Bounds [cx, cy, cz, radius] grown to hold the shadow's square on the ground (near and far planes). */
+  function holdingShadow(bounds, m) {
+    var r = bounds[3], h = m.extent / 2;
+    [[-h, -h], [-h, h], [h, -h], [h, h]].forEach(function (d) {
+      var x = m.cx + d[0] - bounds[0], y = m.ground - bounds[1], z = m.cz + d[1] - bounds[2];
+      r = Math.max(r, Math.sqrt(x * x + y * y + z * z));
+    });
+    return [bounds[0], bounds[1], bounds[2], r];
+  }
+
+  /* Lay the contact shadow m (LigShadow.compute) on the ground: a square that multiplies the colour
+   * under it, behind what is drawn in front of the ground, writing no depth. */
+  Renderer.prototype.shadow = function (m, cam, bounds) {
+    var gl = this.gl, c = this.canvas, n = LigShadow.params.texels, h = m.extent / 2, y = m.ground;
+    var x0 = m.cx - h, x1 = m.cx + h, z0 = m.cz - h, z1 = m.cz + h;
+    gl.useProgram(this.shadowProg);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, this.shadowTex);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.LUMINANCE, n, n, 0, gl.LUMINANCE, gl.UNSIGNED_BYTE, m.keep);
+    gl.uniform1i(this.sKeep, 0);
+    gl.uniform3f(this.sMap, m.cx, m.cz, 1 / m.extent);
+    gl.uniformMatrix4fv(this.sM, false, projection(cam, c.width, c.height, bounds).mvp);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.shadowQuad);
+    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([x0, y, z0, x0, y, z1, x1, y, z1, x0, y, z0, x1, y, z1, x1, y, z0]),
+      gl.DYNAMIC_DRAW);
+    gl.disableVertexAttribArray(this.aC);
+    gl.enableVertexAttribArray(this.sP);
+    gl.vertexAttribPointer(this.sP, 3, gl.FLOAT, false, 0, 0);
+    // The faces sit a little behind their own depth (polygon offset), so a floor at the ground lets the square through.
+    gl.disable(gl.POLYGON_OFFSET_FILL);
+    gl.depthMask(false);
+    gl.enable(gl.BLEND);
+    gl.blendFunc(gl.ZERO, gl.SRC_COLOR);
+    gl.drawArrays(gl.TRIANGLES, 0, 6);
+    gl.disable(gl.BLEND);
+    gl.depthMask(true);
+    gl.useProgram(this.prog);
+    gl.enableVertexAttribArray(this.aP);
+    gl.enableVertexAttribArray(this.aC);
+  };
+
   /* Draw one picture.  frame = {pos: Float32Array, col: Uint8Array,
-   * ranges: [{first, count, cam}]} with first/count in vertices. */
+   * ranges: [{first, count, cam}], objects: [{first, count}]} with first/count
+   * in vertices; objects are what casts or receives the contact shadow one by
+   * one (the figures, the background objects; the ranges when not given). */
   Renderer.prototype.draw = function (frame, bounds) {
     var gl = this.gl, c = this.canvas, modern = this.look === 'modern';
     gl.viewport(0, 0, c.width, c.height);
@@ -213,7 +283,7 @@ var LigGL = (function () {
     gl.depthFunc(gl.LEQUAL);
     gl.useProgram(this.prog);
     var n = frame.pos.length;
-    var lines = [], lineCol = [], lineRanges = [];
+    var lines = [], lineCol = [], lineRanges = [], shadow = null, shadowCam = null;
     if (modern) {
       var shaded = new Uint8Array(n);
       for (var q = 0; q < frame.ranges.length; q++) {
@@ -223,7 +293,10 @@ var LigGL = (function () {
         var l0 = lines.length / 3;
         outlines(frame.pos, frame.col, rg.first, rg.count, rg.cam, normals, lines, lineCol);
         lineRanges.push({ first: l0, count: lines.length / 3 - l0, cam: rg.cam });
+        shadowCam = rg.cam;  // the renderer lays the shadow through the picture's last camera
       }
+      shadow = LigShadow.compute(frame.pos, frame.objects || frame.ranges);
+      if (shadow) bounds = holdingShadow(bounds, shadow);
       frame = { pos: frame.pos, col: shaded, ranges: frame.ranges };
       // Faces a little behind their outlines, so the lines win at equal depth.
       gl.enable(gl.POLYGON_OFFSET_FILL);
@@ -245,6 +318,8 @@ var LigGL = (function () {
       gl.uniformMatrix4fv(this.uM, false, projection(r.cam, c.width, c.height, bounds).mvp);
       gl.drawArrays(gl.TRIANGLES, r.first, r.count);
     }
+    if (shadow) this.shadow(shadow, shadowCam, bounds);
+    this.lastShadow = shadow;
     if (lines.length) {
       gl.bindBuffer(gl.ARRAY_BUFFER, this.linePos);
       gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(lines), gl.DYNAMIC_DRAW);

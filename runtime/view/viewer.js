@@ -40,7 +40,10 @@
       return {
         name: m.name, links: m.links, jointOfLink: m.jointOfLink, joints: m.joints,
         local: V(m.mesh.pos), link: V(m.mesh.link), rgb: V(m.mesh.rgb),
-        rowOf: rowOf, matrices: V(m.matrices), angles: V(m.angles), L: m.links.length, J: m.joints.length
+        rowOf: rowOf, matrices: V(m.matrices), angles: V(m.angles), L: m.links.length, J: m.joints.length,
+        // Morphing segments (SHAPE LINK tracks): the rows that move, and their corners at each drawn tick.
+        morphRows: m.morph ? V(m.morph.rows) : null, morphPos: m.morph ? V(m.morph.pos) : null,
+        scratch: m.morph ? new Float32Array(V(m.mesh.pos)) : null
       };
     });
     var backgrounds = s.backgrounds.map(function (b) {
@@ -85,12 +88,24 @@
     return [t0, Math.min(s.length, t0 + s.k) - 1];
   }
 
+  /* A model's triangles in their links' coordinates at one drawn tick: its own, or, where a
+   * motion morphs segments, with the morphed rows' corners of that tick written in. */
+  function shapeAt(m, row) {
+    if (!m.morphRows) return m.local;
+    var R = m.morphRows.length, local = m.scratch, pos = m.morphPos;
+    for (var q = 0; q < R; q++) {
+      var dst = m.morphRows[q] * 9, from = (row * R + q) * 9;
+      for (var c = 0; c < 9; c++) local[dst + c] = pos[from + c];
+    }
+    return local;
+  }
+
   function build() {
     var s = scenes[state.scene];
     var need = s.capacity * 9 + 9;
     if (frame.pos.length < need) { frame.pos = new Float32Array(need); frame.col = new Uint8Array(need); }
     var pos = frame.pos, col = frame.col, o = 0, oc = 0;
-    var ranges = [], spans = [];
+    var ranges = [], spans = [], objects = [];
     var tr = tickRange(s, state.image);
     var mark = state.pinned || state.hover;
     var add = function (first, cam) {
@@ -105,6 +120,7 @@
       var first = o / 3;
       pos.set(b.pos, o); o += b.pos.length;
       oc = LigGL.colours(col, oc, b.rgb, null, -1, TINT);
+      objects.push({ first: first, count: o / 3 - first });
       add(first, cam0);
     });
     for (var t = tr[0]; t <= tr[1]; t++) {
@@ -113,22 +129,24 @@
         var m = s.models[mi], row = m.rowOf[t];
         if (row < 0) continue;
         var first = o / 3;
-        o = LigGL.transform(pos, o, m.local, m.link, m.matrices, row * m.L * 12);
+        o = LigGL.transform(pos, o, shapeAt(m, row), m.link, m.matrices, row * m.L * 12);
         var tint = mark && mark.model === mi && mark.tick === t ? mark.link : -1;
         oc = LigGL.colours(col, oc, m.rgb, m.link, tint, TINT);
         spans.push({ first: first, count: o / 3 - first, model: mi, tick: t, row: row, cam: cam });
+        objects.push({ first: first, count: o / 3 - first });
         add(first, cam);
       }
     }
     frame.ranges = ranges;
     frame.spans = spans;
+    frame.objects = objects;  // each casts or receives the contact shadow as one object
     frame.used = o;
   }
 
   function draw() {
     build();
     renderer.draw({ pos: frame.pos.subarray(0, frame.used), col: frame.col.subarray(0, frame.used),
-      ranges: frame.ranges }, scenes[state.scene].bounds);
+      ranges: frame.ranges, objects: frame.objects }, scenes[state.scene].bounds);
     showFrame();
     showInfo();
   }
@@ -332,6 +350,8 @@
       draw();
     },
     camera: function () { return state.userCam; },
+    /* The camera the current frame starts from before any orbit: VIEW's, or run's default framing. */
+    sceneCamera: function () { var s = scenes[state.scene]; return sceneCamera(s, tickRange(s, state.image)[0]); },
     ready: performance.now()
   };
 })();

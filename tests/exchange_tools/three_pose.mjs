@@ -52,6 +52,21 @@ for (const [s, scene] of gltf.scenes.entries()) {
         tick.segments.push({model: info.model, segment: info.segment, matrix: Array.from(o.matrixWorld.elements)});
       }
     });
+    // Meshes with morph targets outside a skin (the nodes rig's shape nodes): their vertices, morphed.
+    tick.morphed = [];
+    scene.traverse((o) => {
+      if (o.isMesh && !o.isSkinnedMesh && o.morphTargetInfluences) {
+        const pos = o.geometry.attributes.position;
+        const v = new THREE.Vector3();
+        const flat = new Array(pos.count * 3);
+        for (let i = 0; i < pos.count; i++) {
+          o.getVertexPosition(i, v);  // morphed, in the mesh's space
+          v.applyMatrix4(o.matrixWorld);
+          flat[3 * i] = v.x; flat[3 * i + 1] = v.y; flat[3 * i + 2] = v.z;
+        }
+        tick.morphed.push({name: o.name, vertices: flat});
+      }
+    });
     for (const m of skinned) {
       const world = m.skeleton.bones.map((b) => Array.from(b.matrixWorld.elements));
       m.skeleton.update();

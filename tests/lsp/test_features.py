@@ -177,3 +177,29 @@ def test_what_hover_reads_is_what_the_run_prints(tmp_path):
     printed = printed_tables(appendix.replace("*     SHOOTSCENE", "      PRINT $HUMAN\n*     SHOOTSCENE"), path)
     assert {j.ident: j.extremes for j in human.joints} == printed["HUMAN"]
     assert compared >= 15, compared
+
+
+def test_hover_holds_a_re_rooted_submodel_by_the_link_figure_chose(tmp_path):
+    """After FIGURE S MAIN LINK C, a JOINT takes S by C (thesis 3.3): the joint's links say so."""
+    from liganimate.lsp import statics
+
+    text = (
+        "      GRAPHICAL A, B, LEG, FOOT\n"
+        "      MODEL S, M, K\n"
+        + "".join(f"      {g} :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0\n" for g in ("A", "B", "LEG", "FOOT"))
+        + "      S :- JOINT 1, B, (0.0, -1.0, 0.0), LEG, (0.0, 1.0, 0.0), (0.0, 90.0)\n"
+        "      S :- JOINT 3, S, (0.0, 1.0, 0.0), FOOT, (0.0, 0.0, 0.0), (0.0, 90.0)\n"
+        "      FIGURE S MAIN LINK LEG\n"
+        "      M :- JOINT 2, A, (1.0, 0.0, 0.0), S, (0.5, 0.0, 0.0), (0.0, 90.0)\n"
+        "      FIGURE S MAIN JOINT 3\n"
+        "      K :- JOINT 4, A, (1.0, 0.0, 0.0), S, (0.5, 0.0, 0.0), (0.0, 90.0)\n"
+    )
+    a = analyse(text, str(tmp_path / "graft.lig"))
+    assert a.env is not None
+    s, m, k = (a.env.values[n] for n in ("S", "M", "K"))
+    assert isinstance(m, statics.ModelValue) and isinstance(k, statics.ModelValue)
+    assert s.main == "B" and s.current == "FOOT"
+    links = {j.ident: (j.parent, j.child) for j in m.joints}
+    assert links[2] == ("A", "LEG")
+    assert {j.ident: (j.parent, j.child) for j in k.joints}[4] == ("A", "FOOT")
+    assert "animated from FOOT" in statics.describe(s)

@@ -39,6 +39,9 @@ class ModelValue:
 
     joints: tuple | None  # of Joint, sorted by identifier
     main: str | None = None  # the original main link's name
+    # The link FIGURE made main (None: the original one, "?": not known from
+    # the text): where a JOINT that takes this model as its secondary holds it.
+    current: str | None = None
 
 
 @dataclass(frozen=True)
@@ -152,7 +155,10 @@ class Evaluator:
         if all(isinstance(p, tuple) and len(p) == 3 and p[0] == "pair" for p in pairs):
             extremes = tuple((p[1], p[2]) for p in pairs) + ((0.0, 0.0),) * (3 - len(pairs))
         parent = _link(primary, args[1])
-        child = _link(secondary, args[3])
+        # A secondary model is held by its current main link (thesis 3.3), a primary by its original one.
+        child = (
+            (secondary.current or secondary.main) if isinstance(secondary, ModelValue) else _link(secondary, args[3])
+        )
         joints: list | None = []
         for part in (primary, secondary):
             if isinstance(part, ModelValue):
@@ -161,7 +167,8 @@ class Evaluator:
             return ModelValue(None, parent)
         joints.append(Joint(ident, parent, child, extremes))
         main = primary.main if isinstance(primary, ModelValue) else parent
-        return ModelValue(tuple(sorted(joints, key=lambda j: j.ident)), main)
+        current = primary.current if isinstance(primary, ModelValue) else None  # the result keeps the primary's
+        return ModelValue(tuple(sorted(joints, key=lambda j: j.ident)), main, current)
 
     def _strip(self, e: A.Strip):
         m = self._value(e.motion)
@@ -235,20 +242,20 @@ def _link(value, node) -> str | None:
 
 def _shift(v: ModelValue, by) -> ModelValue:
     if not isinstance(by, int):
-        return ModelValue(None, v.main)
+        return replace(v, joints=None)
     assert v.joints is not None
-    return ModelValue(tuple(replace(j, ident=j.ident + by) for j in v.joints), v.main)
+    return replace(v, joints=tuple(replace(j, ident=j.ident + by) for j in v.joints))
 
 
 def _scale_extremes(v: ModelValue, r) -> ModelValue:
     assert v.joints is not None
     if not _is_number(r):
-        return ModelValue(tuple(replace(j, extremes=None) for j in v.joints), v.main)
+        return replace(v, joints=tuple(replace(j, extremes=None) for j in v.joints))
     out = []
     for j in v.joints:
         ext = None if j.extremes is None else tuple(tuple(sorted((lo * r, hi * r))) for lo, hi in j.extremes)
         out.append(replace(j, extremes=ext))
-    return ModelValue(tuple(out), v.main)
+    return replace(v, joints=tuple(out))
 
 
 class _Statements:
@@ -326,7 +333,7 @@ class _Statements:
         root = False
         for mj in s.joints:
             if isinstance(mj.joint, A.RootTrack):
-                root = True
+                root = root or not mj.joint.orientation  # ROOT ORIENTATION turns, it carries no path
             else:
                 ident = self.ev.value(mj.joint)
                 if isinstance(ident, int) and joints is not None:
@@ -367,7 +374,19 @@ class _Statements:
             self.set(s.translate.name, None)
 
     def s_FigureStmt(self, s: A.FigureStmt) -> None:
-        pass  # the structure and extremes stay; only the main link changes
+        """The structure and extremes stay; the main link a later JOINT holds the model by changes."""
+        m = self.env.values.get(s.model.name)
+        if not isinstance(m, ModelValue):
+            return
+        current: str | None = "?"
+        if s.kind is None:
+            current = None
+        elif s.kind == "LINK" and s.link is not None:
+            current = s.link.name
+        elif s.kind == "JOINT" and m.joints is not None:
+            ident = self.ev.value(s.joint)
+            current = next((j.child for j in m.joints if j.ident == ident and j.child), "?")
+        self.set(s.model.name, replace(m, current=current))
 
 
 def evaluate(program: A.Program, loaded: dict | None = None) -> Env:
@@ -436,6 +455,8 @@ def _describe_model(m: ModelValue) -> str:
     head = f"{len(m.joints)} joint{'s' if len(m.joints) != 1 else ''}"
     if m.main:
         head += f", main link {m.main}"
+    if m.current and m.current != "?":
+        head += f", animated from {m.current}"
     return head + "\n\n" + "\n".join(rows)
 
 

@@ -513,3 +513,52 @@ def test_awkward_joint_names_become_safe_segment_names(tmp_path):
     take = X.collect(load_program(_player(tmp_path, lib, "ODD", "MOVE", 2))[0])[0].models[0]
     assert take.figure.n_joints == 10
     assert [l.name for l in take.figure.links[1:]] == segments
+
+
+# The humanoid held by its right foot on a plinth (a submodel attached by the link FIGURE chose,
+# thesis 3.3), then animated from its left foot: joints walked from their secondaries twice over.
+STATUE = """\
+      LOAD HUMANOID, SQUAT FROM 'humanoid'
+      GRAPHICAL PLINTH
+      MODEL STATUE
+      PLINTH :- BOX WIDTH 1.0, HEIGHT 0.4, DEPTH 1.0
+      FIGURE HUMANOID MAIN LINK R_FOOT
+      STATUE :- JOINT 99, PLINTH, (0.0, 0.2, 0.0), HUMANOID, (0.0, -0.05, 0.0), (-30.0, 30.0)
+      FIGURE STATUE MAIN LINK L_FOOT
+      INITIALIZE SCENE 1
+      STARTSCENE LENGTH 20
+        ANIMATE STATUE FROM 0 TO 19 USING SQUAT
+        STATUE :- STATUE <ROT Y 30.0>
+      ENDSCENE
+      SHOOTSCENES
+"""
+
+
+def test_round_trip_of_a_figure_built_from_a_re_rooted_submodel_keeps_every_joint_in_place(tmp_path):
+    src = _write(tmp_path, "statue.lig", STATUE)
+    bvh = str(tmp_path / "statue.bvh")
+    done = _cli("export", src, "-o", bvh)
+    assert done.returncode == 0, done.stderr
+    lib = str(tmp_path / "statue_lib.lig")
+    assert _cli("import", bvh, "-o", lib, "--model", "BACK", "--motion", "AGAIN").returncode == 0
+    program = load_program(src)[0]
+    fig = X.collect(program)[0].models[0].figure
+    assert fig.inverted.any()
+    original = pose_records(program, tmp_path / "a")
+    again = pose_records(load_program(_player(tmp_path, lib, "BACK", "AGAIN", 20))[0], tmp_path / "b")
+    for t, (ra, rb) in enumerate(zip(original, again)):
+        X_ = [np.array(s["matrix"]).reshape(4, 4) for s in ra["segments"]]
+        # Every joint of the original, in the world, on its (defined) secondary.
+        expected = np.array(
+            [
+                X_[j.secondary][:3, :3] @ (j.loc2 / fig.links[j.secondary].scale) + X_[j.secondary][:3, 3]
+                for j in fig.joints
+            ]
+        )
+        got = np.array(
+            [np.array(s["matrix"]).reshape(4, 4)[:3, 3] for s in rb["segments"] if s["joint"] not in (None, 1)]
+        )
+        assert len(got) == len(expected)
+        d = np.linalg.norm(expected[:, None, :] - got[None, :, :], axis=2)
+        rows, cols = linear_sum_assignment(d)
+        assert d[rows, cols].max() <= 1e-5, (t, d[rows, cols].max())

@@ -93,7 +93,8 @@ def test_a_joint_takes_a_re_rooted_submodel_by_its_new_main_link(angles):
         j1 = fig.joint(1)
         assert (fig.links[j1.primary].name, fig.links[j1.secondary].name) == ("B", "C")
         assert [fig.links[i].name for i in fig.preorder] == ["A", "C", "B", "D"]
-        assert dict(zip(fig.joint_ids, fig.inverted)) == {2: False, 1: True, 3: False}
+        # Joint order: depth first from the root, the submodel's from the link it is held by.
+        assert fig.joint_ids == (2, 1, 3) and list(fig.inverted) == [False, True, False]
         _check_positions(fig, t)
     # SCALE MODEL and TRANS JOINTS keep the structure: twice the figure, joints 11, 12, 13.
     _check_positions(v["Q"], t, scale=2.0, shift=10)
@@ -208,3 +209,19 @@ def test_a_thesis_figure_9_chain_of_re_rooted_submodels():
     for k, name in zip(w.preorder[1:], ["D", "B", "C", "A"]):
         i = next(i for i, l in enumerate(m.links) if l.name == name)
         np.testing.assert_allclose(X[k], Dw @ np.linalg.inv(XM[dm]) @ XM[i], atol=1e-12, err_msg=name)
+
+
+def test_figure_main_link_with_a_repeated_name_says_when_no_main_joint_chooses_the_other():
+    """W holds two A: the root, and M's old main link, which no joint has as its secondary."""
+    text = PLANAR + (
+        "  MODEL W\n"
+        "  FIGURE M MAIN LINK D\n"
+        "  W :- JOINT 7, A, (-1.0, 0.0, 0.0), M, (0.0, 0.5, 0.0), (0.0, 0.0), (0.0, 0.0), (-90.0, 90.0)\n"
+    )
+    w = _variables(text)[0]["W"]
+    chosen, warning = w.with_main_link("A", model_name="W")
+    assert chosen.main == chosen.root
+    assert warning is not None and "2 links are named A" in warning
+    assert "no FIGURE MAIN JOINT chooses the others" in warning
+    # D is joint 3's secondary and joint 7's: MAIN JOINT 3 and MAIN JOINT 7 both choose it.
+    assert w.with_main_joint(3).main == w.with_main_joint(7).main == w.preorder[1]

@@ -132,3 +132,33 @@ def test_the_page_talks_only_to_its_server(studio):
     requests = [url for url, _ in b.requests() if not url.startswith(("chrome:", "data:", "about:"))]
     assert requests
     assert all(url.startswith(server.url) for url in requests), requests
+
+
+def test_the_current_pose_casts_a_contact_shadow_on_its_floor(studio):
+    b = studio[0]
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    floor_box = b.driver.find_element("id", "floor")
+    assert floor_box.is_selected()
+    ActionChains(b.driver).move_to_element(floor_box).perform()  # no limb under the pointer, none tinted
+    on = b.canvas("#current").astype(int)
+    feet = [b.driver.execute_script(f"return ligStudio.linkPoint(0, {link})") for link in (4, 8)]  # R_FOOT, L_FOOT
+    floor_box.click()
+    try:
+        off = b.canvas("#current").astype(int)
+    finally:
+        floor_box.click()
+    assert np.array_equal(b.canvas("#current"), on)
+    # The floor's pixels are those the floor changes (the figure is the same); its ink lines aside,
+    # they would all be one lit shade without the shadow.
+    floor = (on != off) & (on > 150)
+    near = np.zeros_like(floor)
+    for dx, dy in feet:  # offsets from the canvas' centre
+        x, y = dx + on.shape[1] // 2, dy + on.shape[0] // 2
+        near[max(y - 30, 0) : y + 40, max(x - 40, 0) : x + 40] = True
+    assert (floor & near).sum() > 200, feet
+    lit = np.percentile(on[floor], 95)
+    assert lit - np.percentile(on[floor & near], 5) >= 5, "the floor is darker around the feet"
+    # Without the floor the shadow falls on the background (244 far from the figure), as in `liganimate run`.
+    ground = (on != off) & near
+    assert off[5, 5] == 244 and off[ground].min() < 240

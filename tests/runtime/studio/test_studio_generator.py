@@ -13,7 +13,7 @@ from liganimate.runtime.studio import (
     joint_axes,
     sphere,
 )
-from liganimate.runtime.studio._genes import directions, solutions, wrap
+from liganimate.runtime.studio._genes import _limb_axis, directions, solutions, wrap
 
 # humanoid and human come from conftest.py.
 
@@ -333,3 +333,22 @@ def test_a_model_without_joints_is_refused():
 
 def test_wrap():
     assert wrap(np.array([180.0, -180.0, 540.0, 181.0, -181.0])).tolist() == [180.0, 180.0, 180.0, -179.0, 179.0]
+
+
+def test_a_limbs_axes_do_not_depend_on_where_the_model_is_rooted():
+    """A submodel attached by the link FIGURE chose walks some joints from their secondaries;
+    each limb's twist, pivot and flexion axes still come from the limb's own joints."""
+    from exchange_support import GRAFTED
+
+    program, _ = load_program(text=GRAFTED, name="grafted.lig")
+    v = program.execute("check").variables
+    arm, bot = v["ARM"], v["BOT"]
+    assert bot.inverted.any() and not arm.inverted.any()
+    mine = {a.id: a for a in joint_axes(bot)}
+    for a in joint_axes(arm):
+        b = mine[a.id]
+        assert (b.twist, b.pivot, b.flexion, b.sign) == (a.twist, a.pivot, a.flexion, a.sign)
+        assert bot.links[b.link].name == arm.links[a.link].name
+    # The limb's direction itself, from the joint to the link's other joints on it: the elbow's
+    # LOWER holds joints 1 and 2 in both models (BOT's HAND holds joint 3 as well, so it differs).
+    np.testing.assert_array_equal(_limb_axis(bot, bot.joint_index(1)), _limb_axis(arm, arm.joint_index(1)))

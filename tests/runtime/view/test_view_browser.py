@@ -18,6 +18,7 @@ from PIL import Image
 ROOT = ROOT_DIR
 APPENDIX = os.path.join(ROOT, "examples", "appendix_a.lig")
 FIVE = os.path.join(ROOT, "benchmarks", "five_humans.lig")
+MAILBOX = os.path.join(ROOT, "examples", "mailbox.lig")  # morphing segments: SCALE LINK and SHAPE LINK tracks
 
 TWO_SCENES = """\
       GRAPHICAL A, B, FLOOR
@@ -68,6 +69,7 @@ def pages(tmp_path_factory):
     five = Path(FIVE).read_text(encoding="utf-8").replace("STARTSCENE LENGTH 1000", "STARTSCENE LENGTH 60")
     five = re.sub(r"FROM 0 TO 999 ", "FROM 0 TO 59 ", five)
     sources = {"appendix": APPENDIX, "five": tmp / "five.lig", "two": tmp / "two.lig", "walk": tmp / "walk.lig"}
+    sources["mailbox"] = MAILBOX
     (tmp / "five.lig").write_text(five, encoding="utf-8")
     (tmp / "walk.lig").write_text(NO_VIEW, encoding="utf-8")
     (tmp / "two.lig").write_text(TWO_SCENES, encoding="utf-8")
@@ -82,6 +84,11 @@ def pages(tmp_path_factory):
             r = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=600)
             assert r.returncode == 0, r.stderr
         out[name] = (page, tmp / name)
+    # The walk in the modern look too: its default framing and its contact shadow.
+    cmd = [sys.executable, "-m", "liganimate", "run", str(tmp / "walk.lig"), "-o", str(tmp / "walk_modern"), "--quiet"]
+    r = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    out["walk_modern"] = (None, tmp / "walk_modern")
     return out
 
 
@@ -120,6 +127,7 @@ def _run_image(folder, scene_id, image):
         ("appendix", 0, 1, [0]),  # SAMEFRAME 6: six ticks in one picture
         ("two", 0, 1, [0, 10, 20]),  # a background object
         ("two", 1, 2, [0, 3]),  # a camera from above at an angle, SAMEFRAME 2
+        ("mailbox", 0, 1, [0, 30, 41, 60]),  # segments that change shape and size
     ],
 )
 def test_the_canvas_shows_what_liganimate_run_draws(pages, browser, name, scene_index, scene_id, images):
@@ -154,17 +162,108 @@ def test_the_modern_look_lights_and_outlines_what_the_thesis_look_draws_flat(pag
     assert len(np.unique(modern)) > 3 * len(np.unique(flat))
 
 
-def test_a_scene_without_view_is_framed_in_the_modern_look(pages, browser):
-    page, _ = pages["walk"]
+def test_a_scene_without_view_keeps_the_thesis_camera_in_the_thesis_look(pages, browser):
+    page, frames = pages["walk"]
     _open(browser, page, look="thesis")
-    small = _frame(browser, 0, 0)
+    start = browser.driver.execute_script("return ligViewer.sceneCamera()")
+    assert start == {"eye": [0, 0, 10], "target": [0, 0, 0], "k": 1}  # VIEW POINT (0, 0, 10), VIEW WIDTH 10
     _open(browser, page, look="modern")
-    framed = _frame(browser, 0, 0)
-    rows_small = np.nonzero((small < 250).any(axis=1))[0]
-    rows_framed = np.nonzero((framed < 230).any(axis=1))[0]
-    # The thesis' camera shows the 1.8-unit figure in a view 10 units wide; the framing fills the picture's height.
-    assert rows_small.max() - rows_small.min() < 0.35 * small.shape[0]
-    assert rows_framed.max() - rows_framed.min() > 1.4 * (rows_small.max() - rows_small.min())
+    assert browser.driver.execute_script("return ligViewer.sceneCamera()")["eye"] != [0, 0, 10]
+
+
+def test_a_scene_without_view_starts_from_the_camera_liganimate_run_uses(pages, browser, monkeypatch, tmp_path):
+    import liganimate
+    from liganimate.runtime.render import frames
+
+    used = []
+    view = frames.Renderer._view
+    monkeypatch.setattr(frames.Renderer, "_view", lambda self, *a: used.append(view(self, *a)) or used[-1])
+    liganimate.load(str(pages["walk"][0].with_suffix(".lig"))).render(tmp_path, size=(640, 480), quiet=True)
+    (eye, width, target) = used[0]
+    assert set(used) == {used[0]}  # one camera for the whole scene
+    _open(browser, pages["walk"][0], look="modern")
+    start = browser.driver.execute_script("return ligViewer.sceneCamera()")
+    assert start["eye"] == pytest.approx(eye, rel=1e-12) and start["target"] == pytest.approx(target, rel=1e-12)
+    distance = float(np.linalg.norm(np.subtract(eye, target)))
+    assert start["k"] * distance == pytest.approx(width, rel=1e-12)
+    # The picture frames the walker where `liganimate run` does: the drawn box within a few pixels.
+    mine, theirs = _frame(browser, 0, 0), _run_image(pages["walk_modern"][1], 1, 0)
+    boxes = []
+    for img in (mine, theirs):
+        rows, cols = np.nonzero(img < 200)
+        boxes.append((rows.min(), rows.max(), cols.min(), cols.max()))
+    assert np.abs(np.subtract(*boxes)).max() <= 3, boxes
+    assert boxes[0][1] - boxes[0][0] > 100  # framed: the figure is not lost in a corner
+    # Orbiting leaves the scene camera; "Scene camera" comes back to run's.
+    browser.driver.execute_script(
+        "ligViewer.restore({scene: 1, image: 0, cam: {eye: [9, 9, 9], target: [0, 0, 0], k: 1}})"
+    )
+    assert browser.driver.execute_script("return ligViewer.camera()")["eye"] == [9, 9, 9]
+    browser.driver.find_element("id", "reset").click()
+    assert browser.driver.execute_script("return ligViewer.camera()") is None
+    assert np.array_equal(browser.canvas(), mine)
+
+
+def test_a_scene_with_view_keeps_its_view_in_the_modern_look(pages, browser):
+    _open(browser, pages["two"][0], look="modern")
+    start = browser.driver.execute_script("return ligViewer.sceneCamera()")
+    assert start["eye"] == pytest.approx([0.0, 1.0, 8.0]) and start["target"] == [0, 0, 0]
+    assert start["k"] * np.linalg.norm(start["eye"]) == pytest.approx(6.0, rel=1e-6)
+
+
+def test_the_contact_shadow_is_liganimate_runs_and_the_thesis_look_has_none(pages, browser):
+    _open(browser, pages["walk"][0], look="modern")
+    mine = _frame(browser, 0, 0).astype(int)
+    theirs = _run_image(pages["walk_modern"][1], 1, 0).astype(int)
+    rows, cols = np.nonzero(theirs < 200)
+    foot = rows.max()  # the planted foot's lowest pixel
+    # The ground under and around the figure: pixels both show bright (the background, lit faces aside).
+    ground = (mine > 205) & (theirs > 205)
+    ground[: (rows.min() + foot) // 2] = False
+    shadowed = ground & (theirs < 242)
+    assert shadowed.sum() > 500, "liganimate run draws a contact shadow here"
+    assert (np.abs(mine - theirs)[ground] <= 2).mean() > 0.995
+    assert 0.8 < (ground & (mine < 242)).sum() / shadowed.sum() < 1.25
+    # Just under the foot the background is darker than far from the figure.
+    below = mine[foot + 2 : foot + 8, cols.min() : cols.max() + 1]
+    assert below.min() < 240 and mine[foot + 60 :, :].min() == 244 == mine[5, 5]
+    # The thesis look: no shadow, white everywhere the figure is not.
+    _open(browser, pages["walk"][0], look="thesis")
+    flat = _frame(browser, 0, 0)
+    rows, cols = np.nonzero(flat < 255)
+    assert (flat[rows.max() + 1 :] == 255).all() and (flat[:, cols.max() + 1 :] == 255).all()
+
+
+def test_the_notebook_display_draws_the_shadow_from_runs_camera(pages, browser, tmp_path):
+    import liganimate
+
+    _open(browser, pages["walk"][0], look="modern")
+    expected = browser.driver.execute_script("return ligViewer.sceneCamera()")
+    # A notebook shows the viewer in a sandboxed <iframe srcdoc>: a page holding just that.
+    shown = liganimate.load(str(pages["walk"][0].with_suffix(".lig")))._repr_html_()
+    host = tmp_path / "notebook.html"
+    host.write_text(f"<!DOCTYPE html><html><body>{shown}</body></html>", encoding="utf-8")
+    browser.driver.get("about:blank")
+    browser.driver.get(host.as_uri())
+    browser.driver.switch_to.frame(browser.driver.find_element("tag name", "iframe"))
+    try:
+        from selenium.webdriver.support.ui import WebDriverWait
+
+        # Waits for the frame's viewer, however loaded the machine; the bound only stops a hang.
+        WebDriverWait(browser.driver, 60, poll_frequency=0.05).until(
+            lambda d: d.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"),
+            "the notebook's viewer did not start",
+        )
+        start = browser.driver.execute_script("return ligViewer.sceneCamera()")
+        assert start == expected, (start, expected)
+        img = browser.canvas().astype(int)
+        rows, cols = np.nonzero(img < 200)
+        assert len(rows), "the notebook's viewer drew no figure"
+        below = img[rows.max() + 2 : rows.max() + 8, cols.min() : cols.max() + 1]
+        # The grey background, darker under the feet.
+        assert img[0, 0] == 244 and below.min() < 240, (img.shape, img[0, 0], below.min())
+    finally:
+        browser.driver.switch_to.default_content()
 
 
 def test_moving_the_scrubber_changes_the_picture(pages, browser):
