@@ -3,17 +3,19 @@
 Runs the generators of tests/fuzzgen.py -- grammar expansion of
 lang/lig.lark, extreme-number templates, cross-file splices of the
 examples and standard libraries, grammar programs with extreme numbers
-("wild"), and with ``--generators mutate`` the line and token mutations
-of benchmarks/fuzz_compile.py -- in a pool of worker
-processes. Each case is compiled, checked and rendered at 16x12 exactly as
-tests/fuzzrun.py does it, and sorted into ok, diagnosed, error, slow, or
-one of the failures:
+("wild"), deep and long constructs around and past the nesting limits
+("deep"), non-ASCII characters put into real programs ("unicode"), and
+with ``--generators mutate`` the line and token mutations of
+benchmarks/fuzz_compile.py -- in a pool of worker processes. Each case is
+compiled and checked, and every ``--render-every``-th case (default 10th)
+also rendered at 16x12, exactly as tests/fuzzrun.py does it, and sorted
+into ok, diagnosed, error, slow, or one of the failures:
 
 * ``crash``: what the CLI would report as an internal error;
 * ``baddiag``: a diagnostic without a position or with Python text in it;
 * ``disagree``: ``check`` passed but the render failed;
 * ``leak``: a Python RuntimeWarning reached stderr;
-* ``hang``: the worker ignored the time limit (stuck in C code) and was killed;
+* ``hang``: the worker did not answer within ``--hang`` seconds (default 20) and was killed;
 * ``died``: the worker process died (a signal, the kernel's OOM killer).
 
 Failures are grouped by kind and site (exception type and innermost
@@ -27,9 +29,10 @@ Usage::
     python benchmarks/fuzz.py                      # 100,000 cases
     python benchmarks/fuzz.py --cases 3000 --findings findings.md
 
-The last line printed is one JSON object: cases, outcomes, internal_errors
-(crashes), failures (every failure kind), distinct failure sites, seconds,
-rate, peak_rss_mb (the largest resident set of any worker) and the options.
+The last line printed is one JSON object: cases (all checked), rendered,
+outcomes, internal_errors (crashes), failures (every failure kind), hangs,
+distinct failure sites, seconds, rate, peak_rss_mb (the largest resident
+set of any worker), over_1gb and the options.
 """
 
 from __future__ import annotations
@@ -94,9 +97,9 @@ def worker(conn, limit: float, memory: int) -> None:
             if task is None:
                 return
             if task[0] == "case":
-                _, tid, generator, seed = task
+                _, tid, generator, seed, render = task
                 text = generate(generator, seed)
-                out = fuzzrun.timed(text, limit=limit, memory=memory, workdir=workdir)
+                out = fuzzrun.timed(text, limit=limit, memory=memory, workdir=workdir, render=render)
                 keep = out.failed
                 conn.send(
                     (tid, out.kind, out.site, out.detail, round(out.seconds, 4), _rss_mb(), text if keep else None)
@@ -190,12 +193,13 @@ def run(args) -> dict:
     """Run the cases; return counts per generator, failure groups, minimised programs, time and memory."""
     generators = args.generators.split(",")
     pool = Pool(args.workers, args.limit, args.memory << 20)
-    hard = args.limit * 3 + 10
+    hard = args.hang  # a worker that has not answered by then is killed: a hang
     counts = {g: dict.fromkeys(ALL_OUTCOMES, 0) for g in generators}
     groups: dict = {}  # (kind, site) -> {"count", "text", "detail", "generator", "seed"}
     start = time.monotonic()
     budget_end = start + args.budget
     next_case = 0
+    rendered = 0
     done = 0
     last_report = start
     try:
@@ -203,12 +207,14 @@ def run(args) -> dict:
             while next_case < args.cases and pool.idle() and time.monotonic() < budget_end:
                 g = generators[next_case % len(generators)]
                 seed = f"{args.seed}-{g}-{next_case}"
-                pool.submit(pool.idle()[0], ("case", next_case, g, seed), hard)
+                render = next_case % args.render_every == 0
+                rendered += render
+                pool.submit(pool.idle()[0], ("case", next_case, g, seed, render), hard)
                 next_case += 1
             if not any(w["task"] for w in pool.workers):
                 break  # the time budget ran out
             for task, result in pool.results():
-                _, _, g, seed = task
+                _, _, g, seed, _ = task
                 done += 1
                 if result[0] in WORKER_FAILURES:
                     kind, detail = result
@@ -241,6 +247,7 @@ def run(args) -> dict:
         "groups": groups,
         "minimised": minimised,
         "done": done,
+        "rendered": rendered,
         "seconds": seconds,
         "peak_rss_mb": pool.peak_rss,
     }
@@ -284,6 +291,8 @@ def report(res: dict, args) -> dict:
     done, seconds = res["done"], res["seconds"]
     summary = {
         "cases": done,
+        "checked": done,
+        "rendered": res["rendered"],
         "outcomes": total,
         "internal_errors": total["crash"],
         "failures": failures,
@@ -291,6 +300,9 @@ def report(res: dict, args) -> dict:
         "seconds": round(seconds, 1),
         "rate": round(done / seconds, 1) if seconds else None,
         "peak_rss_mb": round(res["peak_rss_mb"], 1),
+        "over_1gb": res["peak_rss_mb"] > 1024,
+        "hangs": total["hang"],
+        "hang_budget_s": args.hang,
         "workers": args.workers,
         "generators": args.generators,
         "seed": args.seed,
@@ -347,10 +359,20 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     parser.add_argument(
         "--generators",
-        default="grammar,numbers,splice,wild",
-        help="comma-separated: grammar, numbers, splice, wild, mutate",
+        default="grammar,numbers,splice,wild,deep,unicode",
+        help="comma-separated: grammar, numbers, splice, wild, deep, unicode, mutate",
     )
     parser.add_argument("--limit", type=float, default=2.0, help="seconds per case before it counts as slow")
+    parser.add_argument(
+        "--hang", type=float, default=20.0, help="seconds after which a case that has not answered is a hang (killed)"
+    )
+    parser.add_argument(
+        "--render-every",
+        type=int,
+        default=10,
+        metavar="N",
+        help="render every Nth case after its check (default 10: 100,000 checked, 10,000 run)",
+    )
     parser.add_argument("--memory", type=int, default=1024, help="MB of address space a case may add")
     parser.add_argument("--minimise", type=int, help="failure groups to minimise (default all, 3 with --quick)")
     parser.add_argument("--minimise-budget", type=float, help="seconds per minimisation (default 30, 4 with --quick)")

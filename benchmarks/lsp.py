@@ -22,8 +22,13 @@ offset moves) and measures, in one run:
 Wall time is the median round; CPU time is the server process's own
 (``/proc/PID/stat``), or the ``check`` process's, for the same rounds: on
 a shared machine wall time is mostly waiting for a core (the load average
-is printed), so CPU time is the fair figure. Issue 21's target: a
-5,000-line program answered within 200 ms of a change.
+is printed), so CPU time is the fair figure. The diagnostics' CPU time is
+that of every thread of the server but the one that builds the index and
+values after the diagnostics are out (``lig-index``); that one's is
+printed beside it ("then the index"), measured once the server is idle
+again. Hover and completion count the whole process, the change's own
+analysis included. Issue 21's target: a 5,000-line program answered
+within 200 ms of a change.
 
 Usage: ``python benchmarks/lsp.py [--quick]``. The last line printed is one
 JSON object holding the figures.
@@ -62,6 +67,32 @@ def process_cpu(pid: int) -> float:
     with open(f"/proc/{pid}/stat") as fh:
         fields = fh.read().rsplit(")", 1)[1].split()
     return (int(fields[11]) + int(fields[12])) / TICK
+
+
+#: The server's thread that builds the index and values after the diagnostics are out (lsp/server.py names it).
+INDEX_THREAD = "lig-index"
+
+
+def server_cpu(pid: int) -> tuple:
+    """``(CPU seconds of the server but its index thread, CPU seconds of its index thread)`` so far.
+
+    The index of a text is built after its diagnostics are published, in a
+    thread of its own, while the client reads the CPU clock: counted apart,
+    the first figure is the work from a change to its diagnostics.
+    """
+    index = 0.0
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{tid}/comm") as fh:
+                name = fh.read().strip()
+            if name != INDEX_THREAD:
+                continue
+            with open(f"/proc/{pid}/task/{tid}/stat") as fh:
+                fields = fh.read().rsplit(")", 1)[1].split()
+            index += (int(fields[11]) + int(fields[12])) / TICK
+        except FileNotFoundError:
+            continue  # a thread that ended meanwhile
+    return process_cpu(pid) - index, index
 
 
 _DECIMAL = re.compile(r"(?<![A-Za-z0-9_])\d+\.(\d)")
@@ -128,6 +159,17 @@ class Session:
             await asyncio.sleep(0.001)
         return self.published[version]
 
+    async def idle(self, quiet: float = 0.05, timeout: float = 30.0) -> None:
+        """Wait until the server has used no CPU for ``quiet`` seconds (the index of the last text is built)."""
+        deadline = time.perf_counter() + timeout
+        before = process_cpu(self.pid)
+        while time.perf_counter() < deadline:
+            await asyncio.sleep(quiet)
+            now = process_cpu(self.pid)
+            if now == before:
+                return
+            before = now
+
     async def stop(self) -> None:
         await self.client.shutdown_async(None)
         self.client.exit(None)
@@ -145,14 +187,17 @@ async def measure_server(text: str, path: str, rounds: int, whole_parse: bool = 
     )
     await session.wait_for(1)
     where = name_position(text)
-    walls: dict = {"diagnostics": [], "hover": [], "completion": []}
-    cpus: dict = {"diagnostics": [], "hover": [], "completion": []}
+    kinds = ("diagnostics",) if whole_parse else ("diagnostics", "hover", "completion")
+    walls: dict = {kind: [] for kind in kinds}
+    cpus: dict = {kind: [] for kind in kinds}
+    index_cpus: list = []
     version = 1
     for _ in range(rounds):
-        for kind in ("diagnostics", "hover", "completion"):
+        for kind in kinds:
             version += 1
             text, change = edit(text, version)
-            cpu0 = process_cpu(session.pid)
+            await session.idle()
+            cpu0, index0 = server_cpu(session.pid)
             sent = time.perf_counter()
             session.client.text_document_did_change(
                 T.DidChangeTextDocumentParams(
@@ -163,7 +208,10 @@ async def measure_server(text: str, path: str, rounds: int, whole_parse: bool = 
             if kind == "diagnostics":
                 got = await session.wait_for(version)
                 walls[kind].append(got - sent)
-                cpus[kind].append(process_cpu(session.pid) - cpu0)
+                cpu1, _ = server_cpu(session.pid)
+                cpus[kind].append(cpu1 - cpu0)
+                await session.idle()
+                index_cpus.append(server_cpu(session.pid)[1] - index0)
                 continue
             await asyncio.sleep(0.01)  # the change's analysis is running now
             cpu0 = process_cpu(session.pid)
@@ -181,7 +229,9 @@ async def measure_server(text: str, path: str, rounds: int, whole_parse: bool = 
             assert answer is not None, kind
             await session.wait_for(version)
     await session.stop()
-    return {kind: {"wall_s": statistics.median(walls[kind]), "cpu_s": statistics.mean(cpus[kind])} for kind in walls}
+    out = {kind: {"wall_s": statistics.median(walls[kind]), "cpu_s": statistics.mean(cpus[kind])} for kind in walls}
+    out["diagnostics"]["index_cpu_s"] = statistics.mean(index_cpus)
+    return out
 
 
 def measure_check(path: str, rounds: int) -> dict:
@@ -201,9 +251,10 @@ def measure_check(path: str, rounds: int) -> dict:
 
 
 def _row(server: dict) -> str:
-    return "  ".join(
+    row = "  ".join(
         f"{kind} {v['wall_s'] * 1000:7.1f} ms wall {v['cpu_s'] * 1000:6.1f} ms CPU" for kind, v in server.items()
     )
+    return row + f"  (then the index: {server['diagnostics']['index_cpu_s'] * 1000:.1f} ms CPU)"
 
 
 def main() -> None:

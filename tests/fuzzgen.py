@@ -484,5 +484,161 @@ def wild_program(rng) -> str:
     return grammar_program(rng, wild, 0.25)
 
 
+#: Sizes of deep and long constructs: around the nesting limit (100) and far past it.
+SIZES = (1, 2, 50, 99, 100, 101, 102, 200, 500, 1000, 3000)
+
+_BOX = "      GRAPHICAL G\n      G :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0\n"
+
+
+def _deep_parens(n: int) -> str:
+    return "      REAL X\n      X = " + "(" * n + "1.5" + ")" * n + "\n      PRINT X\n"
+
+
+def _deep_negations(n: int) -> str:
+    return "      REAL X\n      X = " + "-" * n + "1.5\n      PRINT X\n"
+
+
+def _long_sum(n: int) -> str:
+    return "      INTEGER N\n      N = " + " + ".join(["1"] * n) + "\n      PRINT N\n"
+
+
+def _deep_ifs(n: int) -> str:
+    opened = "".join(f"{'  ' * i}      IF {i} < {n} THEN BEGIN\n" for i in range(n))
+    closed = "".join(f"{'  ' * i}      END\n" for i in reversed(range(n)))
+    return "      INTEGER N\n      N = 0\n" + opened + "      N = N + 1\n" + closed + "      PRINT N\n"
+
+
+def _deep_loops(n: int) -> str:
+    names = [f"I{i}" for i in range(n)]
+    head = "      INTEGER " + ", ".join(names) + "\n"
+    opened = "".join(f"      DO {10 + i} {v} = 1, 1\n" for i, v in enumerate(names))
+    closed = "".join(f" {10 + i}   CONTINUE\n" for i in reversed(range(n)))
+    return head + opened + closed
+
+
+def _modifier_chain(n: int) -> str:
+    return _BOX + "      G :- G" + " <SCALE 1.0>" * n + "\n"
+
+
+def _joint_chain(n: int) -> str:
+    return (
+        _BOX
+        + "      MODEL M\n      INTEGER I\n"
+        + "      M :- JOINT 0, G, (0.0, 1.0, 0.0), G, (0.0, 0.0, 0.0), (-10, 10)\n"
+        + f"      DO 10 I = 1, {n}\n"
+        + "        M :- JOINT I, M, (0.0, 1.0, 0.0), G, (0.0, 0.0, 0.0), (-10, 10)\n"
+        + " 10   CONTINUE\n"
+    )
+
+
+def _motion_sum(n: int) -> str:
+    return (
+        "      MOTION W, S\n      W[1, 1] = FRAME 0 POSITION (0.0, 0.0, 0.0)\n"
+        "      W[1, 2] = FRAME 2 POSITION (0.0, 0.0, 45.0)\n      S = " + " + ".join(["W"] * n) + "\n"
+    )
+
+
+def _many_statements(n: int) -> str:
+    return "      INTEGER N\n      N = 0\n" + "      N = N + 1\n" * n + "      PRINT N\n"
+
+
+def _long_line(n: int) -> str:
+    return "      INTEGER " + ", ".join(f"V{i}" for i in range(n)) + "\n"
+
+
+#: Deep and long constructs, each built for a size.
+DEEP = (
+    _deep_parens,
+    _deep_negations,
+    _long_sum,
+    _deep_ifs,
+    _deep_loops,
+    _modifier_chain,
+    _joint_chain,
+    _motion_sum,
+    _many_statements,
+    _long_line,
+)
+
+
+def deep_program(rng) -> str:
+    """One or two deep or long constructs (nesting, chains, sums, loops) of a size around or past the limits.
+
+    Now and then the construct is spliced into a real program, so that it
+    meets scenes and models.
+    """
+    parts = [DEEP[rng.randrange(len(DEEP))](SIZES[rng.randrange(len(SIZES))]) for _ in range(1 + rng.randrange(2))]
+    text = "".join(parts)
+    if rng.random() < 0.3:
+        files = corpus()
+        _, lines = files[rng.randrange(len(files))]
+        text = text + "\n".join(lines) + "\n"
+    return text
+
+
+#: Characters that are not plain ASCII letters: letters of other scripts, marks, spaces, controls, emoji.
+UNICODE = (
+    "é",
+    "ß",
+    "Ж",
+    "ж",
+    "Ω",
+    "ǅ",
+    "ﬁ",
+    "Ａ",
+    "１",
+    "٣",
+    "\u0301",  # a combining acute accent
+    "\u00a0",  # no-break space
+    "\u2003",  # em space
+    "\u200b",  # zero-width space
+    "\u202e",  # right-to-left override
+    "\u2028",  # line separator
+    "\ufeff",  # byte order mark
+    "\x85",  # next line (C1)
+    "\x1b[31m",  # a terminal escape
+    "\x00",
+    "\t",
+    "\r",
+    "\x0c",
+    "😀",
+    "🏳️‍🌈",
+    "\ud800",  # a lone surrogate (written with surrogatepass)
+    "°",
+    "′",
+    "−",  # the minus sign, not a hyphen
+    "İ",
+    "ı",
+)
+
+
+def unicode_program(rng) -> str:
+    """A real or spliced program with one to four non-ASCII characters or sequences put in.
+
+    Each goes into a name (after or inside a word), a quoted string, a
+    comment, between tokens or at the start of the file.
+    """
+    text = splice_program(rng) if rng.random() < 0.5 else "\n".join(corpus()[rng.randrange(len(corpus()))][1])
+    for _ in range(1 + rng.randrange(4)):
+        piece = UNICODE[rng.randrange(len(UNICODE))]
+        where = rng.random()
+        if where < 0.1:
+            at = 0
+        else:
+            words = [m.end() for m in re.finditer(r"[A-Za-z_][A-Za-z0-9_]*|'|\{|\s", text)]
+            at = words[rng.randrange(len(words))] if words else 0
+            if where < 0.4 and words:
+                at = max(0, at - 1 - rng.randrange(3))
+        text = text[:at] + piece + text[at:]
+    return text
+
+
 #: The generators by name, as the benchmark and the tests call them.
-GENERATORS = {"grammar": grammar_program, "numbers": number_program, "splice": splice_program, "wild": wild_program}
+GENERATORS = {
+    "grammar": grammar_program,
+    "numbers": number_program,
+    "splice": splice_program,
+    "wild": wild_program,
+    "deep": deep_program,
+    "unicode": unicode_program,
+}

@@ -229,7 +229,7 @@ def _progress_for(quiet: bool, asked: bool = False):
     return None
 
 
-def _checked(program, quiet: bool, stdout=None, asked: bool = False):
+def _checked(program, quiet: bool, stdout=None, asked: bool = False, drawing: bool = False):
     """Run every check (``Program.check``) with a progress line on a terminal (or when ``asked``); returns the runtime.
 
     Its ``warnings`` are the run's warnings, its ``shot`` the number of
@@ -239,8 +239,8 @@ def _checked(program, quiet: bool, stdout=None, asked: bool = False):
     try:
         if stdout is None:
             # PRINT output is dropped: a run prints it once, when it renders.
-            return program.execute("check", stdout=io.StringIO(), progress=progress)
-        return program.execute("check", stdout=stdout, echo_print=True, progress=progress)
+            return program.execute("check", stdout=io.StringIO(), progress=progress, drawing=drawing)
+        return program.execute("check", stdout=stdout, echo_print=True, progress=progress, drawing=drawing)
     finally:
         if progress is not None:
             progress.done()
@@ -256,7 +256,7 @@ def _render(program, warnings, options, asked: bool = False) -> int:
     from liganimate.runtime.render.options import MOVIES
 
     _print_diagnostics(warnings)
-    checked = _checked(program, options.quiet, asked=asked)
+    checked = _checked(program, options.quiet, asked=asked, drawing=True)
     _print_diagnostics(checked.warnings)
     if not checked.shot:
         # Nothing to draw: no empty folder, no "frames written".
