@@ -159,3 +159,39 @@ def test_synchronize_of_two_orientations_is_an_error():
     d = error(text)
     assert d.pos.line == 4
     assert d.message == "the root orientation is driven by both operand 1 and operand 2 of SYNCHRONIZE"
+
+
+def test_a_rerooted_figure_turns_about_its_new_main_link():
+    """FIGURE ... MAIN JOINT 4 stands the human on its right foot: ROOT ORIENTATION turns it about that foot."""
+    from liganimate.runtime import exchange as X
+    from liganimate.runtime.figure.pose import world_transforms
+
+    text = """\
+      LOAD HUMAN FROM 'human'
+      MODEL ON_FOOT
+      MOTION SPIN
+      STARTMOTION SPIN
+        ROOT ORIENTATION
+          FRAME 8 POSITION 0.0, 90.0, 0.0
+      ENDMOTION
+      ON_FOOT :- HUMAN
+      FIGURE ON_FOOT MAIN JOINT 4
+      INITIALIZE SCENE 1
+      STARTSCENE LENGTH 9
+        ANIMATE ON_FOOT FROM 0 TO 8 USING SPIN
+      ENDSCENE
+      SHOOTSCENES
+      END
+"""
+    program, _ = load_program(text=text, name="t.lig")
+    take = X.collect(program)[0].models[0]
+    fig = take.figure
+    W = world_transforms(fig, take.angles, take.placements)
+    foot = fig.main
+    torso = fig.root
+    # The foot (the main link) turns in place; the torso, above it, swings round it.
+    np.testing.assert_allclose(W[:, foot, :3, 3], W[:1, foot, :3, 3].repeat(9, axis=0), atol=1e-12)
+    np.testing.assert_allclose(W[-1, foot, :3, :3] @ [1.0, 0.0, 0.0], [0.0, 0.0, -1.0], atol=1e-9)
+    lever = W[:, torso, :3, 3] - W[:, foot, :3, 3]
+    assert not np.allclose(lever[0], lever[-1], atol=1e-3)
+    np.testing.assert_allclose(np.linalg.norm(lever, axis=1), np.linalg.norm(lever[0]), atol=1e-9)

@@ -245,3 +245,32 @@ def test_a_plain_import_gives_the_actor_s_turn_to_the_root_orientation(tmp_path)
     h = twice.root_orientation([0.0, 68.0, 136.0])[:, 1]
     assert h[1] - h[0] == pytest.approx(want[-1] - want[0], abs=1.0)
     assert h[2] - h[0] == pytest.approx(2 * (want[-1] - want[0]), abs=2.0)
+
+
+def test_the_viewer_s_matrices_show_the_turn(tmp_path):
+    """The browser viewer draws from the scene manifest's matrices: its main link turns as ANIMATE draws it."""
+    from liganimate.runtime.view._scene_data import Blob, scene_manifest
+
+    program = (
+        "      LOAD HUMANOID FROM 'humanoid'\n"
+        "      MOTION TURN\n"
+        "      STARTMOTION TURN\n"
+        "        ROOT ORIENTATION\n"
+        "          FRAME 12 POSITION 0.0, 90.0, 0.0\n"
+        "      ENDMOTION\n"
+        "      INITIALIZE SCENE 1\n"
+        "      STARTSCENE LENGTH 13\n"
+        "        ANIMATE HUMANOID FROM 0 TO 12 USING TURN\n"
+        "      ENDSCENE\n"
+        "      SHOOTSCENES\n"
+        "      END\n"
+    )
+    scenes = X.collect(load_program(text=program, name="t.lig")[0])
+    blob = Blob()
+    model = scene_manifest(scenes, blob)[0]["models"][0]
+    ref = model["matrices"]
+    data = np.frombuffer(blob.tobytes(), dtype=np.float32, count=ref["n"], offset=ref["o"]).reshape(13, -1, 3, 4)
+    main = scenes[0].models[0].figure.main
+    first, last = data[0, main, :, :3] @ [1.0, 0.0, 0.0], data[-1, main, :, :3] @ [1.0, 0.0, 0.0]
+    np.testing.assert_allclose(first / np.linalg.norm(first), [1, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(last / np.linalg.norm(last), [0, 0, -1], atol=1e-6)
