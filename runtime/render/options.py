@@ -31,7 +31,6 @@ from liganimate.runtime.render.raster import MAX_AA
 from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, check_crf, check_preset
 
 from .movies import MOVIES, Movie
-
 from .outputs import check_fps, check_outputs
 
 __all__ = [
