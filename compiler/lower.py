@@ -21,7 +21,7 @@ from liganimate.lang import numbers as N
 from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import FUNCTIONS, MODIFIERS, Operator, operators_for
-from liganimate.runtime.ik.solvers import DEFAULT_SOLVER, SOLVER_KEYWORDS
+from liganimate.runtime.ik.names import DEFAULT_SOLVER, SOLVER_KEYWORDS
 
 from . import types as T
 from .check import Checked, expr_type

@@ -16,7 +16,7 @@ from liganimate.lang import bindings, keyframe_table, messages, numbers
 from liganimate.lang.diagnostics import did_you_mean
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import DRAW_WITH, NUMBER
-from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS  # the solver registry, by name only
+from liganimate.runtime.ik.names import SOLVER_KEYWORDS  # the solvers, by name only
 from liganimate.runtime.motion import interpolation
 
 from . import scopes as S

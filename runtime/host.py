@@ -763,7 +763,8 @@ class Runtime(Arithmetic):
 
     def _bind(self, fig: F.Figure, motion: M.Motion, at):
         """Check (once per pair) that a motion suits a model; warn about joints it lacks."""
-        key = (id(fig.joints), id(motion))
+        # (A motion that morphs segments meets the links too: the same joints may carry other shapes.)
+        key = (id(fig.joints), id(motion), id(fig.links) if motion.morphs is not None else None)
         if key in self._bind_cache:
             return
         self._bind_cache[key] = (fig, motion)

@@ -44,6 +44,8 @@ def split_heading(parents: np.ndarray, angles: np.ndarray) -> tuple:
         unwrapped; None where the ROOT has no axis that stays level enough to
         head anywhere (then ``angles`` is returned unchanged).
     """
+    if len(angles) < 2:
+        return angles, None  # a still: nowhere to turn
     root = int(np.flatnonzero(parents < 0)[0])
     Q = matrix_from_euler_zyx(angles[:, root])
     # The hips' own axis that stays most level over the take: its heading is the actor's.
