@@ -74,6 +74,8 @@ WRITERS = 2
 # Bounds of the memory of evaluated joint angles: (model, motion) pairs, frames each.
 _ANGLE_MODELS = 64
 _ANGLE_FRAMES = 4096
+# Background objects whose drawings are remembered (see Renderer._background).
+_STATICS = 256
 # Seconds close() waits for the images being drawn before it kills the workers.
 _CLOSE_WAIT = 30.0
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -179,6 +181,7 @@ class Renderer:
         self.futures: list = []  # (future, [(scene id, image number)]), in order
         self._chunk: list = []
         self._angles: dict = {}
+        self._statics: dict = {}  # id(background item) -> (item, its drawing); see _background
         self.angle_frames = 0  # frames whose joint angles were evaluated (see _joint_angles)
         self.scene_id = None
         self.scene_total = 0
@@ -281,13 +284,28 @@ class Renderer:
         return (tuple(float(x) for x in state.view_point), float(state.view_width))
 
     def _background(self, state, camera):
+        """The image's background: each BACKGROUND object's drawing, from the static-background table.
+
+        A background object is a value that never changes (a graphical
+        object, or a model drawn in its neutral pose at its placement), and
+        the same objects stay in the background image after image: each
+        one's triangles, shades and culling are worked out once per render
+        (a model's pose included) and reused by identity, for at most
+        :data:`_STATICS` objects, so memory stays flat.
+        """
         parts = []
         for item in state.background:
-            if isinstance(item, Graphical):
-                if len(item):
-                    parts.append((item.triangles, item.shades(), item.closed))
-            else:
-                parts.append(static_triangles(item))
+            hit = self._statics.get(id(item))
+            if hit is None or hit[0] is not item:
+                if isinstance(item, Graphical):
+                    part = (item.triangles, item.shades(), item.closed) if len(item) else None
+                else:
+                    part = static_triangles(item)
+                if len(self._statics) >= _STATICS:
+                    self._statics.clear()
+                hit = self._statics[id(item)] = (item, part)
+            if hit[1] is not None:
+                parts.append(hit[1])
         return (camera, parts)
 
     # ---------------------------------------------------------------- batch

@@ -34,7 +34,7 @@ def _print_diagnostics(diags, stream=None) -> None:
 
 
 def _size(text: str):
-    from liganimate.runtime.render.options import MAX_SIDE
+    from liganimate.runtime.render.options import MAX_SIDE  # only when --size is given
 
     try:
         width, height = text.lower().split("x")
@@ -77,7 +77,9 @@ def shot_scenes(path: str, doing: str) -> list:
 
 
 def _add_render_options(p: argparse.ArgumentParser) -> None:
-    from liganimate.runtime.render.options import MOVIES
+    # Every command builds the whole parser: the movie table is read from its
+    # own light module, not the renderer's options (which import the renderer).
+    from liganimate.runtime.render.movies import MOVIES
 
     p.add_argument(
         "-o",
@@ -229,7 +231,7 @@ def _progress_for(quiet: bool, asked: bool = False):
     return None
 
 
-def _checked(program, quiet: bool, stdout=None, asked: bool = False):
+def _checked(program, quiet: bool, stdout=None, asked: bool = False, drawing: bool = False):
     """Run every check (``Program.check``) with a progress line on a terminal (or when ``asked``); returns the runtime.
 
     Its ``warnings`` are the run's warnings, its ``shot`` the number of
@@ -239,8 +241,8 @@ def _checked(program, quiet: bool, stdout=None, asked: bool = False):
     try:
         if stdout is None:
             # PRINT output is dropped: a run prints it once, when it renders.
-            return program.execute("check", stdout=io.StringIO(), progress=progress)
-        return program.execute("check", stdout=stdout, echo_print=True, progress=progress)
+            return program.execute("check", stdout=io.StringIO(), progress=progress, drawing=drawing)
+        return program.execute("check", stdout=stdout, echo_print=True, progress=progress, drawing=drawing)
     finally:
         if progress is not None:
             progress.done()
@@ -256,7 +258,7 @@ def _render(program, warnings, options, asked: bool = False) -> int:
     from liganimate.runtime.render.options import MOVIES
 
     _print_diagnostics(warnings)
-    checked = _checked(program, options.quiet, asked=asked)
+    checked = _checked(program, options.quiet, asked=asked, drawing=True)
     _print_diagnostics(checked.warnings)
     if not checked.shot:
         # Nothing to draw: no empty folder, no "frames written".
