@@ -10,7 +10,8 @@ token of each: the parser's exact state there. For the next text it
    texts);
 2. goes on from the last Mark before the change, whose token and the
    lexer's look past it lie in the unchanged start, so the parser is where
-   a whole parse of the new text would be;
+   a whole parse of the new text would be (from the start of the text when
+   the change is in the first statement);
 3. stops at the first Mark past the change (on a later line) where the
    parser's states and the token are those of a Mark of the last parse at
    the same place in the unchanged end: from there the whole parse would do
