@@ -101,15 +101,14 @@ def _preorder(robot: Urdf) -> list:
 
 def matrix_rpy(R: np.ndarray) -> tuple[float, float, float]:
     """URDF roll, pitch, yaw (radians) of a rotation, ``R = Rz(yaw) Ry(pitch) Rx(roll)``."""
-    s = -float(R[2, 0])
-    if abs(s) >= 1.0 - 1e-12:
-        pitch = math.copysign(math.pi / 2, s)
-        return math.atan2(-float(R[1, 2]), float(R[1, 1])), pitch, 0.0
-    return (
-        math.atan2(float(R[2, 1]), float(R[2, 2])),
-        math.asin(s),
-        math.atan2(float(R[1, 0]), float(R[0, 0])),
-    )
+    # Near pitch +-90 degrees (UR's rpy="0 1.570796325 0") yaw is ill-conditioned and asin loses half
+    # the digits; taking yaw out first and reading roll and pitch from what is left gives angles whose
+    # matrix is R to rounding, whatever error yaw has (at the exact singularity, yaw is 0).
+    R = np.asarray(R, dtype=np.float64)
+    yaw = math.atan2(float(R[1, 0]), float(R[0, 0])) if math.hypot(R[0, 0], R[1, 0]) > 0.0 else 0.0
+    c, s = math.cos(yaw), math.sin(yaw)
+    M = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]) @ R  # Rz(-yaw) R = Ry(pitch) Rx(roll)
+    return math.atan2(-float(M[1, 2]), float(M[1, 1])), math.atan2(-float(M[2, 0]), float(M[0, 0])), yaw
 
 
 def _placed(expr: str, R: np.ndarray, t: np.ndarray) -> str:

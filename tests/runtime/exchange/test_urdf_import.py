@@ -330,3 +330,15 @@ def test_line_endings_bom_tabs_and_a_late_declaration_are_read(variant, tmp_path
     with pytest.raises(LigDiagnostics) as info:
         X.read_urdf(str(path))
     assert info.value.diagnostics[0].pos.line == (10 if variant == "blank-lines-first" else 8)
+
+
+def test_rpy_of_a_frame_near_a_quarter_pitch_gives_back_the_frame():
+    # example-robot-data's UR5 with gripper turns by rpy="0 1.570796325 0": the name table's RPY
+    # snapped to exactly pi/2 and the frame was 1.8e-9 off.
+    from liganimate.runtime.exchange._urdf_lig import matrix_rpy
+
+    rng = np.random.default_rng(3)
+    for pitch in (1.570796325, -1.570796325, math.pi / 2, -math.pi / 2, 1.5707963267, 0.3):
+        for _ in range(20):
+            R = rpy_matrix((rng.uniform(-math.pi, math.pi), pitch, rng.uniform(-math.pi, math.pi)))
+            np.testing.assert_allclose(rpy_matrix(matrix_rpy(R)), R, rtol=0, atol=1e-15)
