@@ -4,7 +4,9 @@ Part 1, per capture (bvhtoolbox's mocapbank and Mixamo takes, bvhtools'
 Rigify take), retargeted onto the library HUMANOID with
 ``liganimate import --onto humanoid``: the contact frames held, the most a
 held ankle moves in a frame (mm, measured with the runtime's kinematics),
-the joint-frames clamped into HUMANOID's extremes, and the time.
+the joint-frames clamped into HUMANOID's extremes, how far the figure turns
+(its ROOT ORIENTATION's heading, first frame to last) beside how far the
+actor does (the hips' heading, from the BVH's own rotations), and the time.
 
 Part 2, against capture length: a capture of 30 joints (a Mixamo-style
 skeleton) of 1,000, 5,000 and 20,000 frames, made by repeating bvhtools'
@@ -18,7 +20,7 @@ under 10 s of CPU time and 400 MB for each step (issue 19); wall time is
 printed beside it.
 
 Usage: ``python benchmarks/retarget.py [--quick]`` (``--quick``: 1,000 and
-5,000 frames, and the mocapbank capture only). The last line printed is one
+5,000 frames, and the mocapbank and Mixamo captures only). The last line printed is one
 JSON object with every figure.
 """
 
@@ -148,6 +150,20 @@ def length_rows(lengths: list, folder: str) -> list:
     return out
 
 
+def actor_turn(clip) -> float:
+    """Degrees the capture's hips turn about the file's Y, first frame to last, from the BVH's rotations alone."""
+    import numpy as np
+
+    from liganimate.runtime.exchange._clip import clip_pose
+    from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
+
+    pose = clip_pose(clip, "drop")
+    Q = matrix_from_euler_zyx(pose.angles[:, int(np.flatnonzero(clip.parents < 0)[0])])
+    axis = int(np.argmin([np.abs(Q[:, 1, a]).mean() for a in range(3)]))  # the hips' most horizontal axis
+    heading = np.degrees(np.unwrap(np.arctan2(Q[:, 0, axis], Q[:, 2, axis])))
+    return float(heading[-1] - heading[0])
+
+
 def capture_rows(names: list) -> list:
     """Foot slide and clamped frames of each real capture retargeted onto HUMANOID (part 1)."""
     from liganimate.runtime import exchange as X
@@ -171,12 +187,14 @@ def capture_rows(names: list) -> list:
             "held_contact_frames": {s: int(m.sum()) for s, m in result.planted.items()},
             "max_slide_mm_per_frame": round(slide, 4),
             "clamped_joint_frames": int(sum(result.clamped.values())),
+            "figure_turn_deg": round(float(result.orientation[-1, 1] - result.orientation[0, 1]), 2),
+            "actor_turn_deg": round(actor_turn(clip), 2),
             "retarget_cpu_s": round(cpu, 3),
         }
         print(
             f"{name:>9}: {row['frames']} frames, held contacts {row['held_contact_frames']}, "
             f"worst slide {slide:.4f} mm/frame, clamped {row['clamped_joint_frames']} joint-frames, "
-            f"{cpu:.2f} s CPU"
+            f"turns {row['figure_turn_deg']:+.1f} deg (actor {row['actor_turn_deg']:+.1f}), {cpu:.2f} s CPU"
         )
         out.append(row)
     return out
@@ -185,7 +203,7 @@ def capture_rows(names: list) -> list:
 def main() -> None:
     quick = "--quick" in sys.argv
     folder = tempfile.mkdtemp(prefix="retarget-bench-")
-    captures = capture_rows(["mocapbank"] if quick else ["mocapbank", "mixamo", "rigify"])
+    captures = capture_rows(["mocapbank", "mixamo"] if quick else ["mocapbank", "mixamo", "rigify", "long"])
     lengths = length_rows([1000, 5000] if quick else [1000, 5000, 20000], folder)
     print(json.dumps({"benchmark": "retarget", "quick": quick, "captures": captures, "lengths": lengths}))
 

@@ -8,6 +8,12 @@
   navigation to the first frame drawn, as the page measures it
   (``performance.now()`` when the viewer is ready; goal: under 2 s).  The
   best of a few loads (the machine is shared);
+* ``draw``: in the same browser, the page drawing 100 frames of the scene
+  one after another (``setFrame``, then a pixel read that waits for the
+  GPU), in the thesis look and the modern look, and of the modern look's
+  time the contact shadow's (``LigShadow.compute``: the height map from the
+  pose, its blur; the goal is a small share of a frame at 24 frames a
+  second);
 * ``generator``: the studio's Generator producing nine candidates for the
   library HUMANOID, first generation and later ones at three intensities
   (goal: under 50 ms each).  The median and the worst of many.
@@ -48,13 +54,53 @@ def build_page(folder: str):
     return path, time.perf_counter() - t0
 
 
-def load_times(path: str, rounds: int):
-    """Milliseconds from navigation to the first frame, one per load; None without Chromium."""
+# Draws 100 frames; the milliseconds a frame, and the contact shadow's share of them.
+_DRAW = """
+var real = LigShadow.compute, spent = 0;
+LigShadow.compute = function (pos, objects) {
+  var t = performance.now(), m = real(pos, objects);
+  spent += performance.now() - t;
+  return m;
+};
+var gl = document.getElementById('view').getContext('webgl'), px = new Uint8Array(4);
+var t0 = performance.now();
+for (var f = 0; f < 100; f++) ligViewer.setFrame(f * 7);
+gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+LigShadow.compute = real;
+return [(performance.now() - t0) / 100, spent / 100];
+"""
+
+
+def draw_times(driver, path: str, rounds: int) -> dict:
+    """Milliseconds a frame drawing the page, in each look, and the modern look's shadow; the best of ``rounds``."""
+    out: dict = {}
+    for _ in range(rounds):
+        for look in ("thesis", "modern"):
+            driver.get("about:blank")
+            driver.get("file://" + os.path.abspath(path) + f"#size=640x480&look={look}")
+            deadline = time.time() + 60
+            while not driver.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"):
+                if time.time() > deadline:
+                    raise RuntimeError("the viewer did not start")
+                time.sleep(0.02)
+            frame, shadow = driver.execute_script(_DRAW)
+            out[f"{look}_ms"] = min(out.get(f"{look}_ms", frame), frame)
+            if look == "modern":
+                out["shadow_ms"] = min(out.get("shadow_ms", shadow), shadow)
+    return out
+
+
+def load_times(path: str, rounds: int, draws: dict):
+    """Milliseconds from navigation to the first frame, one per load; None without Chromium.
+
+    ``draws`` receives :func:`draw_times`'s figures, measured in the same browser.
+    """
     if missing():
         return None
     times = []
     with Browser(1000, 760) as browser:
         driver = browser.driver
+        draws.update(draw_times(driver, path, rounds))
         for _ in range(rounds):
             driver.get("about:blank")
             driver.get("file://" + os.path.abspath(path))
@@ -108,13 +154,20 @@ def main(argv=None) -> int:
         size = os.path.getsize(path)
         print(f"page: {size / 1e6:.2f} MB (goal < 10 MB), built in {build:.2f} s")
         result.update(html_bytes=size, html_mb=round(size / 1e6, 3), build_s=round(build, 3))
-        times = load_times(path, loads)
+        draws: dict = {}
+        times = load_times(path, loads, draws)
     if times is None:
         print("load: skipped (no chromium, chromium-driver or selenium)")
         result["load_ms"] = None
     else:
         print(f"load: best {min(times):.0f} ms, all {[round(t) for t in times]} (goal < 2000 ms)")
         result.update(load_ms=round(min(times), 1), load_ms_all=[round(t, 1) for t in times])
+        th, mo, sh = draws["thesis_ms"], draws["modern_ms"], draws["shadow_ms"]
+        print(
+            f"draw: thesis look {th:.2f} ms a frame, modern look {mo:.2f} ms ({mo / th:.1f}x), "
+            f"of which the contact shadow {sh:.2f} ms ({100 * sh / mo:.0f} %)"
+        )
+        result["draw_ms"] = {k: round(v, 3) for k, v in draws.items()}
     g = generator_times(gens)
     summary = {}
     for name, ts in g.items():

@@ -21,7 +21,7 @@ from liganimate.lang import numbers as N
 from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import FUNCTIONS, MODIFIERS, Operator, operators_for
-from liganimate.runtime.ik.solvers import DEFAULT_SOLVER, SOLVER_KEYWORDS
+from liganimate.runtime.ik.names import DEFAULT_SOLVER, SOLVER_KEYWORDS
 
 from . import types as T
 from .check import Checked, expr_type
@@ -311,10 +311,12 @@ class Lowerer(NodeVisitor):
         )
 
     def joint_or_root(self, e) -> str:
-        """A keyframe's joint identifier, None for the ROOT track, ``(kind, link)`` for a morph track."""
+        """A keyframe's joint identifier: None for the ROOT track, 'ORIENTATION' for ROOT ORIENTATION, ``(kind, link)`` for a morph track."""
         if isinstance(e, A.MorphTrack):
             return repr((e.kind, e.link))
-        return "None" if isinstance(e, A.RootTrack) else self.expr(e)
+        if isinstance(e, A.RootTrack):
+            return repr("ORIENTATION") if e.orientation else "None"
+        return self.expr(e)
 
     def position(self, items: list) -> str:
         if len(items) == 1:

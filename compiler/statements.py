@@ -16,7 +16,7 @@ from liganimate.lang import bindings, keyframe_table, messages, numbers
 from liganimate.lang.diagnostics import did_you_mean
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import DRAW_WITH, NUMBER
-from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS  # the solver registry, by name only
+from liganimate.runtime.ik.names import SOLVER_KEYWORDS  # the solvers, by name only
 from liganimate.runtime.motion import interpolation
 
 from . import scopes as S
@@ -187,13 +187,14 @@ class StatementChecker(NodeVisitor):
             seen[key] = joint.pos
             return
         if isinstance(joint, A.RootTrack):
-            if "ROOT" in seen:
+            word = "ROOT ORIENTATION" if joint.orientation else "ROOT"
+            if word in seen:
                 self.st.out.error(
                     joint,
-                    f"ROOT appears twice in motion {s.name.name}",
-                    f"the first is at line {seen['ROOT'].line}; a motion has one root track",
+                    f"{word} appears twice in motion {s.name.name}",
+                    f"the first is at line {seen[word].line}; a motion has one {word} track",
                 )
-            seen["ROOT"] = joint.pos
+            seen[word] = joint.pos
         else:
             self.t.want(joint, T.INTEGER, "a joint identifier")
         ident = const(joint)

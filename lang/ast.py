@@ -341,7 +341,12 @@ class ModelBlock(Node):
 
 @dataclass(slots=True)
 class RootTrack(Node):
-    """The word ROOT where a joint identifier stands: the motion's root-translation track."""
+    """The word ROOT where a joint identifier stands: the motion's root-translation track.
+
+    ``ROOT ORIENTATION`` (``orientation`` True) is its root orientation track.
+    """
+
+    orientation: bool = False
 
 
 @dataclass(slots=True)

@@ -10,7 +10,8 @@ token of each: the parser's exact state there. For the next text it
    texts);
 2. goes on from the last Mark before the change, whose token and the
    lexer's look past it lie in the unchanged start, so the parser is where
-   a whole parse of the new text would be;
+   a whole parse of the new text would be (from the start of the text when
+   the change is in the first statement);
 3. stops at the first Mark past the change (on a later line) where the
    parser's states and the token are those of a Mark of the last parse at
    the same place in the unchanged end: from there the whole parse would do
@@ -95,9 +96,7 @@ class Reparser:
                 self.reused = len(text)
                 self.fresh = [] if last.passed else None
                 return self.finish(list(last.statements))
-            resumed = self._resume(last, text)
-            if resumed is not None:
-                return resumed
+            return self._resume(last, text)
         watch = _Watch(self._between_state(), None, text, primitives)
         value = self.driver.parse(text, primitives, watch=watch)
         self._keep(watch, watch.statements)
@@ -118,31 +117,33 @@ class Reparser:
         return self._between
 
     def _resume(self, last: _Last, text: str):
-        """Parse ``text`` from the last Mark before its change from ``last.text``; None when there is none."""
+        """Parse ``text`` from the last Mark before its change from ``last.text`` (or from its start, if none)."""
         old = last.text
         head = _common_start(old, text)
         tail = _common_end(old, text, min(len(old), len(text)) - head)
         k = bisect.bisect_left(last.offsets, head) - 1
         while k >= 0 and _lexed_before(text, last.marks[k].tok, head) is False:
             k -= 1
-        if k < 0:
-            return None
-        mark = last.marks[k]
         watch = _Watch(self._between_state(), last, text, last.primitives)
         watch.kept = last.marks[: k + 1]
         watch.changed_end = len(text) - tail
         watch.shift = len(text) - len(old)
-        statements = last.statements[: mark.preceding]
-        watch.statements = statements
-        self.reused = mark.tok[6]
-        value = self.driver.parse(text, last.primitives, resume=(mark, statements), watch=watch)
+        if k < 0:  # a change in the first statement: from the start, but the last parse still takes over after it
+            first, resume, self.reused = 0, None, 0
+        else:
+            mark = last.marks[k]
+            first, self.reused = mark.preceding, mark.tok[6]
+            watch.statements = last.statements[:first]
+            resume = (mark, watch.statements)
+        value = self.driver.parse(text, last.primitives, resume=resume, watch=watch)
+        statements = watch.statements
         self._keep(watch, statements)
-        if last.passed:
-            self.fresh = statements[mark.preceding : watch.taken_at]
+        if last.passed and statements is not None:
+            self.fresh = statements[first : watch.taken_at]
         self.reused += watch.reused_tail
         if watch.result is None:
             return value  # the parse went on to the end of the text
-        return self.finish(list(statements))
+        return self.finish(list(watch.result))
 
     def forget(self) -> None:
         """Parse the next text whole."""

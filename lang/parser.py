@@ -447,6 +447,10 @@ def _token_diagnostic(tok, expected: set, text: str, source: Source) -> Diagnost
     elif tok.type == "PRIM_NAME" and "NAME" in expected:
         message = f"{tok.value.upper()} is a primitive, so it cannot be used as a variable name here"
         hint = "choose another name"
+    elif str(tok.value).upper() == "ORIENTATION" and "ORIENTATION" not in expected:
+        # A turn written on a joint's track (JOINT 3 ORIENTATION, m[3 ORIENTATION, k]): only the figure turns as a whole.
+        message = "only the ROOT track has an ORIENTATION; a joint's three angles are its POSITION"
+        hint = "turn the whole figure with a ROOT ORIENTATION entry (its POSITION is three angles, the heading about Y)"
     else:
         message = f"unexpected {_describe_token(tok)}; expected {_describe_expected(expected)}"
         hint = _misspelt_keyword(tok, expected)

@@ -140,8 +140,6 @@ class ToAst(Transformer):
 
     def keyframe_assign(self, children):
         target, joint, index, op, keyframe = children
-        if isinstance(joint, TOKENS) and joint.type == "ROOT":
-            joint = A.RootTrack(_tpos(joint))
         return A.KeyframeAssign(span(children), _name(target), joint, index, op.value, keyframe)
 
     def keyframe(self, children):
@@ -286,10 +284,10 @@ class ToAst(Transformer):
         return A.MotionTable(span(children), columns, rows.value, _tpos(rows))
 
     def table_column(self, children):
-        c = children[0]
-        if isinstance(c, TOKENS) and c.type == "ROOT":
-            return A.RootTrack(_tpos(c))
-        return c
+        return children[0]
+
+    def root_track(self, children):
+        return A.RootTrack(_tpos(children[0]), len(children) > 1)
 
     def motion_joint(self, children):
         joint = children[1]
@@ -308,7 +306,7 @@ class ToAst(Transformer):
         return A.MotionJoint(span(children), joint, start, keyframes)
 
     def motion_root(self, children):
-        joint = A.MotionJoint(span(children), A.RootTrack(_tpos(children[0])), None, [])
+        joint = A.MotionJoint(span(children), children[0], None, [])
         rest = self.motion_joint([children[0], None] + list(children[1:]))
         joint.start, joint.keyframes = rest.start, rest.keyframes
         return joint

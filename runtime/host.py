@@ -587,7 +587,7 @@ class Runtime(Arithmetic):
                 morphs.append((*joint, start, kfs, jat))
                 continue
             if joint in spec:
-                self.fail(jat, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
+                self.fail(jat, f"{_track_label(joint)} appears twice in this motion")
             for _frame, pos, _method, kat in kfs:
                 self._guard(kat, E.check_angles, pos, joint is None)
             self._frames_in_order(kfs)
@@ -597,9 +597,11 @@ class Runtime(Arithmetic):
                 tuple(start) if start is not None else (0.0, 0.0, 0.0),
                 [Keyframe(f, tuple(p), meth or "LINEAR") for f, p, meth, _ in kfs],
             )
-        root = spec.pop(None, None)  # the ROOT entry (lower.py writes its joint as None)
-        arrays = self._table_tracks(tables, spec, root is not None)
-        motion = self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays))
+        # The ROOT entries (lower.py writes their joints as None and M.ORIENTATION).
+        root, turn = spec.pop(None, None), spec.pop(M.ORIENTATION, None)
+        given = {j for j, track in ((None, root), (M.ORIENTATION, turn)) if track is not None}
+        arrays = self._table_tracks(tables, spec, given)
+        motion = self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays, turn=turn))
         if not morphs:
             return motion
         return self._guard(at, lambda: motion.with_morphs(MO.channels(morphs, motion.length, self.fail)))
@@ -615,7 +617,7 @@ class Runtime(Arithmetic):
                 self.fail(kat, messages.keyframes_too_close(frame, last), messages.GAP_HINT)
             last = frame
 
-    def _table_tracks(self, tables, spec: dict, has_root: bool) -> dict:
+    def _table_tracks(self, tables, spec: dict, given: set) -> dict:
         """Each table column as ``(start, frames, values)``: its first row is the start, the others keyframes."""
         arrays: dict = {}
         for t in tables:
@@ -625,8 +627,8 @@ class Runtime(Arithmetic):
                 self.fail(t.at, "this keyframe table's rows do not have one frame and three numbers per column")
             data = data.reshape(-1, width)
             for n, joint in enumerate(t.columns):
-                if joint in spec or joint in arrays or (joint is None and has_root):
-                    self.fail(t.at, f"{'ROOT' if joint is None else f'joint {joint}'} appears twice in this motion")
+                if joint in spec or joint in arrays or joint in given:
+                    self.fail(t.at, f"{_track_label(joint)} appears twice in this motion")
                 cols = data[:, 1 + 3 * n : 4 + 3 * n]
                 arrays[joint] = (cols[0], data[1:, 0], cols[1:])
         return arrays
@@ -761,7 +763,8 @@ class Runtime(Arithmetic):
 
     def _bind(self, fig: F.Figure, motion: M.Motion, at):
         """Check (once per pair) that a motion suits a model; warn about joints it lacks."""
-        key = (id(fig.joints), id(motion))
+        # (A motion that morphs segments meets the links too: the same joints may carry other shapes.)
+        key = (id(fig.joints), id(motion), id(fig.links) if motion.morphs is not None else None)
         if key in self._bind_cache:
             return
         self._bind_cache[key] = (fig, motion)
@@ -861,12 +864,19 @@ class SceneState:
 
 
 def _rooted(posed: Posed) -> Posed:
-    """A drawn pose with its motion's root path folded into the placement (world = placement @ Trans(root) @ pose)."""
-    if posed.motion.root is None:
+    """A drawn pose with its motion's root track folded into the placement (world = placement @ Trans(root) @ Rot @ pose)."""
+    if posed.motion.root is None and posed.motion.turn is None:
         return posed
     fig = posed.figure
     placed = P.rooted_placements(np.asarray(fig.placement)[None], posed.motion, np.array([posed.frame]))[0]
     return posed.with_figure(fig.with_placement(placed))
+
+
+def _track_label(joint) -> str:
+    """How a diagnostic names a motion's track: ``joint 3``, ``ROOT``, ``ROOT ORIENTATION``."""
+    if joint is None:
+        return "ROOT"
+    return "ROOT ORIENTATION" if joint == M.ORIENTATION else f"joint {joint}"
 
 
 def _joint_kind(kind) -> F.JointKind:

@@ -28,7 +28,7 @@ def model_table(figure, label: str, motion=None, frame: float | None = None) -> 
 
 
 def motion_listing(motion, label: str) -> str:
-    """``PRINT motion``: its length and joints, then each joint's keyframes and the ROOT track's (at most 1,000 each)."""
+    """``PRINT motion``: its length and joints, then each joint's keyframes and the ROOT tracks' (at most 1,000 each)."""
     joints = ", ".join(map(str, motion.joints)) or "none"
     lines = [f"MOTION {label}: length {motion.length:g} frames, joints {joints}"]
     try:
@@ -40,6 +40,11 @@ def motion_listing(motion, label: str) -> str:
         if motion.root is not None:
             start, kfs = motion.root_keyframes(limit=1000)
             lines.append(f"  ROOT POSITION {_vector(start)}")
+            for k in kfs:
+                lines.append(f"    FRAME {k.frame:g} POSITION {_vector(k.position)} INTERPOLATE {k.method}")
+        if motion.turn is not None:
+            start, kfs = motion.turn_keyframes(limit=1000)
+            lines.append(f"  ROOT ORIENTATION POSITION {_vector(start)}")
             for k in kfs:
                 lines.append(f"    FRAME {k.frame:g} POSITION {_vector(k.position)} INTERPOLATE {k.method}")
         if motion.morphs is not None:

@@ -36,7 +36,7 @@ CONTRACT = {
         "liganimate.lang",
         # The runtime's vocabularies, by name only: the interpolation methods and solvers a program may name.
         "liganimate.runtime.motion.interpolation",
-        "liganimate.runtime.ik.solvers",
+        "liganimate.runtime.ik.names",
         # compiler.load_program executes the module it lowered, piece by piece.
         "liganimate.runtime.loader",
     ),

@@ -96,8 +96,10 @@ def read_bvh(path: str) -> BvhClip:
     """
     with open(path, "rb") as fh:
         raw = fh.read()
-    text = raw.decode("utf-8", errors="replace")
-    text = text.removeprefix("\ufeff")
+    # Windows editors save "Unicode" as UTF-16 with a byte order mark; old Mac files end lines with CR alone.
+    encoding = "utf-16" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "utf-8"
+    text = raw.decode(encoding, errors="replace")
+    text = text.removeprefix("\ufeff").replace("\r\n", "\n").replace("\r", "\n")
     return parse_bvh(text, path)
 
 

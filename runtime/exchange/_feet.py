@@ -26,8 +26,8 @@ REACH = 0.995  # of the straight leg's length
 HOLD = 0.0005
 
 
-def _world(tgt, angles: np.ndarray, path: np.ndarray):
-    """World rotations (F, n, 3, 3) and joint points (F, n, 3) of every link, the main link at ``path``."""
+def _world(tgt, angles: np.ndarray, path: np.ndarray, main: np.ndarray | None = None):
+    """World rotations (F, n, 3, 3) and joint points (F, n, 3) of every link, the main link at ``path`` turned by ``main``."""
     F = len(angles)
     n = tgt.fig.n_links
     W = np.empty((F, n, 3, 3))
@@ -36,7 +36,7 @@ def _world(tgt, angles: np.ndarray, path: np.ndarray):
     for i in tgt.order:
         p, k = tgt.parent[i], tgt.joint[i]
         if p < 0:
-            W[:, i], O[:, i], P[:, i] = np.eye(3), path, path
+            W[:, i], O[:, i], P[:, i] = np.eye(3) if main is None else main, path, path
             continue
         P[:, i] = O[:, p] + W[:, p] @ tgt.loc1[k]
         W[:, i] = W[:, p] @ matrix_from_euler_zyx(angles[:, k])
@@ -44,9 +44,13 @@ def _world(tgt, angles: np.ndarray, path: np.ndarray):
     return W, P
 
 
-def leg_chain_positions(tgt, angles: np.ndarray, path: np.ndarray, link: int) -> np.ndarray:
-    """Where link ``link``'s joint is at every frame (F, 3), in the model's frame."""
-    return _world(tgt, angles, path)[1][:, link]
+def leg_chain_positions(tgt, angles: np.ndarray, path: np.ndarray, link: int | None, main=None) -> np.ndarray:
+    """Where link ``link``'s joint is at every frame (F, 3), in the model's frame (``link`` None: every link's, (F, n, 3)).
+
+    ``main`` (F, 3, 3): the main link's world rotation (None: it does not turn).
+    """
+    points = _world(tgt, angles, path, main)[1]
+    return points if link is None else points[:, link]
 
 
 def _knee_axis(tgt, k: int) -> int:
@@ -141,10 +145,12 @@ def _solve_leg(x, W_parent, hip, goal, a, b, axis, hip_ext, knee_ext, steps: int
     return x
 
 
-def keep_feet(tgt, angles: np.ndarray, path: np.ndarray, desired: dict, planted: dict, jmap) -> list:
-    """Hold each planted ankle (changes ``angles`` and ``path`` in place); returns notes."""
+def keep_feet(tgt, angles: np.ndarray, path: np.ndarray, desired: dict, planted: dict, jmap, main=None) -> list:
+    """Hold each planted ankle (changes ``angles`` and ``path`` in place); returns notes.
 
-    W, P = _world(tgt, angles, path)
+    ``main`` (F, 3, 3) is the main link's world rotation (its ROOT ORIENTATION); None: it does not turn.
+    """
+    W, P = _world(tgt, angles, path, main)
     goals = {}
     drop = np.zeros(len(angles))
     for side, mask in planted.items():
@@ -153,7 +159,7 @@ def keep_feet(tgt, angles: np.ndarray, path: np.ndarray, desired: dict, planted:
         reach = float(np.linalg.norm(tgt.pivot[low] - tgt.pivot[up]) + np.linalg.norm(tgt.pivot[foot] - tgt.pivot[low]))
         drop = np.maximum(drop, _lower_pelvis(P[:, up], goals[side][0], mask, reach))
     path[:, 1] -= drop
-    W, P = _world(tgt, angles, path)
+    W, P = _world(tgt, angles, path, main)
     released = {}
     for side, (goal, held) in goals.items():
         up, low, foot = jmap.feet[side][1]

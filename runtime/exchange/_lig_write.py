@@ -37,6 +37,7 @@ from liganimate.runtime.motion.algebra import Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
 from ._clip import clip_pose, clip_size
+from ._heading import split_heading
 from ._numbers import format_rows
 
 __all__ = [
@@ -170,8 +171,11 @@ def import_library(clip, options: ImportOptions) -> tuple:
         name_table.format_table(options.model, _name_rows(clip, links)),
     ]
     head = ("\n".join(parts) + "\n").encode("utf-8")
-    keep = reduce_keyframes(pose.angles, options.tolerance) if options.tolerance > 0 else None
-    return head + _motion_text(options.motion, pose.angles, pose.rotating, keep, pose.path), list(pose.notes)
+    # The hips' turn about up is the motion's ROOT ORIENTATION, so that + continues it.
+    angles, orientation = split_heading(clip.parents, pose.angles)
+    keep = reduce_keyframes(angles, options.tolerance) if options.tolerance > 0 else None
+    body = _motion_text(options.motion, angles, pose.rotating, keep, pose.path, orientation=orientation)
+    return head + body, list(pose.notes)
 
 
 def _refuse_beyond_reach(clip, offsets: np.ndarray) -> None:
@@ -216,7 +220,8 @@ def _header(clip, options: ImportOptions, links: list, src: str) -> list:
         "C real time render with --fps matching the capture.",
         "C",
         "C The ROOT's path is the motion's ROOT track: ANIMATE carries the figure along it, in",
-        "C the model's own frame, after the placement (see docs/exchange.md). The {@names}",
+        "C the model's own frame, after the placement (see docs/exchange.md); the ROOT's turn",
+        "C about Y, from the first frame's, is its ROOT ORIENTATION, and JOINT 1 the rest. The {@names}",
         "C table after the model keeps the BVH names and channels for export.",
         "C",
         "C   joint  segment            BVH joint (channels)",
@@ -276,12 +281,15 @@ def _name_rows(clip, links: list) -> list:
     return rows
 
 
-def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None, ids=None) -> bytes:
+def _motion_text(
+    name: str, angles: np.ndarray, rotating: np.ndarray, keep=None, path=None, ids=None, orientation=None
+) -> bytes:
     """STARTMOTION ... ENDMOTION: keyframes at every frame (or at ``keep[j]``) for every joint that moves.
 
     ``path`` (F, 3), if given, is the ROOT track: its start position, then a
     keyframe at every frame if it moves.  ``ids`` are the joints' identifiers
-    (default 1, 2, ...).  With a keyframe at every frame (``keep`` None) the
+    (default 1, 2, ...).  ``orientation`` (F, 3), if given, is the ROOT
+    ORIENTATION track, written as the path is.  With a keyframe at every frame (``keep`` None) the
     moving tracks go into one keyframe table (``TABLE``, docs/language.md
     4.8), a row a frame; with ``keep``, each joint lists its own keyframes.
     """
@@ -291,10 +299,32 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
     if F > 1 and not moving.any():
         moving[0] = True  # keep the motion's length: one joint carries every frame
     ids = list(range(1, J + 1)) if ids is None else list(ids)
-    root_moves = path is not None and F > 1 and bool((path != path[:1]).any())
     table = keep is None and F > 1
     frames = np.arange(1, F, dtype=np.float64)
-    for j in range(J):
+    parts += _joint_entries(angles, rotating, moving, ids, keep, table)
+    columns = [angles[:, j] for j in range(J) if moving[j]] if table else []
+    names = [str(ids[j]) for j in range(J) if moving[j]] if table else []
+    for word, track in (("ROOT", path), ("ROOT ORIENTATION", orientation)):
+        if track is None:
+            continue
+        if table and F > 1 and bool((track != track[:1]).any()):
+            columns.append(track)
+            names.append(word)
+            continue
+        parts.append(format_rows(track[:1], DECIMALS, sep=",", prefix=f"        {word} POSITION", suffix="\n"))
+        if F > 1 and bool((track != track[:1]).any()):
+            parts.append(_keyframe_rows(frames, track[1:]))
+    if table:
+        parts.append(_table_text(names, np.arange(F, dtype=np.float64), columns))
+    parts.append(b"      ENDMOTION\n")
+    return b"".join(parts)
+
+
+def _joint_entries(angles, rotating, moving, ids: list, keep, table: bool) -> list:
+    """``JOINT n POSITION ...`` and its keyframe lines for each joint not in the table."""
+    frames = np.arange(1, len(angles), dtype=np.float64)
+    parts = []
+    for j in range(angles.shape[1]):
         if not rotating[j] and not moving[j] or (table and moving[j]):
             continue
         start = format_rows(angles[:1, j], DECIMALS, sep=",", prefix=f"        JOINT {ids[j]} POSITION", suffix="\n")
@@ -302,16 +332,7 @@ def _motion_text(name: str, angles: np.ndarray, rotating: np.ndarray, keep=None,
         if moving[j]:
             rows = keep[j][keep[j] > 0]
             parts.append(_keyframe_rows(frames[rows - 1], angles[rows, j]))
-    if path is not None and not (table and root_moves):
-        parts.append(format_rows(path[:1], DECIMALS, sep=",", prefix="        ROOT POSITION", suffix="\n"))
-        if root_moves:
-            parts.append(_keyframe_rows(frames, path[1:]))
-    if table:
-        columns = [angles[:, j] for j in range(J) if moving[j]] + ([path] if root_moves else [])
-        names = [str(ids[j]) for j in range(J) if moving[j]] + (["ROOT"] if root_moves else [])
-        parts.append(_table_text(names, np.arange(F, dtype=np.float64), columns))
-    parts.append(b"      ENDMOTION\n")
-    return b"".join(parts)
+    return parts
 
 
 def _table_text(names: list, frames: np.ndarray, columns: list) -> bytes:
@@ -320,7 +341,7 @@ def _table_text(names: list, frames: np.ndarray, columns: list) -> bytes:
     for k in range(12, len(names), 12):
         head[-1] += ","
         head.append("              " + ", ".join(names[k : k + 12]))
-    legend = "frame, then x y z of " + ", ".join(n if n == "ROOT" else f"JOINT {n}" for n in names)
+    legend = "frame, then x y z of " + ", ".join(n if n.startswith("ROOT") else f"JOINT {n}" for n in names)
     head.append(f"{{ {legend} }}")
     table = np.column_stack([frames] + columns)
     rows = format_rows(table, [0] + [DECIMALS] * (table.shape[1] - 1), prefix="          |", suffix="\n")
@@ -328,7 +349,13 @@ def _table_text(names: list, frames: np.ndarray, columns: list) -> bytes:
 
 
 def motion_library(
-    name: str, angles: np.ndarray, ids: list, path: np.ndarray, comments: list, tolerance: float = 0.0
+    name: str,
+    angles: np.ndarray,
+    ids: list,
+    path: np.ndarray,
+    comments: list,
+    tolerance: float = 0.0,
+    orientation: np.ndarray | None = None,
 ) -> bytes:
     """A library holding one MOTION: ``comments`` (lines) first, then its declaration and keyframes.
 
@@ -344,12 +371,15 @@ def motion_library(
         Written as ``C`` lines (made safe for a brace comment).
     tolerance : float
         As :class:`ImportOptions`'.
+    orientation : ndarray, shape (F, 3), optional
+        The ROOT ORIENTATION track (degrees, unwrapped along the frames).
     """
     head = [("C " + comment_text(c)).rstrip() for c in comments]
     head += ["", f"      MOTION {name}", ""]
     keep = reduce_keyframes(angles, tolerance) if tolerance > 0 else None
     rotating = np.ones(angles.shape[1], dtype=bool)
-    return ("\n".join(head) + "\n").encode("utf-8") + _motion_text(name, angles, rotating, keep, path, ids)
+    body = _motion_text(name, angles, rotating, keep, path, ids, orientation)
+    return ("\n".join(head) + "\n").encode("utf-8") + body
 
 
 def read_root_path(path: str) -> np.ndarray:

@@ -114,11 +114,15 @@ def foot_slide(fig, result: Retargeted, jmap: JointMap) -> float:
     the retargeting's.
     """
     from liganimate.runtime.figure.kinematics import pose_transforms
+    from liganimate.runtime.motion.turning import orientation_matrix
 
     angles = np.zeros((len(result.path), fig.n_joints, 3))
     for n, jid in enumerate(result.joint_ids):
         angles[:, fig.joint_index(jid)] = result.angles[:, n]
     X = pose_transforms(fig, angles)
+    if result.orientation is not None:  # the figure turns: world = Trans(path) @ Rot(orientation) @ pose
+        R = orientation_matrix(result.orientation)
+        X[:, :, :3, :] = np.einsum("fij,fnjk->fnik", R, X[:, :, :3, :])
     worst = 0.0
     for side, mask in result.planted.items():
         foot = jmap.feet[side][1][2]
@@ -148,7 +152,9 @@ def retarget_library(clip, options: OntoOptions) -> tuple:
         "",
         *report,
     ]
-    text = motion_library(options.motion, result.angles, result.joint_ids, result.path, comments, options.tolerance)
+    text = motion_library(
+        options.motion, result.angles, result.joint_ids, result.path, comments, options.tolerance, result.orientation
+    )
     return text, report, result
 
 
@@ -174,5 +180,10 @@ def _report(clip, fig, name, library, jmap: JointMap, result: Retargeted) -> lis
             f"planted frames: left {planted.get('L', 0)}, right {planted.get('R', 0)}; "
             f"the most a planted ankle moves in a frame: {slide:.3g}"
         )
+    heading = result.orientation[:, 1]
+    lines.append(
+        f"heading (ROOT ORIENTATION, degrees about up): {heading[0]:.0f} to {heading[-1]:.0f}, "
+        f"turning {heading[-1] - heading[0]:+.0f} in all (between {heading.min():.0f} and {heading.max():.0f})"
+    )
     lines += [f"note: {n}" for n in result.notes]
     return lines

@@ -5,7 +5,11 @@ The steps (docs/exchange.md, "Retargeting", has the whole story):
 1. **Facing.**  Each skeleton's right, up and forward directions come from
    its rest pose (right: the right thigh's joint less the left's; up: the
    head or neck less the hips); ``F`` turns the capture's world into the
-   figure's (a capture facing +Z onto HUMANOID, which faces +X).
+   figure's (a capture facing +Z onto HUMANOID, which faces +X), the
+   capture's mean heading forward.  Where the capture's hips head, frame by
+   frame (their turn about up away from that mean), is the motion's ROOT
+   ORIENTATION: the figure's main link turns with the actor, and the tilt
+   is left to the joints below it, as before.
 2. **Rest pose.**  For each mapped pair, ``C`` is the smallest rotation
    taking the figure's bone (from its joint to the next mapped joint below
    it) onto the capture's rest bone, seen through ``F``: a T-pose capture's
@@ -34,9 +38,10 @@ import numpy as np
 
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure.kinematics import matrix_from_euler_zyx
+from liganimate.runtime.motion.turning import orientation_angles
 
 from ._clip import clip_pose, rest_positions
-from ._feet import keep_feet
+from ._feet import keep_feet, leg_chain_positions
 from ._joint_map import JointMap
 from ._rigging import CLAMP_REPORT, at_least, fit_angles, rotation_between, runs
 
@@ -80,6 +85,10 @@ class Retargeted:
     angles : ndarray, shape (F, len(joint_ids), 3)
     path : ndarray, shape (F, 3)
         The ROOT track: the main link's displacement in the model's frame.
+    orientation : ndarray, shape (F, 3)
+        The ROOT ORIENTATION track: the main link's heading, degrees
+        (:func:`liganimate.runtime.motion.turning.orientation_angles`),
+        unwrapped along the frames.
     scale : float
     clamped : dict
         Joint id -> number of frames an angle of it was clamped by more than
@@ -92,6 +101,7 @@ class Retargeted:
     joint_ids: list
     angles: np.ndarray
     path: np.ndarray
+    orientation: np.ndarray
     scale: float
     clamped: dict
     planted: dict = field(default_factory=dict)
@@ -122,7 +132,8 @@ class _Source:
                 self.Q[:, j] = self.Q[:, p] @ local[:, j]
                 self.P[:, j] = self.P[:, p] + self.Q[:, p] @ pose.offsets[j]
         self.frame_time = clip.frame_time
-        self.turn = 0.0  # degrees the hips turn away from their mean heading (set by _alignment)
+        self.turn = np.zeros(F)  # radians the hips turn away from their mean heading (set by _alignment)
+        self.up = np.array([0.0, 1.0, 0.0])  # the figure's up (set by _alignment)
 
 
 # ---------------------------------------------------------------- target side
@@ -167,7 +178,13 @@ def _frame(right: np.ndarray, up: np.ndarray) -> np.ndarray:
 
 
 def _alignment(src: _Source, tgt: _Target, jmap: JointMap):
-    """``F`` (capture world to figure world) and, per mapped pair, the rest correction ``C``."""
+    """``Fw`` (capture world to figure world), ``Fr`` (capture rest to figure rest) and each pair's rest correction ``C``.
+
+    The two differ for a capture whose rest pose does not stand upright in
+    its file (bvhtools' long take lies along -X at rest, its hips' rotation
+    standing it up): the world's up is the file's axis the posed hips stand
+    along over the ankles, the rest pose's where its own hips are.
+    """
     (s_left, _, s_lfoot), (t_left, _, t_lfoot) = jmap.feet["L"]
     (s_right, _, s_rfoot), (t_right, _, t_rfoot) = jmap.feet["R"]
     s_root = int(np.flatnonzero(src.parents < 0)[0])
@@ -175,30 +192,37 @@ def _alignment(src: _Source, tgt: _Target, jmap: JointMap):
     s_up = src.rest[s_root] - (src.rest[s_lfoot] + src.rest[s_rfoot]) / 2
     t_up = tgt.pivot[tgt.fig.main] - (tgt.pivot[t_lfoot] + tgt.pivot[t_rfoot]) / 2
     t_frame = _frame(tgt.pivot[t_right] - tgt.pivot[t_left], t_up)
-    Fm = t_frame @ _frame(src.rest[s_right] - src.rest[s_left], s_up).T
-    # The figure's main link cannot turn: face the capture's mean heading forward.
-    turn = _heading(Fm, src.Q[:, s_root], t_frame[:, 1], t_frame[:, 2])
+    Fr = t_frame @ _frame(src.rest[s_right] - src.rest[s_left], s_up).T
+    # The world's up is the file's axis nearest to where the posed hips are over the ankles
+    # (BVH's Y, nearly always): the floor of a capture is level in its file.
+    lift = (src.P[:, s_root] - (src.P[:, s_lfoot] + src.P[:, s_rfoot]) / 2).mean(axis=0)
+    w_up = np.zeros(3)
+    w_up[int(np.argmax(np.abs(lift)))] = 1.0 if lift[int(np.argmax(np.abs(lift)))] > 0 else -1.0
+    Fw = rotation_between(w_up, t_frame[:, 1])
+    # Face the capture's mean heading forward; the main link turns away from it with the hips.
+    turn = _heading(Fw, src.Q[:, s_root], Fr.T @ t_frame[:, 2], t_frame[:, 1], t_frame[:, 2])
     mean = float(np.arctan2(np.sin(turn).mean(), np.cos(turn).mean()))
-    Fm = _about(t_frame[:, 1], -mean) @ Fm
-    src.turn = float(np.degrees(np.abs((turn - mean + np.pi) % (2 * np.pi) - np.pi).max()))
+    Fw = _about(t_frame[:, 1], -mean) @ Fw
+    src.turn = np.unwrap((turn - mean + np.pi) % (2 * np.pi) - np.pi)
+    src.up = t_frame[:, 1]
     corrections = []
     for s, t in jmap.pairs:
         tip = _tip(src.parents, tgt.parent, jmap.pairs, s, t)
         if tip is None:
             corrections.append(np.eye(3))
             continue
-        s_bone = Fm @ (src.rest[tip[0]] - src.rest[s])
+        s_bone = Fr @ (src.rest[tip[0]] - src.rest[s])
         t_bone = tgt.pivot[tip[1]] - tgt.pivot[t]
         if np.linalg.norm(s_bone) < 1e-12 or np.linalg.norm(t_bone) < 1e-12:
             corrections.append(np.eye(3))
         else:
             corrections.append(rotation_between(t_bone, s_bone))
-    return Fm, corrections
+    return Fw, Fr, corrections
 
 
-def _heading(Fm: np.ndarray, Q: np.ndarray, up: np.ndarray, ref: np.ndarray) -> np.ndarray:
-    """The angles (radians, about ``up``) by which rotations ``Q`` (seen through ``Fm``) turn ``ref`` around."""
-    v = np.einsum("ij,fjk,lk,l->fi", Fm, Q, Fm, ref)
+def _heading(Fw: np.ndarray, Q: np.ndarray, forward: np.ndarray, up: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """The angles (radians, about ``up``) from ``ref`` to where rotations ``Q`` point the capture's rest ``forward``, seen through ``Fw``."""
+    v = np.einsum("ij,fjk,k->fi", Fw, Q, forward)
     v -= np.outer(v @ up, up)
     return np.arctan2(np.cross(ref, v) @ up, v @ ref)
 
@@ -240,18 +264,27 @@ def _depth(parents, j: int) -> int:
 # ---------------------------------------------------------------- rotations
 
 
-def _rotations(src: _Source, tgt: _Target, jmap: JointMap, Fm: np.ndarray, corrections: list):
+def _main_rotation(src: _Source) -> np.ndarray:
+    """The main link's world rotation (F, 3, 3): the hips' heading about the figure's up."""
+    axis = src.up
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    s, c = np.sin(src.turn)[:, None, None], np.cos(src.turn)[:, None, None]
+    return np.eye(3) + s * K + (1 - c) * (K @ K)
+
+
+def _rotations(src: _Source, tgt: _Target, jmap: JointMap, frames: tuple, corrections: list):
     """Clamped joint angles (F, J, 3) of the figure and each link's world rotation (F, n_links, 3, 3)."""
+    Fw, Fr = frames
     F = src.Q.shape[0]
     n, J = tgt.fig.n_links, tgt.fig.n_joints
-    desired = {t: np.einsum("ij,fjk,lk,lm->fim", Fm, src.Q[:, s], Fm, C) for (s, t), C in zip(jmap.pairs, corrections)}
+    desired = {t: np.einsum("ij,fjk,lk,lm->fim", Fw, src.Q[:, s], Fr, C) for (s, t), C in zip(jmap.pairs, corrections)}
     W = np.empty((F, n, 3, 3))
     angles = np.zeros((F, J, 3))
     clamped = np.zeros((F, J), dtype=bool)
     for i in tgt.order:
         p, k = tgt.parent[i], tgt.joint[i]
         if p < 0:
-            W[:, i] = np.eye(3)
+            W[:, i] = _main_rotation(src)
             continue
         if i in desired:
             local = np.swapaxes(W[:, p], -1, -2) @ desired[i]
@@ -279,6 +312,19 @@ def _root_path(src: _Source, tgt: _Target, jmap: JointMap, Fm: np.ndarray, scale
     path = (hips - hips[0]) * scale
     path[:, 1] = (hips[:, 1] - ankle_level) * scale + float(np.mean(tgt.pivot[feet_t, 1])) - tgt.pivot[tgt.fig.main, 1]
     return path
+
+
+def _stand(tgt: _Target, jmap: JointMap, angles: np.ndarray, path: np.ndarray, main: np.ndarray) -> None:
+    """Set the figure on its feet (``path`` changed in place): its ankles, as its own retargeted legs put them, are
+    as low at their lowest (the 5th percentile of both) as they are when the figure stands at rest.
+
+    The capture's hips-over-ankles height, scaled, only approximates this: the figure's legs bend
+    as their extremes let them, not exactly as the actor's.
+    """
+    feet = [jmap.feet[side][1][2] for side in jmap.feet]
+    points = leg_chain_positions(tgt, angles, path, None, main)
+    level = float(np.percentile(points[:, feet, 1], 5))
+    path[:, 1] += float(np.mean(tgt.pivot[feet, 1])) - level
 
 
 def _contacts(src: _Source, jmap: JointMap, Fm: np.ndarray, length: float) -> dict:
@@ -325,27 +371,27 @@ def retarget(clip, fig, jmap: JointMap, options: RetargetOptions = RetargetOptio
             "map both legs in the map file (--map), or retarget onto a figure with legs and feet",
         )
     src, tgt = _Source(clip, options.joint_translation), _Target(fig)
-    Fm, corrections = _alignment(src, tgt, jmap)
+    Fm, Fr, corrections = _alignment(src, tgt, jmap)
     s_len = np.mean([_leg_length(src.rest, jmap.feet[s][0]) for s in "LR"])
     t_len = np.mean([_leg_length(tgt.pivot, jmap.feet[s][1]) for s in "LR"])
     scale = options.scale if options.scale is not None else float(t_len / s_len)
-    angles, W, clamped, desired = _rotations(src, tgt, jmap, Fm, corrections)
+    angles, W, clamped, desired = _rotations(src, tgt, jmap, (Fm, Fr), corrections)
     path = _root_path(src, tgt, jmap, Fm, scale)
     planted = _contacts(src, jmap, Fm, float(s_len)) if options.keep_feet else {}
     notes = list(src.notes)
-    if src.turn > 10.0:
-        notes.append(
-            f"the capture's hips turn up to {src.turn:.0f} degrees from their mean heading; the figure's main "
-            "link cannot turn, so the joints below it take the turn up to their extremes"
-        )
+    main = _main_rotation(src)
+    orientation = np.degrees(np.unwrap(np.radians(orientation_angles(main)), axis=0))
+    _stand(tgt, jmap, angles, path, main)
     if planted:
-        notes += keep_feet(tgt, angles, path, desired, planted, jmap)
+        notes += keep_feet(tgt, angles, path, desired, planted, jmap, main)
+        _stand(tgt, jmap, angles, path, main)  # the held feet moved: stand again (all together, so none slides)
     driven = sorted({int(tgt.joint[t]) for _, t in jmap.pairs if tgt.joint[t] >= 0} | _feet_joints(tgt, jmap))
     ids = [tgt.fig.joints[k].id for k in driven]
     return Retargeted(
         joint_ids=ids,
         angles=angles[:, driven],
         path=path,
+        orientation=orientation,
         scale=scale,
         clamped={tgt.fig.joints[k].id: int(clamped[:, k].sum()) for k in driven if clamped[:, k].any()},
         planted=planted,

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from liganimate.lang import name_table
+from liganimate.runtime.budgets import budget
 
 from ._lig_write import _identifier, _num, comment_text
 from ._urdf_read import Urdf, UrdfJoint, UrdfVisual
@@ -46,6 +47,11 @@ __all__ = ["MESH_TRIANGLES", "UrdfImportOptions", "import_urdf", "matrix_rpy", "
 MESH_TRIANGLES = 1500
 #: The most triangles all of a robot's meshes keep together.
 ROBOT_TRIANGLES = 40000
+#: Mesh files URDF import reads (by name, before opening): a URDF cannot make it read other files.
+MESH_SUFFIXES = (".stl", ".obj", ".dae")
+#: The environment variable that sets the largest mesh file read, in MiB (docs/security.md).
+MESH_MB_ENV = "LIGANIMATE_MAX_MESH_MB"
+MESH_MB = 100
 _DIGITS = 6  # significant digits of mesh vertices (a micrometre on a metre-sized robot)
 
 
@@ -157,7 +163,23 @@ class _Meshes:
         )
 
     def primitive(self, visual: UrdfVisual) -> str:
+        if not (visual.filename or "").lower().endswith(MESH_SUFFIXES):
+            raise self.robot.error(
+                visual.pos,
+                f"the mesh {visual.filename} is not an STL, OBJ or DAE file.",
+                "URDF import reads meshes named .stl, .obj or .dae, and no other file",
+            )
         path = self.resolve(visual)
+        limit = budget(MESH_MB_ENV, MESH_MB)
+        size = os.path.getsize(path)
+        if size > limit * 1024 * 1024:
+            # Estimated before reading: trimesh would hold the whole file and more in memory.
+            raise self.robot.error(
+                visual.pos,
+                f"the mesh {os.path.basename(path)} is {size / 1048576:.0f} MiB, more than the {limit} MiB "
+                "URDF import reads.",
+                f"simplify the mesh, or raise the budget with {MESH_MB_ENV}",
+            )
         key = (path, visual.size)
         if key in self.names:
             return self.names[key]
@@ -315,11 +337,16 @@ def import_urdf(robot: Urdf, options: UrdfImportOptions) -> tuple[bytes, list]:
         segment[j.child] = _identifier(j.child, taken)
     meshes = _Meshes(robot, options, taken)
     shapes = {}
+    notes = []
     for link in robot.links:
-        expr = _segment_expr(link.visuals, frames[link.name][:3, :3], meshes)
+        # A zero size (pybullet's Laikago marks its toes with <sphere radius="0.0"/>) draws nothing, and
+        # LIG's shapes would be degenerate polygons the compiler refuses: such a visual is left out.
+        visuals = [v for v in link.visuals if all(s != 0.0 for s in v.size)]
+        if len(visuals) < len(link.visuals):
+            notes.append(f"link {link.name} has a visual of zero size, which draws nothing; it is left out")
+        expr = _segment_expr(visuals, frames[link.name][:3, :3], meshes)
         if expr is not None:
             shapes[link.name] = expr
-    notes = []
     for j in joints:
         if j.mimic is not None:
             notes.append(
@@ -327,7 +354,12 @@ def import_urdf(robot: Urdf, options: UrdfImportOptions) -> tuple[bytes, list]:
                 "of its own, which a motion drives itself"
             )
     if not joints:
-        raise robot.error(robot.link(robot.root).pos, "the robot has no joints, so it is not a MODEL.")
+        raise robot.error(
+            robot.link(robot.root).pos,
+            "the robot has no joints, so it is not a MODEL.",
+            "a LIG model is links joined by joints; to import a single rigid object, add a link "
+            '<link name="world"/> and a fixed joint from it to this link',
+        )
     text = _library_text(robot, options, joints, segment, shapes, frames, meshes)
     return text.encode("utf-8"), notes
 

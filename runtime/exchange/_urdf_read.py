@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import xml.parsers.expat
 from dataclasses import dataclass, field
 from typing import NoReturn
@@ -220,6 +221,24 @@ class _Refused(Exception):
     """A document type declaration: never read, so that no entity can be defined."""
 
 
+# Blank lines before the XML declaration: XML forbids them, but ROS's and pybullet's parsers
+# (TinyXML) take them, and pybullet_data ships such files (differential/diff_ring.urdf).
+_LATE_DECLARATION = re.compile(rb"\A(?:\xef\xbb\xbf)?[ \t\r\n]+(<\?xml[^>]*\?>)")
+_ENCODING = re.compile(rb"""encoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
+
+
+def _late_declaration(raw: bytes) -> tuple[bytes, str | None]:
+    """``raw`` with an XML declaration after leading white space blanked out (lines and columns
+    unchanged), and the encoding it declared, for expat, which accepts a declaration only first."""
+    m = _LATE_DECLARATION.match(raw)
+    if m is None:
+        return raw, None
+    declaration = m.group(1)
+    named = _ENCODING.search(declaration)
+    blanked = raw[: m.start(1)] + b" " * len(declaration) + raw[m.end(1) :]
+    return blanked, named.group(1).decode("ascii") if named else None
+
+
 class _Reader:
     def __init__(self, raw: bytes, filename: str):
         self.filename = filename
@@ -236,7 +255,8 @@ class _Reader:
         raise LigDiagnostics([Diagnostic(self.filename, pos, message, hint, source=self.text)])
 
     def parse(self) -> _Element:
-        parser = xml.parsers.expat.ParserCreate()
+        raw, encoding = _late_declaration(self.raw)
+        parser = xml.parsers.expat.ParserCreate(encoding)
         stack: list = []
         root: list = []
         count = [0]
@@ -267,7 +287,7 @@ class _Reader:
         parser.EntityDeclHandler = entity
         parser.SetParamEntityParsing(xml.parsers.expat.XML_PARAM_ENTITY_PARSING_NEVER)
         try:
-            parser.Parse(self.raw, True)
+            parser.Parse(raw, True)
         except xml.parsers.expat.ExpatError as exc:
             message = xml.parsers.expat.ErrorString(exc.code)
             self.fail(self.pos(exc.lineno, exc.offset + 1), f"the URDF is not well-formed XML: {message}.")
@@ -299,9 +319,15 @@ class _Reader:
         except ValueError:
             values = ()
         if len(values) != n or not all(math.isfinite(v) for v in values):
+            hint = None
+            if "$(" in text or "${" in text:  # husky.urdf in pybullet_data keeps $(optenv ...) unexpanded
+                hint = "this is a xacro substitution: expand the file with xacro first (xacro robot.urdf.xacro > robot.urdf)"
+            elif "," in text:
+                hint = "URDF separates numbers with spaces, not commas"
             self.fail(
                 el.pos,
                 f'<{el.tag} {attr}="{text}"> must be {n} finite number{"s" if n > 1 else ""}.',
+                hint,
             )
         return values
 

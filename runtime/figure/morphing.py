@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from liganimate.lang.messages import did_you_mean
+from liganimate.lang.numbers import GEOMETRY_MAX, magnitude
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.motion import morph as mo
@@ -148,7 +149,36 @@ def bind(fig: F.Figure, morphs: mo.Morphs) -> Binding:
             else:
                 own = {i: _own(fig, i, morphs.shape(link, np.zeros(1))[0]) for i in where}
                 shapes.append((tuple(where), link, _targets(fig, where, link, morphs), own))
-    return Binding(tuple(scales), tuple(shapes))
+    binding = Binding(tuple(scales), tuple(shapes))
+    _within_limits(fig, binding, morphs)
+    return binding
+
+
+def _within_limits(fig: F.Figure, binding: Binding, morphs: mo.Morphs) -> None:
+    """Refuse morphs that would draw beyond the geometry limit (as limits.check_figure measures a model)."""
+    size = {
+        i: abs(link.scale) * link.shape.extent()
+        for i, link in enumerate(fig.links)
+        if isinstance(link.shape, Graphical)
+    }
+    for where, _link, targets, _own in binding.shapes:
+        for i in where:
+            size[i] = max([size.get(i, 0.0)] + [abs(fig.links[i].scale) * float(np.max(np.abs(t))) for t in targets[i]])
+    for where, link in binding.scales:
+        factor = morphs.largest_scale(link)
+        for i in where:
+            size[i] = size.get(i, 0.0) * factor
+    p = np.asarray(fig.placement, dtype=np.float64)
+    with np.errstate(all="ignore"):
+        joints = sum(float(np.max(np.abs(j.loc1))) + float(np.max(np.abs(j.loc2))) for j in fig.joints)
+        reach = np.sqrt(3.0) * (joints + max(size.values(), default=0.0))
+        far = float(np.linalg.norm(p[:3, :3]) * reach + np.max(np.abs(p[:3, 3])))
+    if not far <= GEOMETRY_MAX:
+        raise LigError(
+            f"with its morphed segments the model can reach {magnitude(far)} units from the origin, beyond the "
+            f"limit of {magnitude(GEOMETRY_MAX)} for anything drawn",
+            "keep the SCALE LINK factors and SHAPE LINK shapes smaller",
+        )
 
 
 def _own(fig: F.Figure, i: int, targets: list) -> np.ndarray:

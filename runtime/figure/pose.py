@@ -16,6 +16,7 @@ from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import morphing as MO
 from liganimate.runtime.figure import tree as F
 from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.motion.turning import orientation_matrix
 from liganimate.runtime.values import Graphical, joined_shades
 
 # (id(motion), id(joints)) -> (motion, joints, bound); the stored objects keep
@@ -150,7 +151,7 @@ def mesh_table(fig: F.Figure) -> MeshTable:
 
 
 def rooted_placements(placements: np.ndarray, motion: Motion | None, frames: np.ndarray) -> np.ndarray:
-    """Host placements with a motion's root path applied: ``placement @ Trans(root(frame))``.
+    """Host placements with a motion's root track applied: ``placement @ Trans(root(frame)) @ Rot(orientation(frame))``.
 
     Parameters
     ----------
@@ -163,17 +164,23 @@ def rooted_placements(placements: np.ndarray, motion: Motion | None, frames: np.
     Returns
     -------
     ndarray, shape (T, 4, 4)
-        ``placements`` itself when the motion has no root track; otherwise a
-        new array whose translation column moves by the placement's linear
-        part applied to the offset, so a model turned by ``<ROT Y 90>`` walks
-        along its turned path.
+        ``placements`` itself when the motion has neither a root path nor a
+        root orientation; otherwise a new array whose translation column
+        moves by the placement's linear part applied to the offset, so a
+        model turned by ``<ROT Y 90>`` walks along its turned path, and whose
+        linear part is turned by the root orientation
+        (:func:`liganimate.runtime.motion.turning.orientation_matrix`).
     """
     placements = np.asarray(placements, dtype=np.float64)
-    if motion is None or motion.root is None:
+    if motion is None or (motion.root is None and motion.turn is None):
         return placements
-    offset = motion.root_offset(np.asarray(frames, dtype=np.float64).reshape(-1))
+    times = np.asarray(frames, dtype=np.float64).reshape(-1)
     out = placements.copy()
-    out[:, :3, 3] += np.einsum("tij,tj->ti", placements[:, :3, :3], offset)
+    if motion.root is not None:
+        offset = motion.root_offset(times)
+        out[:, :3, 3] += np.einsum("tij,tj->ti", placements[:, :3, :3], offset)
+    if motion.turn is not None:
+        out[:, :3, :3] = placements[:, :3, :3] @ orientation_matrix(motion.root_orientation(times))
     return out
 
 

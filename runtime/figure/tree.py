@@ -155,11 +155,15 @@ def frame_from_axis(axis) -> np.ndarray:
         )
     a = a / norm
     c = float(a[0])
-    if c <= -1.0 + 1e-12:
-        return np.diag([-1.0, -1.0, 1.0])
     v = np.array([0.0, -a[2], a[1]])  # e_x cross a
+    s2 = float(v @ v)  # sin^2 of the turn, exact to rounding however small
+    if s2 == 0.0 and c < 0.0:
+        return np.diag([-1.0, -1.0, 1.0])
+    # 1 + c cancels near the axis -X (pybullet's Laikago has axes 6e-6 from it, where 1 + c lost
+    # six digits and the frame was off by 1e-6): 1 + c = sin^2 / (1 - c) keeps every digit.
+    one_plus_c = s2 / (1.0 - c) if c < 0.0 else 1.0 + c
     vx = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-    R = np.eye(3) + vx + vx @ vx / (1.0 + c)
+    R = np.eye(3) + vx + vx @ vx / one_plus_c
     R[:, 0] = a  # exactly the given direction
     return R
 

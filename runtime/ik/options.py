@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from liganimate.runtime.ik.solvers import DEFAULT_SOLVER
+from liganimate.runtime.ik.names import DEFAULT_SOLVER
 
 
 @dataclass(frozen=True)

@@ -48,9 +48,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .names import DEFAULT_SOLVER, SOLVER_KEYWORDS  # the names alone live there, for the compiler and the host
+
 if TYPE_CHECKING:
-    # Only for annotations: importing this module (as the compiler does, for
-    # the solver names) loads numpy and nothing else of the runtime.
+    # Only for annotations: importing this module loads numpy and nothing
+    # else of the runtime.
     from liganimate.runtime.ik.goals import GoalStack
     from liganimate.runtime.ik.model import IKModel
 
@@ -67,8 +69,6 @@ __all__ = [
     "LIMIT",
 ]
 
-#: The solver used when none is named (the language's default too).
-DEFAULT_SOLVER = "dls"
 
 # Status codes per batch element.
 RUNNING, CONVERGED, STALLED, LIMIT = 0, 1, 2, 3
@@ -1166,5 +1166,8 @@ SOLVERS: Mapping[str, Solver] = MappingProxyType(
 )
 #: The runtime's solver names.
 SOLVER_NAMES: tuple[str, ...] = tuple(SOLVERS)
-#: The language's solver words -> the runtime's names (``{"DLS": "dls", ...}``).
-SOLVER_KEYWORDS: Mapping[str, str] = MappingProxyType({s.keyword: s.name for s in SOLVERS.values()})
+if dict(SOLVER_KEYWORDS) != {s.keyword: s.name for s in SOLVERS.values()} or list(SOLVER_KEYWORDS.values()) != list(
+    SOLVER_NAMES
+):
+    # names.py is what the compiler checks programs against: it must name exactly these solvers.
+    raise ImportError("runtime/ik/names.py SOLVER_KEYWORDS does not match the SOLVERS table")

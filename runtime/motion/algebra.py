@@ -25,6 +25,7 @@ from liganimate.runtime.motion.keyframe import RAMP, Keyframe
 
 __all__ = [
     "DEFAULT_KEYFRAME_LIMIT",
+    "ORIENTATION",
     "Motion",
     "concat",
     "repeat",
@@ -35,6 +36,9 @@ __all__ = [
 ]
 
 DEFAULT_KEYFRAME_LIMIT = 100_000
+
+#: The key of the root orientation track where tracks are keyed by joint (None is the ROOT path).
+ORIENTATION = "ORIENTATION"
 
 # Derived motions remembered per motion (see Motion._derive).
 _DERIVED_MAX = 8
@@ -69,9 +73,15 @@ def _real(r, what: str) -> float:
     return r
 
 
-def _leaf(joint: int | None, spec) -> tr.Leaf:
+def _who(joint) -> str:
+    if joint is None:
+        return "the root track"
+    return "the root orientation" if joint == ORIENTATION else f"joint {joint}"
+
+
+def _leaf(joint, spec) -> tr.Leaf:
     """Validate one joint's ``(start, keyframes)`` and build its leaf (``joint`` None: the root track)."""
-    who = "the root track" if joint is None else f"joint {joint}"
+    who = _who(joint)
     try:
         start, keys = spec
     except (TypeError, ValueError):
@@ -123,9 +133,9 @@ def _leaf(joint: int | None, spec) -> tr.Leaf:
     return tr.Leaf(start, frames, positions, methods, ramps)
 
 
-def _array_leaf(joint: int | None, start, frames, values) -> tr.Leaf:
+def _array_leaf(joint, start, frames, values) -> tr.Leaf:
     """A LINEAR leaf from arrays (a keyframe table's column), checked at once rather than key by key."""
-    who = "the root track" if joint is None else f"joint {joint}"
+    who = _who(joint)
     start = _vector(start, f"{who}: start position")
     frames = np.asarray(frames, dtype=np.float64).reshape(-1)
     positions = np.asarray(values, dtype=np.float64).reshape(len(frames), 3)
@@ -155,7 +165,7 @@ class Motion:
     ``n * m`` and the methods below.  All operations return new motions.
     """
 
-    __slots__ = ("_derived", "_expr", "_length", "_morph", "_open", "_root", "_tail", "_tracks")
+    __slots__ = ("_derived", "_expr", "_length", "_morph", "_open", "_root", "_tail", "_tracks", "_turn")
 
     def __init__(
         self,
@@ -165,6 +175,7 @@ class Motion:
         gaps: tuple[Iterable[int], Iterable[int]] = ((), ()),
         root: tr.Track | None = None,
         morph: mo.Morphs | None = None,
+        turn: tr.Track | None = None,
     ):
         """Internal: use :meth:`from_tracks`, :meth:`empty` and the operations.
 
@@ -183,12 +194,15 @@ class Motion:
             The root path (see :mod:`liganimate.runtime.motion.path`).
         morph : Morphs, optional
             The links' scale and shape channels (see :mod:`liganimate.runtime.motion.morph`).
+        turn : Track, optional
+            The root orientation: three angles (see :mod:`liganimate.runtime.motion.turning`).
         """
         self._tracks = dict(sorted(tracks.items()))
         self._root = root
+        self._turn = turn
         self._open = frozenset(gaps[0]) & self._tracks.keys()
         self._tail = frozenset(gaps[1]) & self._tracks.keys()
-        ends = [t.end for t in self._tracks.values()] + ([root.end] if root is not None else [])
+        ends = [t.end for t in self._tracks.values()] + [t.end for t in (root, turn) if t is not None]
         ends += [morph.end] if morph is not None else []
         self._length = float(length if length is not None else max(ends, default=0.0))
         if not math.isfinite(self._length):
@@ -224,20 +238,26 @@ class Motion:
         return out
 
     def __getstate__(self):
-        return (self._tracks, self._length, self._expr, self._open, self._tail, self._root, self._morph)
+        return (self._tracks, self._length, self._expr, self._open, self._tail, self._root, self._morph, self._turn)
 
     def __setstate__(self, state):
         self._tracks, self._length, self._expr = state[:3]
         self._open, self._tail = state[3:5] if len(state) > 3 else (frozenset(), frozenset())
         self._root = state[5] if len(state) > 5 else None
         self._morph = state[6] if len(state) > 6 else None
+        self._turn = state[7] if len(state) > 7 else None
         self._derived = None
 
     # -- construction -----------------------------------------------------
 
     @classmethod
     def from_tracks(
-        cls, tracks: Mapping[int, tuple], name: str | None = None, root: tuple | None = None, arrays=None
+        cls,
+        tracks: Mapping[int, tuple],
+        name: str | None = None,
+        root: tuple | None = None,
+        arrays=None,
+        turn: tuple | None = None,
     ) -> Motion:
         """Build a motion from explicit keyframes.
 
@@ -257,6 +277,10 @@ class Motion:
             shape (3,), ``frames`` shape (K,), ``values`` shape (K, 3), every
             keyframe LINEAR with the default ramp; None is the root track.
             Checked all at once, so a table of 20,000 rows stays fast.
+            :data:`ORIENTATION` is the root orientation.
+        turn : (start, keyframes), optional
+            The root orientation, built as a joint's: three angles in
+            degrees, the heading about Y outermost (see :func:`.turning.orientation_matrix`).
 
         Returns
         -------
@@ -273,14 +297,17 @@ class Motion:
             j = _joint_id(joint)
             leaves[j] = _leaf(j, spec)
         path = None if root is None else _leaf(None, root)
+        heading = None if turn is None else _leaf(ORIENTATION, turn)
         for joint, (start, frames, values) in (arrays or {}).items():
             if joint is None:
                 path = _array_leaf(None, start, frames, values)
+            elif joint == ORIENTATION:
+                heading = _array_leaf(ORIENTATION, start, frames, values)
             else:
                 j = _joint_id(joint)
                 leaves[j] = _array_leaf(j, start, frames, values)
-        nkeys = sum(len(leaf.frames) for leaf in leaves.values()) + (len(path.frames) if path is not None else 0)
-        return cls(leaves, ("keys", name, len(leaves), nkeys), root=path)
+        nkeys = sum(len(leaf.frames) for leaf in [*leaves.values(), path, heading] if leaf is not None)
+        return cls(leaves, ("keys", name, len(leaves), nkeys), root=path, turn=heading)
 
     @classmethod
     def empty(cls) -> Motion:
@@ -335,7 +362,7 @@ class Motion:
         Motion
             Its length covers the morph channels too.
         """
-        return Motion(self._tracks, self._expr, None, (self._open, self._tail), self._root, morph)
+        return Motion(self._tracks, self._expr, None, (self._open, self._tail), self._root, morph, self._turn)
 
     @property
     def root(self) -> tr.Track | None:
@@ -362,6 +389,69 @@ class Motion:
             out = self._root.sample_x(t)
         _finite(out)
         return out
+
+    @property
+    def turn(self) -> tr.Track | None:
+        """The root orientation track, or None for a motion that does not turn the figure."""
+        return self._turn
+
+    def root_orientation(self, times) -> np.ndarray:
+        """The root orientation's three angles at some times (zero without one).
+
+        Parameters
+        ----------
+        times : array_like, shape (T,)
+
+        Returns
+        -------
+        ndarray, shape (T, 3)
+            Degrees; ``world = placement @ Trans(offset) @ Rot(angles) @ pose``
+            with ``Rot`` :func:`.turning.orientation_matrix`.
+        """
+        t = self._times(times)
+        if self._turn is None:
+            return np.zeros((len(t), 3))
+        with np.errstate(all="ignore"):  # see evaluate
+            out = self._turn.sample_x(t)
+        _finite(out)
+        return out
+
+    def turn_keyframes(self, limit: int = DEFAULT_KEYFRAME_LIMIT) -> tuple[tuple, list[Keyframe]]:
+        """The root orientation written out as one keyframe list (see :meth:`keyframes`).
+
+        Returns
+        -------
+        start : tuple of 3 float
+        keys : list of Keyframe
+
+        Raises
+        ------
+        MotionError
+            If the motion has no root orientation or the listing would exceed ``limit``.
+        """
+        if self._turn is None:
+            raise MotionError("this motion has no root orientation")
+        try:
+            return tr.materialize(self._turn, limit)
+        except MotionError as exc:
+            raise MotionError(
+                f"the root orientation: {exc.message}", hint="use describe() to see how the motion is built"
+            ) from None
+
+    def heading(self, side: str) -> float:
+        """Degrees about Y the figure faces at the start (``"start"``) or the end (``"end"``); 0 without a root orientation.
+
+        Parameters
+        ----------
+        side : {"start", "end"}
+
+        Returns
+        -------
+        float
+        """
+        if self._turn is None:
+            return 0.0
+        return float((self._turn.start_value if side == "start" else self._turn.end_value)[1])
 
     def root_keyframes(self, limit: int = DEFAULT_KEYFRAME_LIMIT) -> tuple[tuple, list[Keyframe]]:
         """The root path written out as one keyframe list (see :meth:`keyframes`).
@@ -475,9 +565,13 @@ class Motion:
                     tb = tr.refill(tb, ta.end_value)
                 ta, tb = tr.join_smoothly(ta, tb, la)
                 tracks[j] = tr.concat(ta, tb, la)
-        root = rp.concat(self._root, la, other._root, lb)
+        # The later motion continues in the heading the earlier one leaves the figure in;
+        # an empty operand without an orientation is an identity.
+        delta = 0.0 if (self._turn is None and la == 0) else self.heading("end") - other.heading("start")
+        root = rp.concat(self._root, la, other._root, lb, delta)
+        turn = _concat_turns(self._turn, la, other._turn, lb, delta)
         morph = mo.concat(self._morph, la, other._morph, lb, Motion)
-        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail), root=root, morph=morph)
+        return Motion(tracks, ("+", self._expr, other._expr), gaps=(opened, tail), root=root, morph=morph, turn=turn)
 
     def repeat(self, n: int) -> Motion:
         """``n`` copies played back to back (the thesis' ``n * motion``).
@@ -507,14 +601,16 @@ class Motion:
 
     def _repeat(self, n: int) -> Motion:
         expr = ("*", n, self._expr)
-        root = self._root
+        root, turn = self._root, self._turn
         morph = mo.repeat(self._morph, n, self._length)
         if n == 0:
             still = None if root is None else tr.Const(root.start_value)
-            return Motion({j: tr.Const(t.start_value) for j, t in self._tracks.items()}, expr, root=still, morph=morph)
+            facing = None if turn is None else tr.Const(turn.start_value)
+            consts = {j: tr.Const(t.start_value) for j, t in self._tracks.items()}
+            return Motion(consts, expr, root=still, morph=morph, turn=facing)
         gaps = (self._open, self._tail)
         if n == 1 or self._length == 0:
-            return Motion(self._tracks, expr, self._length * n, gaps, root, morph)
+            return Motion(self._tracks, expr, self._length * n, gaps, root, morph, turn)
         L = self._length
         tracks = {}
         for j, t in self._tracks.items():
@@ -528,7 +624,9 @@ class Motion:
                 tracks[j] = tr.concat(t, rest, L, end=end if end is not None else (n - 1) * L + t.end)
             else:
                 tracks[j] = tr.repeat_smoothly(t, n, L, end)
-        return Motion(tracks, expr, n * L, gaps, None if root is None else rp.repeat(root, n, L), morph)
+        delta = self.heading("end") - self.heading("start")
+        root = None if root is None else rp.repeat(root, n, L, delta)
+        return Motion(tracks, expr, n * L, gaps, root, morph, _repeat_turn(turn, n, L, delta))
 
     def __mul__(self, n) -> Motion:
         return self.repeat(n)
@@ -556,9 +654,14 @@ class Motion:
         for joint in joints:
             j = self._driven(joint, "the motion being stripped")
             kept[j] = self._tracks[j]
-        # The root path and the morphs are not joints: STRIP keeps them.
+        # The root tracks and the morphs are not joints: STRIP keeps them.
         return Motion(
-            kept, ("strip", tuple(kept), self._expr), gaps=(self._open, self._tail), root=self._root, morph=self._morph
+            kept,
+            ("strip", tuple(kept), self._expr),
+            gaps=(self._open, self._tail),
+            root=self._root,
+            morph=self._morph,
+            turn=self._turn,
         )
 
     def scale_frames(self, r: float) -> Motion:
@@ -590,12 +693,16 @@ class Motion:
         memo: dict = {}
         tracks = {j: tr.scale_frames(t, s, memo) for j, t in self._tracks.items()}
         root = None if self._root is None else tr.scale_frames(self._root, s, memo)
+        turn = None if self._turn is None else tr.scale_frames(self._turn, s, memo)
         gaps = (self._open, self._tail)
         if r < 0:
             tracks = {j: tr.reverse(t, L, memo) for j, t in tracks.items()}
             gaps = (self._tail, self._open)  # a trailing hold played backwards is a leading gap
-            root = None if root is None else rp.reverse(root, L, memo)
-        return Motion(tracks, ("frames", r, self._expr), L, gaps, root, mo.scale_frames(self._morph, r, self._length))
+            back = self.heading("start") - self.heading("end")  # walk back facing as it came
+            root = None if root is None else rp.reverse(root, L, memo, back)
+            turn = None if turn is None else rp.reverse(turn, L, memo, 0.0, (0.0, back, 0.0))
+        morph = mo.scale_frames(self._morph, r, self._length)
+        return Motion(tracks, ("frames", r, self._expr), L, gaps, root, morph, turn)
 
     def scale_extremes(self, r: float) -> Motion:
         """Multiply every angle (start and keyframe positions) by ``r``.
@@ -614,9 +721,10 @@ class Motion:
     def _scale_extremes(self, r: float) -> Motion:
         memo: dict = {}
         tracks = {j: tr.scale_extremes(t, r, memo) for j, t in self._tracks.items()}
-        # Positions, scales and shapes are not angles: the root path and the morphs are left as they are.
+        # Positions, scales and shapes are not angles: the root tracks and the morphs are left as they
+        # are (where the figure faces is not a joint's angle either).
         gaps = (self._open, self._tail)
-        return Motion(tracks, ("extremes", r, self._expr), self._length, gaps, self._root, self._morph)
+        return Motion(tracks, ("extremes", r, self._expr), self._length, gaps, self._root, self._morph, self._turn)
 
     def unwrapped(self, free_axes: Mapping[int, tuple[bool, bool, bool]]) -> Motion:
         """Take the short way round on axes that can turn freely.
@@ -640,7 +748,8 @@ class Motion:
             j = _joint_id(joint)
             if j in tracks and any(axes):
                 tracks[j] = tr.unwrap(tracks[j], (bool(axes[0]), bool(axes[1]), bool(axes[2])), memo)
-        return Motion(tracks, ("unwrap", self._expr), self._length, (self._open, self._tail), self._root, self._morph)
+        gaps = (self._open, self._tail)
+        return Motion(tracks, ("unwrap", self._expr), self._length, gaps, self._root, self._morph, self._turn)
 
     # -- evaluation -------------------------------------------------------
 
@@ -752,7 +861,7 @@ class Motion:
         -------
         Footprint
         """
-        return tr.footprint(list(self._tracks.values()) + ([self._root] if self._root is not None else []))
+        return tr.footprint(list(self._tracks.values()) + [t for t in (self._root, self._turn) if t is not None])
 
     def describe(self, max_chars: int = 2000) -> str:
         """A compact text of the expression that built this motion.
@@ -832,6 +941,41 @@ class _Describer:
         return self.put(")")
 
 
+def _concat_turns(a: tr.Track | None, la: float, b: tr.Track | None, lb: float, delta: float) -> tr.Track | None:
+    """The root orientation of ``a + b``: ``b``'s heading turned by ``delta``.
+
+    A motion without one keeps the figure upright, facing on in the heading
+    it inherits (as a zero orientation would); one of length 0 is an identity.
+    """
+    if a is None and b is None:
+        return None
+    if b is None and lb == 0:
+        return tr.pad(a, la) if a is not None else None
+    if a is None and la == 0:
+        return b
+    a = tr.Const(np.zeros(3)) if a is None else a
+    moved = rp.shift(tr.Const(np.zeros(3)) if b is None else b, (0.0, delta, 0.0))
+    if _tilt_meets(a.end_value, moved.start_value):
+        # The headings meet by construction: share the velocity as a path does.
+        a, moved = rp.join(a, moved, la)
+    return tr.concat(a, moved, la)
+
+
+def _tilt_meets(end: np.ndarray, start: np.ndarray) -> bool:
+    """Whether an orientation that ends tilted as ``end`` meets one that starts as ``start`` (X and Z)."""
+    return bool(end[0] == start[0] and end[2] == start[2])
+
+
+def _repeat_turn(turn: tr.Track | None, n: int, period: float, delta: float) -> tr.Track | None:
+    """The root orientation of ``n * m`` (``n >= 2``): copy ``k`` turned by ``k * delta``, as ``m + m + ...``."""
+    if turn is None:
+        return None
+    step = (0.0, delta, 0.0)
+    if _tilt_meets(turn.end_value, turn.start_value):
+        return rp.repeat(turn, n, period, 0.0, step)
+    return rp.Drift(turn, n, period, step, n * period if turn.end == period else None)
+
+
 def _finite(values: np.ndarray) -> None:
     if not np.isfinite(values).all():  # pragma: no cover - the limits are meant to make this impossible
         raise MotionError("the motion's interpolation gave a number that is not finite")
@@ -904,9 +1048,17 @@ def synchronize(*motions: Motion) -> Motion:
     opened: set[int] = set()
     tail: set[int] = set()
     root, root_owner = None, 0
+    turn, turn_owner = None, 0
     for i, m in enumerate(motions, start=1):
         if not isinstance(m, Motion):
             raise MotionError(f"operand {i} of SYNCHRONIZE is not a motion")
+        if m._turn is not None:
+            if turn is not None and m._turn is not turn:
+                raise MotionError(
+                    f"the root orientation is driven by both operand {turn_owner} and operand {i} of SYNCHRONIZE",
+                    hint="a figure faces one way at a time: build one of them without a ROOT ORIENTATION track",
+                )
+            turn, turn_owner = m._turn, i
         if m._root is not None:
             # The same path twice (two STRIPs of one motion) is one path, not two.
             if root is not None and m._root is not root:
@@ -926,7 +1078,8 @@ def synchronize(*motions: Motion) -> Motion:
         opened |= m._open
         tail |= m._tail
     morph = mo.synchronize(enumerate((m._morph for m in motions), start=1), Motion)
-    return Motion(tracks, ("sync", tuple(m._expr for m in motions)), gaps=(opened, tail), root=root, morph=morph)
+    sync = ("sync", tuple(m._expr for m in motions))
+    return Motion(tracks, sync, gaps=(opened, tail), root=root, morph=morph, turn=turn)
 
 
 def scale_frames(a: Motion, r: float) -> Motion:

@@ -14,7 +14,7 @@ from __future__ import annotations
 from liganimate.lang import messages
 from liganimate.lang import numbers as N
 from liganimate.runtime.errors import MotionError
-from liganimate.runtime.motion.algebra import Motion
+from liganimate.runtime.motion.algebra import ORIENTATION, Motion
 from liganimate.runtime.motion.keyframe import Keyframe
 
 
@@ -29,7 +29,8 @@ class EditError(MotionError):
 class KeyframeEdits:
     """A motion being written keyframe by keyframe: a base motion and a chain of edits.
 
-    ``edit`` is ``(joint, k, frame, position (3,), method or None, at)``; joint None is the ROOT track.
+    ``edit`` is ``(joint, k, frame, position (3,), method or None, at)``; joint None is the ROOT track,
+    :data:`~.algebra.ORIENTATION` the ROOT ORIENTATION track.
     """
 
     __slots__ = ("_cache", "base", "edit", "parent")
@@ -115,9 +116,15 @@ def apply(m: KeyframeEdits) -> Motion:
     edits.reverse()
     base = m.base
     tracks: dict = {}
-    for j in base.joints + ((None,) if base.root is not None else ()):
+    extra = ((None,) if base.root is not None else ()) + ((ORIENTATION,) if base.turn is not None else ())
+    for j in base.joints + extra:
         # Keep each keyframe's ramp so a stretched motion stays stretched.
-        start, kfs = base.root_keyframes() if j is None else base.keyframes(j)
+        if j is None:
+            start, kfs = base.root_keyframes()
+        elif isinstance(j, str):  # ORIENTATION
+            start, kfs = base.turn_keyframes()
+        else:
+            start, kfs = base.keyframes(j)
         tracks[j] = [tuple(start), {i + 1: (kf, None) for i, kf in enumerate(kfs)}]
     for joint, k, frame, position, method, eat in edits:
         entry = tracks.setdefault(joint, [(0.0, 0.0, 0.0), {}])
@@ -149,11 +156,13 @@ def apply(m: KeyframeEdits) -> Motion:
                 raise EditError(messages.keyframes_too_close(key.frame, previous, where), messages.GAP_HINT, eat)
             previous = key.frame
         spec[joint] = (start, [key for key, _ in seq])
-    root = spec.pop(None, None)
-    motion = Motion.from_tracks(spec, root=root)
+    root, turn = spec.pop(None, None), spec.pop(ORIENTATION, None)
+    motion = Motion.from_tracks(spec, root=root, turn=turn)
     m._cache = motion
     return motion
 
 
 def _track_name(joint) -> str:
+    if joint == ORIENTATION:
+        return "the ROOT ORIENTATION track"
     return "the ROOT track" if joint is None else f"joint {joint}"

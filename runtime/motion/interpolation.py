@@ -17,7 +17,6 @@ monotone cubic Hermite where the velocity adjustment gives it others (see
 
 from __future__ import annotations
 
-import importlib.metadata
 import warnings
 from collections.abc import Callable
 from typing import Protocol, runtime_checkable
@@ -221,6 +220,10 @@ def _load_plugins() -> None:
     if _plugins_loaded:
         return
     _plugins_loaded = True
+    # Imported here: importlib.metadata (and the email package it pulls in)
+    # costs a cold start ~10 ms, and only a name no built-in has needs it.
+    import importlib.metadata
+
     for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
         try:
             method = ep.load()

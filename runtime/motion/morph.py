@@ -122,6 +122,27 @@ class Morphs:
             w = np.stack([_channels(self.motion)[k].sample_x(t)[:, 0] for k in keys], axis=1)
         return [self.targets[k[2]] for k in keys], w
 
+    def largest_scale(self, link: str) -> float:
+        """The largest factor the link's SCALE track ever shows (its start, keyframes and holds).
+
+        No in-between leaves the range of the keyframes it joins, so this
+        bounds every frame; found on the track's distinct nodes, whatever
+        repetition count the motion carries.
+        """
+        seen: set = set()
+        stack = [_channels(self.motion)[(SCALE, link)]]
+        big = 1.0
+        while stack:
+            node = stack.pop()
+            if id(node) in seen:
+                continue
+            seen.add(id(node))
+            for values in (getattr(node, "start", None), getattr(node, "values", None), getattr(node, "value", None)):
+                if values is not None and np.size(values):
+                    big = max(big, float(np.max(values)))
+            stack.extend(node.children())
+        return big
+
     def channels(self) -> tuple:
         """Every channel key, sorted."""
         return tuple(_channels(self.motion))

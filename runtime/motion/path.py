@@ -18,8 +18,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import track as tr
+from . import turning as tu
 
-__all__ = ["Drift", "Reversal", "Shift", "concat", "repeat", "reverse", "shift"]
+__all__ = ["Drift", "Reversal", "Shift", "concat", "join", "repeat", "reverse", "shift"]
 
 
 class Shift(tr.Track):
@@ -62,7 +63,7 @@ class Shift(tr.Track):
 
     def _emit(self, out, offset):
         saved = out.shift
-        out.shift = saved + self.d
+        out.shift = saved + (self.d if out.rot is None else out.rot @ self.d)
         self.inner._emit(out, offset)
         out.shift = saved
 
@@ -168,28 +169,29 @@ class Drift(tr.Track):
     def _emit(self, out, offset):
         P, inner = self.rep.period, self.rep.inner
         saved = out.shift
+        step = self.step if out.rot is None else out.rot @ self.step
         for k in range(self.rep.n):
-            out.shift = saved + k * self.step
+            out.shift = saved + k * step
             if k:
                 out.junction(offset + k * P, inner.start_value, False)
             inner._emit(out, offset + k * P)
         out.shift = saved
 
 
-def _join(first: tr.Track, second: tr.Track, pivot: float) -> tuple[tr.Track, tr.Track]:
+def join(first: tr.Track, second: tr.Track, pivot: float) -> tuple[tr.Track, tr.Track]:
     """Share the velocity across a junction: a path always meets itself, so only the ends must be leaves."""
     if first.end != pivot:
         return first, second
     a, b = tr.edge_leaf(first, "right"), tr.edge_leaf(second, "left")
-    if a is None or b is None:
-        return first, second
+    if a is None or b is None or abs(tu.edge_turn(first, "right") - tu.edge_turn(second, "left")) > tu.SAME_TURN:
+        return first, second  # where the heading changes the velocities are in different frames
     ea, eb = a._prepare().last, b._prepare().first
     if ea is None or eb is None or not tr._changes(ea, eb):
         return first, second
     return tr.with_edge(first, "right", eb), tr.with_edge(second, "left", ea)
 
 
-def concat(a: tr.Track | None, la: float, b: tr.Track | None, lb: float) -> tr.Track | None:
+def concat(a: tr.Track | None, la: float, b: tr.Track | None, lb: float, turn: float = 0.0) -> tr.Track | None:
     """The root path of ``a + b``, for motions of lengths ``la`` and ``lb``.
 
     Parameters
@@ -198,23 +200,31 @@ def concat(a: tr.Track | None, la: float, b: tr.Track | None, lb: float) -> tr.T
         The operands' paths; None for a motion without one, which stands
         still (at the other's end or start, as a joint it does not drive).
     la, lb : float
+    turn : float
+        Degrees about Y by which ``b``'s heading is turned to continue from
+        where ``a`` left the figure facing (0 without root orientations).
 
     Returns
     -------
     Track or None
-        ``a`` until ``la``, then ``b`` moved so that it starts where ``a``
-        ended; None if neither operand has a path.
+        ``a`` until ``la``, then ``b`` turned by ``turn`` and moved so that it
+        starts where ``a`` ended; None if neither operand has a path.
     """
     if b is None:
         return None if a is None else tr.pad(a, la + lb)
     if a is None:
-        return b if la == 0 else tr.concat(tr.Const(b.start_value), b, la)
-    moved = shift(b, a.end_value - b.start_value)
-    first, second = _join(a, moved, la)
+        # Stands where b starts, then walks b in the heading it continues from.
+        turned = tu.rotate(b, turn)
+        if turn:
+            turned = shift(turned, b.start_value - turned.start_value)
+        return turned if la == 0 else tr.concat(tr.Const(b.start_value), turned, la)
+    turned = tu.rotate(b, turn)
+    moved = shift(turned, a.end_value - turned.start_value)
+    first, second = join(a, moved, la)
     return tr.concat(first, second, la)
 
 
-def repeat(a: tr.Track, n: int, period: float) -> tr.Track:
+def repeat(a: tr.Track, n: int, period: float, turn: float = 0.0, step=None) -> tr.Track:
     """The root path of ``n * m`` (``n >= 2``), ``period`` being ``m``'s length.
 
     Parameters
@@ -223,16 +233,24 @@ def repeat(a: tr.Track, n: int, period: float) -> tr.Track:
     n : int
     period : float
         > 0.
+    turn : float
+        Degrees about Y that ``m``'s heading changes by over one copy: copy
+        ``k`` walks turned by ``k * turn`` (a :class:`~.turning.Spiral`).
+    step : array_like, shape (3,), optional
+        What one copy adds (default ``a.end_value - a.start_value``); a root
+        orientation track passes its heading change alone.
 
     Returns
     -------
     Track
-        Copy ``k`` shows ``a`` moved by ``k * (a.end_value - a.start_value)``;
-        where ``a`` lasts the whole period the copies share their velocity at
-        each junction, as a cycle's joints do.
+        Copy ``k`` shows ``a`` moved by ``k * step``; where ``a`` lasts the
+        whole period the copies share their velocity at each junction, as a
+        cycle's joints do (not where the path turns: see :mod:`.turning`).
     """
-    step = a.end_value - a.start_value
+    step = a.end_value - a.start_value if step is None else np.asarray(step, dtype=float)
     end = n * period if a.end == period else None
+    if abs(turn) > tu.SAME_TURN:
+        return tu.Spiral(a, n, period, 0.0, turn, step, a.start_value, a.start_value, end)
     plain = Drift(a, n, period, step, end)
     if a.end != period:
         return plain
@@ -268,13 +286,17 @@ class Reversal(tr.Track):
     length : float
     played : Track
         What the reversal shows: ``origin`` mirrored about ``length / 2``,
-        moved to start where ``origin`` starts; ends at ``length``.
+        turned by ``turn`` degrees about Y, then moved by ``d`` (to start
+        where ``origin`` starts); ends at ``length``.
+    turn : float
+    d : array_like, shape (3,)
     """
 
-    __slots__ = ("length", "origin", "played")
+    __slots__ = ("d", "length", "origin", "played", "turn")
 
-    def __init__(self, origin: tr.Track, length: float, played: tr.Track):
+    def __init__(self, origin: tr.Track, length: float, played: tr.Track, turn: float, d):
         self.origin, self.length, self.played = origin, float(length), played
+        self.turn, self.d = float(turn), tr._frozen(d).reshape(3)
         self.end = played.end
         self.start_value, self.end_value = played.start_value, played.end_value
         self.min_keys = played.min_keys
@@ -292,13 +314,14 @@ class Reversal(tr.Track):
         # A time mirror alone (a piece of a reversed sum): over the same length it is the
         # origin, moved as ``played`` moved it.
         if length == self.length:
-            return shift(self.origin, self.origin.start_value - self.origin.end_value)
+            return shift(tu.rotate(self.origin, self.turn), self.d)
         return tr.reverse(self.played, length, memo)
 
     def _scaled_frames(self, r, memo):
         # Stretching commutes with reversal; the played path is stretched as before, so
         # only the memory is new.
-        return Reversal(tr.scale_frames(self.origin, r, memo), self.length * r, tr.scale_frames(self.played, r, memo))
+        origin, played = tr.scale_frames(self.origin, r, memo), tr.scale_frames(self.played, r, memo)
+        return Reversal(origin, self.length * r, played, self.turn, self.d)
 
     def _mapped(self, m, memo):  # pragma: no cover - angle maps never reach a root path
         raise TypeError("a root path has no angles to map")
@@ -313,8 +336,8 @@ class Reversal(tr.Track):
         return tr.with_edge(self.played, side, edge)
 
 
-def reverse(a: tr.Track, length: float, memo: dict | None = None) -> tr.Track:
-    """The path played backwards over ``length`` frames: ``a'(t) = a(length - t) - a(length) + a(0)``.
+def reverse(a: tr.Track, length: float, memo: dict | None = None, turn: float = 0.0, d=None) -> tr.Track:
+    """The path played backwards over ``length`` frames: ``a'(t) = a(0) + R (a(length - t) - a(length))``.
 
     Parameters
     ----------
@@ -323,6 +346,13 @@ def reverse(a: tr.Track, length: float, memo: dict | None = None) -> tr.Track:
         >= ``a.end``.
     memo : dict, optional
         Shared with :func:`liganimate.runtime.motion.track.reverse`.
+    turn : float
+        ``R`` is a turn by this many degrees about Y: the heading the motion
+        starts in less the one it ends in, so that the figure walks back the
+        way it came, facing as it does.
+    d : array_like, shape (3,), optional
+        What to add instead of ``a(0) - R a(length)`` (a root orientation
+        track passes its heading change alone).
 
     Returns
     -------
@@ -333,4 +363,7 @@ def reverse(a: tr.Track, length: float, memo: dict | None = None) -> tr.Track:
     """
     if isinstance(a, Reversal) and a.length == length:
         return a.origin
-    return Reversal(a, length, shift(tr.reverse(a, length, memo), a.start_value - a.end_value))
+    mirrored = tu.rotate(tr.reverse(a, length, memo), turn)
+    if d is None:
+        d = a.start_value - tu.about_y(turn) @ a.end_value
+    return Reversal(a, length, shift(mirrored, d), turn, d)

@@ -510,7 +510,7 @@ class Leaf(Track):
 
     def _emit(self, out, offset):
         for f, v, m, r in zip(self.frames, self.values, self.methods, self.ramps):
-            out.add(offset + f, v + out.shift, m.name, r)
+            out.add(offset + f, out.place(v), m.name, r)
 
 
 def _col(a):
@@ -1357,8 +1357,14 @@ class _Emitter:
         self.limit = limit
         self.cur = start
         self.last = 0.0
-        # Added to every value emitted: the displacement a root path's Shift nodes carry.
+        # Every value emitted is ``rot @ value + shift``: what a root path's Shift and turning
+        # nodes (liganimate.runtime.motion.path) carry; rot None is the identity.
         self.shift = np.zeros(3)
+        self.rot: np.ndarray | None = None
+
+    def place(self, value) -> np.ndarray:
+        """``value`` as the enclosing path nodes move it."""
+        return (value if self.rot is None else self.rot @ value) + self.shift
 
     def add(self, frame, value, method, ramp):
         if len(self.keys) >= self.limit:
@@ -1395,7 +1401,7 @@ class _Emitter:
         """
         if smooth and self.last == frame:
             return
-        start = start + self.shift
+        start = self.place(start)
         self.hold_until(frame)
         if not (self._at_step() and np.array_equal(self.cur, start)):
             self.add(frame, start, "LINEAR", RAMP)

@@ -7,10 +7,11 @@ renderer, the output checks (:mod:`.outputs`) and the output lock all read
 that one value.
 
 The movie files a render may write beside (or instead of) the PNG frames
-are a table, :data:`MOVIES`: each names its ``RenderOptions`` field, its
+are a table, :data:`MOVIES` (kept in :mod:`.movies`, which the command
+line reads without importing the renderer): each names its ``RenderOptions`` field, its
 ``--help`` line, what must be present before anything is written (ffmpeg),
 and how to open its stream (:mod:`.video`).  Adding a movie format (WebM)
-is a field here, an entry in :data:`MOVIES`, and its stream class; the
+is a field here, an entry in :data:`MOVIES` (in :mod:`.movies`), and its stream class; the
 command line, the checks, the lock and the renderer take it from the table
 (docs/architecture.md, "A new output format").
 """
@@ -20,23 +21,16 @@ from __future__ import annotations
 import dataclasses
 import numbers
 import os
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 from liganimate.runtime.errors import RenderError
 from liganimate.runtime.render.look import DEFAULT_LOOK, check_look
 from liganimate.runtime.render.raster import MAX_AA
-from liganimate.runtime.render.video import (
-    DEFAULT_CRF,
-    DEFAULT_PRESET,
-    GifStream,
-    Mp4Stream,
-    check_crf,
-    check_preset,
-    find_ffmpeg,
-)
+from liganimate.runtime.render.video import DEFAULT_CRF, DEFAULT_PRESET, check_crf, check_preset
 
+from .movies import MOVIES, Movie
 from .outputs import check_fps, check_outputs
 
 __all__ = [
@@ -164,44 +158,6 @@ class RenderOptions:
         """Every output file asked for (movies, then the pose record): what the checks and the lock guard."""
         return tuple(path for _, path in self.movies()) + ((self.poses,) if self.poses is not None else ())
 
-
-@dataclass(frozen=True)
-class Movie:
-    """A movie file a render can write, fed the drawn images in order.
-
-    Attributes
-    ----------
-    name : str
-        Its :class:`RenderOptions` field and keyword; the command line's flag is ``--<name>``.
-    label : str
-        What the command line calls it when done (``MP4 written to film.mp4``).
-    help : str
-        The ``--help`` line.
-    open : callable
-        ``open(path, options) -> stream``: the stream the frames go to (:mod:`.video`).
-    require : callable, optional
-        Called by :func:`checked`, before anything is written: raises a
-        :class:`RenderError` when the movie cannot be made here (no ffmpeg).
-    """
-
-    name: str
-    label: str
-    help: str
-    open: Callable[[str, RenderOptions], Any] = field(repr=False)
-    require: Callable[[], object] | None = field(default=None, repr=False)
-
-
-#: The movie formats, in the order their options are listed.
-MOVIES: tuple[Movie, ...] = (
-    Movie("gif", "GIF", "write an animated GIF", lambda path, o: GifStream(path, o.fps)),
-    Movie(
-        "mp4",
-        "MP4",
-        "write an MP4 (needs ffmpeg: pip install imageio-ffmpeg)",
-        lambda path, o: Mp4Stream(path, o.fps, o.crf, o.preset),
-        find_ffmpeg,
-    ),
-)
 
 _FIELDS = tuple(f.name for f in dataclasses.fields(RenderOptions))
 #: How the command line spells each option in messages.

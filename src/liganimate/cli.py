@@ -34,7 +34,7 @@ def _print_diagnostics(diags, stream=None) -> None:
 
 
 def _size(text: str):
-    from liganimate.runtime.render.options import MAX_SIDE
+    from liganimate.runtime.render.options import MAX_SIDE  # only when --size is given
 
     try:
         width, height = text.lower().split("x")
@@ -77,7 +77,9 @@ def shot_scenes(path: str, doing: str) -> list:
 
 
 def _add_render_options(p: argparse.ArgumentParser) -> None:
-    from liganimate.runtime.render.options import MOVIES
+    # Every command builds the whole parser: the movie table is read from its
+    # own light module, not the renderer's options (which import the renderer).
+    from liganimate.runtime.render.movies import MOVIES
 
     p.add_argument(
         "-o",

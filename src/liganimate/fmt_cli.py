@@ -14,7 +14,6 @@ usage error.
 
 from __future__ import annotations
 
-import difflib
 import os
 import sys
 
@@ -93,6 +92,8 @@ def _one(path: str, args) -> str:
             return 0
         result[0] = "changed"
         if args.diff:
+            import difflib  # only for --diff: every command imports this module
+
             lines = difflib.unified_diff(_lines(before), _lines(after), path, path + " (formatted)")
             sys.stdout.writelines(lines)
         if not args.check and not args.diff:

@@ -191,3 +191,15 @@ def test_poses_records_scale_and_how_much_of_its_own_shape_a_segment_shows(tmp_p
     # The matrix carries the scale: B's Y column is three times as long at the end.
     m = np.reshape(b[2]["matrix"], (4, 4))
     np.testing.assert_allclose(np.linalg.norm(m[:3, :3], axis=0), [1.0, 3.0, 1.0])
+
+
+def test_a_morph_that_would_draw_beyond_the_geometry_limit_is_refused_at_the_animate():
+    d = error(motion("        SCALE LINK B\n          FRAME 2 POSITION 1.0E300, 1.0, 1.0\n") + SCENE)
+    assert d.pos.line == 11 and "beyond the limit of 1E12" in d.message
+    # A shape within the limit, which the link's scale then takes beyond it.
+    huge = motion(
+        "        SHAPE LINK A\n          FRAME 2 POSITION (A <SCALE 4.0E11>)\n"
+        "        SCALE LINK A\n          FRAME 2 POSITION 10.0, 1.0, 1.0\n"
+    )
+    huge += SCENE
+    assert "beyond the limit" in error(huge).message

@@ -158,3 +158,12 @@ def test_a_change_just_after_a_statement_s_first_word_is_lexed_as_the_whole_pars
     assert outcome(base, reparser)[0] == "ok"
     for text in ("X = 1\nY = 2\nMOTION =M\nZ = 3\n", "X = 1\nY = 2\nMOTION= M\nZ = 3\n", base):
         assert outcome(text, reparser) == outcome(text)
+
+
+def test_an_edit_of_the_first_statement_reparses_it_and_takes_the_rest_from_the_last_parse():
+    reparser = parser.reparser()
+    outcome(BIG, reparser)
+    at = BIG.index("LIGHT2 = LIGHT * 1.5") + len("LIGHT2 = LIGHT * 1.")  # inside the PRIMITIVE BOX that opens it
+    text = BIG[:at] + "7" + BIG[at:]
+    assert outcome(text, reparser) == outcome(text)
+    assert reparser.reused > 0.9 * len(text)

@@ -333,7 +333,7 @@ class _Statements:
         root = False
         for mj in s.joints:
             if isinstance(mj.joint, A.RootTrack):
-                root = True
+                root = root or not mj.joint.orientation  # ROOT ORIENTATION turns, it carries no path
             else:
                 ident = self.ev.value(mj.joint)
                 if isinstance(ident, int) and joints is not None:

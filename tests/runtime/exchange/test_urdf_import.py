@@ -26,6 +26,10 @@ ROBOTS = [
     "r2d2.urdf",  # boxes, cylinders, spheres, continuous wheels, a prismatic gripper
     "xarm/xarm6_robot.urdf",
     "a1/a1.urdf",  # a quadruped: a tree, not a chain
+    # Joint axes 6e-6 from -X (rpy 1.57079 0 1.57079, not quite a quarter turn), and toes drawn
+    # as spheres of radius 0: the frame was off by 1e-6 and the library did not compile.
+    "laikago/laikago_toes_zup_lores.urdf",
+    "differential/diff_ring.urdf",  # blank lines before its XML declaration, which TinyXML takes
 ]
 
 
@@ -214,3 +218,115 @@ def test_forward_kinematics_agree_with_pinocchio_at_random_joint_values(name, tm
             np.testing.assert_allclose(X_lig[i, :3, :3] @ R0, T[:3, :3], rtol=0, atol=1e-9, err_msg=link.source.name)
             checked += 1
     assert checked == 5 * fig.n_links
+
+
+def test_an_axis_next_to_minus_x_gives_an_orthonormal_frame():
+    # 1 + cos cancels there: the frame came out 1e-6 from a rotation.
+    from liganimate.runtime.figure.tree import frame_from_axis
+
+    for axis in [(-1.0, 6e-6, -6e-6), (-1.0, 1e-7, 0.0), (-1.0, 0.0, 3e-9), (-1.0, 0.0, 0.0)]:
+        F = frame_from_axis(axis)
+        np.testing.assert_allclose(F.T @ F, np.eye(3), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(F[:, 0], np.asarray(axis) / np.linalg.norm(axis), rtol=0, atol=1e-15)
+
+
+# ------------------------------------------------------------------ hostile and unusual files
+
+
+def _import_cli(path, out, env=None):
+    return subprocess.run(
+        [sys.executable, "-m", "liganimate", "import", str(path), "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=None if env is None else {**os.environ, **env},
+    )
+
+
+MESH = GOOD.replace('<box size="1 1 1"/>', '<mesh filename="{name}"/>')
+
+
+@pytest.mark.parametrize(
+    ("name", "words"),
+    [
+        ("../../../../../../etc/passwd", "not an STL, OBJ or DAE file"),
+        ("/etc/passwd", "not an STL, OBJ or DAE file"),
+        ("package://", "not an STL, OBJ or DAE file"),
+        ("package://nopackage/meshes/arm.stl", "not found beside the URDF"),
+        ("../../../../../../../nowhere/arm.stl", "not found beside the URDF"),
+    ],
+)
+def test_a_mesh_name_that_leads_to_any_other_file_is_refused_at_its_line(name, words, tmp_path):
+    path = tmp_path / "bad.urdf"
+    path.write_text(MESH.format(name=name))
+    out = tmp_path / "bad.lig"
+    done = _import_cli(path, out)
+    assert done.returncode == 1 and "bad.urdf:3:" in done.stderr and words in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr and not out.exists()
+
+
+def test_a_mesh_over_the_budget_is_refused_before_it_is_read(tmp_path):
+    big = tmp_path / "big.stl"
+    with open(big, "wb") as fh:  # sparse: 200 MiB on paper, no disk used
+        fh.truncate(200 * 1024 * 1024)
+    path = tmp_path / "bad.urdf"
+    path.write_text(MESH.format(name="big.stl"))
+    out = tmp_path / "bad.lig"
+    done = _import_cli(path, out)
+    assert done.returncode == 1 and "bad.urdf:3:" in done.stderr, done.stderr
+    assert "200 MiB, more than the 100 MiB" in done.stderr and "LIGANIMATE_MAX_MESH_MB" in done.stderr
+    assert not out.exists()
+    # The budget is the user's to raise: then the file is read (and this one, all zeros, is no mesh).
+    done = _import_cli(path, out, {"LIGANIMATE_MAX_MESH_MB": "300"})
+    assert done.returncode == 1 and "MiB" not in done.stderr and "Traceback" not in done.stderr, done.stderr
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "words"),
+    [
+        (GOOD.replace('xyz="0 0 1"', 'xyz="$(optenv ARM_XYZ 0 0 1)"'), 7, "xacro"),
+        (GOOD.replace('xyz="0 0 1"', 'xyz="0, 0, 1"'), 7, "not commas"),
+        (
+            GOOD.split('<link name="arm"/>')[0] + "</robot>\n",
+            3,
+            "fixed joint from it",
+        ),
+        (
+            '<?xml version="1.0"?>\n<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>\n<robot name="x">&x;</robot>\n',
+            2,
+            "document type",
+        ),
+    ],
+)
+def test_refusals_name_the_cause_in_a_hint(text, line, words, tmp_path):
+    path = tmp_path / "bad.urdf"
+    path.write_text(text)
+    out = tmp_path / "bad.lig"
+    done = _import_cli(path, out)
+    assert done.returncode == 1 and f"bad.urdf:{line}:" in done.stderr and words in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr and not out.exists()
+
+
+@pytest.mark.parametrize("variant", ["crlf", "bom", "tabs", "blank-lines-first"])
+def test_line_endings_bom_tabs_and_a_late_declaration_are_read(variant, tmp_path):
+    text = GOOD
+    if variant == "crlf":
+        text = text.replace("\n", "\r\n")
+    elif variant == "tabs":
+        text = text.replace("  ", "\t")
+    elif variant == "blank-lines-first":
+        text = "\n\n  " + text
+    raw = text.encode("utf-8")
+    if variant == "bom":
+        raw = b"\xef\xbb\xbf" + raw
+    path = tmp_path / "two.urdf"
+    path.write_bytes(raw)
+    fig, robot = imported(str(path), tmp_path)
+    assert [link.source.name for link in fig.links] == ["base", "arm"] and robot.joints[0].name == "j1"
+    # Positions still count the file's own lines.
+    bad = raw.replace(b'upper="1"', b'upper="x"')
+    path.write_bytes(bad)
+    with pytest.raises(LigDiagnostics) as info:
+        X.read_urdf(str(path))
+    assert info.value.diagnostics[0].pos.line == (10 if variant == "blank-lines-first" else 8)

@@ -225,3 +225,21 @@ def test_figure_main_link_with_a_repeated_name_says_when_no_main_joint_chooses_t
     assert "no FIGURE MAIN JOINT chooses the others" in warning
     # D is joint 3's secondary and joint 7's: MAIN JOINT 3 and MAIN JOINT 7 both choose it.
     assert w.with_main_joint(3).main == w.with_main_joint(7).main == w.preorder[1]
+
+
+@pytest.mark.parametrize("frames", [1, 40, 3000])
+def test_every_batch_length_gives_the_hand_worked_positions(frames):
+    """Short and long batches take different walks (walk.py, folded.py): both by hand."""
+    m = _variables(PLANAR)[0]["M"]
+    rng = np.random.default_rng(frames)
+    t = rng.uniform(-90.0, 90.0, size=(frames, 3))  # joints 1, 2, 3
+    angles = np.zeros((frames, m.n_joints, 3))
+    for c, jid in enumerate((1, 2, 3)):
+        angles[:, m.joint_index(jid), 2] = t[:, c]
+    X = K.pose_transforms(m, angles)
+    for f in {0, frames // 2, frames - 1}:
+        expected = by_hand(*t[f])
+        for i, link in enumerate(m.links):
+            (x, y), heading = expected[link.name]
+            np.testing.assert_allclose(X[f, i, :2, 3], [x, y], atol=1e-12, err_msg=f"{f} {link.name}")
+            np.testing.assert_allclose(X[f, i, :2, :2], _rot(heading), atol=1e-12, err_msg=f"{f} {link.name}")

@@ -618,17 +618,27 @@ def test_the_solver_registry_is_the_one_table_of_names_words_and_limits():
         S.SOLVERS["newton"] = S.SOLVERS["dls"]  # read-only: one table, not a copy per reader
 
 
-def test_the_solver_names_load_without_the_figure_code():
-    """The compiler imports the registry for the solver names; that must not load the kinematics."""
+def test_the_solver_names_load_without_the_solvers():
+    """The compiler and the host read the solver names from ik/names.py: no solver, no figure code, no numpy."""
     import subprocess
     import sys
 
     code = (
-        "import sys; from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS; "
-        "print(sorted(m for m in sys.modules if m.startswith('liganimate.runtime.') and 'ik.solvers' not in m))"
+        "import sys; from liganimate.runtime.ik.names import SOLVER_KEYWORDS; "
+        "print(sorted(m for m in sys.modules if m.startswith('liganimate.runtime.') or m == 'numpy'))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.strip() == "['liganimate.runtime.ik']"
+    assert out.strip() == "['liganimate.runtime.ik', 'liganimate.runtime.ik.names']"
+
+
+def test_the_solver_names_are_the_solver_tables_names():
+    """ik/names.py and the SOLVERS table name the same solvers with the same words, in the same order."""
+    from liganimate.runtime.ik import names as N
+    from liganimate.runtime.ik import solvers as S
+
+    assert dict(N.SOLVER_KEYWORDS) == {s.keyword: s.name for s in S.SOLVERS.values()}
+    assert tuple(N.SOLVER_KEYWORDS.values()) == S.SOLVER_NAMES
+    assert S.SOLVER_KEYWORDS is N.SOLVER_KEYWORDS and S.DEFAULT_SOLVER == N.DEFAULT_SOLVER
 
 
 def test_the_stopping_rules_say_the_same_for_one_solve_and_for_a_batch():

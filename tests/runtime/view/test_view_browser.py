@@ -84,11 +84,12 @@ def pages(tmp_path_factory):
             r = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=600)
             assert r.returncode == 0, r.stderr
         out[name] = (page, tmp / name)
-    # The walk in the modern look too: its default framing and its contact shadow.
-    cmd = [sys.executable, "-m", "liganimate", "run", str(tmp / "walk.lig"), "-o", str(tmp / "walk_modern"), "--quiet"]
-    r = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=600)
-    assert r.returncode == 0, r.stderr
-    out["walk_modern"] = (None, tmp / "walk_modern")
+    # The walk and Appendix A in the modern look too: the default framing, and the contact shadow.
+    for name in ("walk", "appendix"):
+        cmd = [sys.executable, "-m", "liganimate", "run", str(sources[name]), "-o", str(tmp / f"{name}_modern")]
+        r = subprocess.run(cmd + ["--quiet"], check=False, capture_output=True, text=True, timeout=600)
+        assert r.returncode == 0, r.stderr
+        out[f"{name}_modern"] = (None, tmp / f"{name}_modern")
     return out
 
 
@@ -211,19 +212,32 @@ def test_a_scene_with_view_keeps_its_view_in_the_modern_look(pages, browser):
     assert start["k"] * np.linalg.norm(start["eye"]) == pytest.approx(6.0, rel=1e-6)
 
 
+def _ground_agrees(mine, theirs, rows) -> int:
+    """Assert that the viewer's ground (under the figures' middle) is run's, shadow included; return its shadowed pixels."""
+    # The ground under and around the figures: pixels both show bright (the background, lit faces aside).
+    ground = (mine > 205) & (theirs > 205)
+    ground[: (rows.min() + rows.max()) // 2] = False
+    shadowed = ground & (theirs < 242)
+    assert shadowed.sum() > 500, "liganimate run draws a contact shadow here"
+    assert (np.abs(mine - theirs)[ground] <= 2).mean() > 0.995
+    assert 0.8 < (ground & (mine < 242)).sum() / shadowed.sum() < 1.25
+    return int(shadowed.sum())
+
+
+def test_the_contact_shadow_of_a_scene_with_view_is_liganimate_runs(pages, browser):
+    _open(browser, pages["appendix"][0], look="modern")
+    mine = _frame(browser, 0, 0).astype(int)  # six squat stages (SAMEFRAME 6), seen from the side
+    theirs = _run_image(pages["appendix_modern"][1], 1, 0).astype(int)
+    _ground_agrees(mine, theirs, np.nonzero(theirs < 200)[0])
+
+
 def test_the_contact_shadow_is_liganimate_runs_and_the_thesis_look_has_none(pages, browser):
     _open(browser, pages["walk"][0], look="modern")
     mine = _frame(browser, 0, 0).astype(int)
     theirs = _run_image(pages["walk_modern"][1], 1, 0).astype(int)
     rows, cols = np.nonzero(theirs < 200)
     foot = rows.max()  # the planted foot's lowest pixel
-    # The ground under and around the figure: pixels both show bright (the background, lit faces aside).
-    ground = (mine > 205) & (theirs > 205)
-    ground[: (rows.min() + foot) // 2] = False
-    shadowed = ground & (theirs < 242)
-    assert shadowed.sum() > 500, "liganimate run draws a contact shadow here"
-    assert (np.abs(mine - theirs)[ground] <= 2).mean() > 0.995
-    assert 0.8 < (ground & (mine < 242)).sum() / shadowed.sum() < 1.25
+    _ground_agrees(mine, theirs, rows)
     # Just under the foot the background is darker than far from the figure.
     below = mine[foot + 2 : foot + 8, cols.min() : cols.max() + 1]
     assert below.min() < 240 and mine[foot + 60 :, :].min() == 244 == mine[5, 5]
@@ -247,15 +261,21 @@ def test_the_notebook_display_draws_the_shadow_from_runs_camera(pages, browser, 
     browser.driver.get(host.as_uri())
     browser.driver.switch_to.frame(browser.driver.find_element("tag name", "iframe"))
     try:
-        deadline = time.time() + 30
-        while not browser.driver.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"):
-            assert time.time() < deadline, "the notebook's viewer did not start"
-            time.sleep(0.05)
-        assert browser.driver.execute_script("return ligViewer.sceneCamera()") == expected
+        from selenium.webdriver.support.ui import WebDriverWait
+
+        # Waits for the frame's viewer, however loaded the machine; the bound only stops a hang.
+        WebDriverWait(browser.driver, 60, poll_frequency=0.05).until(
+            lambda d: d.execute_script("return !!(window.ligViewer && window.ligViewer.ready)"),
+            "the notebook's viewer did not start",
+        )
+        start = browser.driver.execute_script("return ligViewer.sceneCamera()")
+        assert start == expected, (start, expected)
         img = browser.canvas().astype(int)
         rows, cols = np.nonzero(img < 200)
+        assert len(rows), "the notebook's viewer drew no figure"
         below = img[rows.max() + 2 : rows.max() + 8, cols.min() : cols.max() + 1]
-        assert img[0, 0] == 244 and below.min() < 240  # the grey background, darker under the feet
+        # The grey background, darker under the feet.
+        assert img[0, 0] == 244 and below.min() < 240, (img.shape, img[0, 0], below.min())
     finally:
         browser.driver.switch_to.default_content()
 

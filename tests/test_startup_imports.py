@@ -1,0 +1,66 @@
+"""What a cold ``liganimate check`` imports: the language, the compiler and the host, never the renderer, the
+solvers or the exchange formats (issue 22's start-up goal; benchmarks/compile.py measures its cost).
+
+Structural, not timed: a new process runs the command's own entry point on Appendix A and lists the
+modules it holds at exit. A module that appears here was imported by something ``check`` runs; make
+that import lazy (at its call site) rather than widen the allowed list.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+from paths import ROOT_DIR
+
+APPENDIX_A = os.path.join(ROOT_DIR, "examples", "appendix_a.lig")
+
+#: Run ``liganimate check`` as the console script does, then print the modules loaded.
+_PROBE = """
+import json, sys
+from liganimate.cli import main
+status = main(["check", sys.argv[1]])
+sys.stdout.write("\\n" + json.dumps({"status": status, "modules": sorted(sys.modules)}) + "\\n")
+"""
+
+#: Packages check needs none of: drawing, solving, reading or writing other formats, the plugin lookup.
+FORBIDDEN = (
+    "liganimate.runtime.render.",
+    "liganimate.runtime.ik.",
+    "liganimate.runtime.exchange.",
+    "liganimate.runtime.view",
+    "liganimate.runtime.studio",
+    "importlib.metadata",
+    "matplotlib",
+    "scipy",
+)
+#: Light modules under those packages that check does use: the host's framing of a scene and its camera,
+#: the movie table behind the command line's flags, REACH's options and solver names, the export formats' table.
+ALLOWED = {
+    "liganimate.runtime.render.framing",
+    "liganimate.runtime.render.camera",
+    "liganimate.runtime.render.movies",
+    "liganimate.runtime.ik.options",
+    "liganimate.runtime.ik.names",
+    "liganimate.runtime.exchange._formats",
+}
+
+
+def _modules_after_check() -> list[str]:
+    r = subprocess.run(
+        [sys.executable, "-c", _PROBE, APPENDIX_A], cwd=ROOT_DIR, capture_output=True, text=True, check=False
+    )
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout.strip().splitlines()[-1])
+    assert report["status"] == 0, r.stderr
+    return report["modules"]
+
+
+def test_check_imports_no_renderer_solver_or_exchange_module():
+    modules = _modules_after_check()
+    # The probe is real: check did load the compiler and ran the program in the host.
+    assert {"liganimate.compiler.check", "liganimate.runtime.host", "liganimate.lang.parser"} <= set(modules)
+    stray = [m for m in modules if m.startswith(FORBIDDEN) and m not in ALLOWED]
+    assert stray == [], f"check imported {stray}: import them where they are used"
