@@ -310,10 +310,19 @@ def _segment_expr(visuals, R0: np.ndarray, meshes: _Meshes) -> str | None:
     return " +\n          ".join(parts) if parts else None
 
 
+#: Beyond this a revolute joint's limit is no limit (LIG's extremes stop at 1E9 degrees).
+_UNBOUNDED_DEGREES = 1e9
+
+
+def _unbounded(j: UrdfJoint) -> bool:
+    """A revolute joint whose limits say "none": SDF converters write lower="-1e+16" upper="1e+16"."""
+    return j.type == "revolute" and max(abs(math.degrees(j.lower)), abs(math.degrees(j.upper))) > _UNBOUNDED_DEGREES
+
+
 def _extremes(j: UrdfJoint) -> str:
     if j.type == "fixed":
         return "(0.0, 0.0)"
-    if j.type == "continuous":
+    if j.type == "continuous" or _unbounded(j):
         return "(-180.0, 180.0)"
     if j.type == "prismatic":
         return f"SLIDE ({_num(j.lower)}, {_num(j.upper)})"
@@ -347,7 +356,11 @@ def import_urdf(robot: Urdf, options: UrdfImportOptions) -> tuple[bytes, list]:
         if expr is not None:
             shapes[link.name] = expr
     for j in joints:
-        if j.mimic is not None:
+        if _unbounded(j):
+            notes.append(
+                f"joint {j.name}'s limits ({j.lower:g}, {j.upper:g}) bound nothing; it turns freely, as a continuous joint"
+            )
+        if j.mimic is not None and j.type != "fixed":
             notes.append(
                 f"joint {j.name} mimics {j.mimic[0]} (x {j.mimic[1]:g} + {j.mimic[2]:g}); it is imported as a joint "
                 "of its own, which a motion drives itself"

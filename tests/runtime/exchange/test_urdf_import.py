@@ -342,3 +342,20 @@ def test_rpy_of_a_frame_near_a_quarter_pitch_gives_back_the_frame():
         for _ in range(20):
             R = rpy_matrix((rng.uniform(-math.pi, math.pi), pitch, rng.uniform(-math.pi, math.pi)))
             np.testing.assert_allclose(rpy_matrix(matrix_rpy(R)), R, rtol=0, atol=1e-15)
+
+
+def test_a_revolute_joint_with_limits_that_bound_nothing_turns_freely(tmp_path):
+    # example-robot-data's iris drone (converted from SDF) gives its rotors lower="-1e+16" upper="1e+16":
+    # the library was written with extremes LOAD refuses (beyond 1E9 degrees).
+    path = tmp_path / "rotor.urdf"
+    path.write_text(GOOD.replace('lower="-1" upper="1"', 'lower="-1e+16" upper="1e+16"'))
+    robot = X.read_urdf(str(path))
+    text, notes = X.import_urdf(robot, X.UrdfImportOptions(model="BOT", mesh_triangles=24))
+    assert any("j1's limits (-1e+16, 1e+16) bound nothing" in n for n in notes)
+    fig, _ = imported(str(path), tmp_path)
+    ref = yourdfpy.URDF.load(str(path), load_meshes=False)
+    for q in (-2.5, 0.7, 3.0):
+        ref.update_cfg(np.array([q]))
+        X_lig = K.pose_transforms(fig, lig_values(fig, robot, {"j1": q})[None])[0]
+        T = ref.get_transform("arm", ref.base_link)
+        np.testing.assert_allclose(X_lig[1, :3, :3], T[:3, :3], rtol=0, atol=1e-12)
