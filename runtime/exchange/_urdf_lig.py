@@ -280,7 +280,11 @@ def _mesh_primitive(name: str, V: np.ndarray, F: np.ndarray, source: str) -> str
         f"      {name} ::= '{name}' ;",
     ]
     pts = [f"({_g(v[0])}, {_g(v[1])}, {_g(v[2])})" for v in V]
-    body = [f"      DRAW POLY FROM {pts[a]} TO {pts[b]} TO {pts[c]}" for a, b, c in F]
+    # Corners a micrometre apart are one corner once written to _DIGITS digits (ANYmal C's meshes):
+    # such a sliver draws nothing, and the compiler refuses a polygon with two corners, so it is left out.
+    kept = [(a, b, c) for a, b, c in F if len({pts[a], pts[b], pts[c]}) == 3]
+    head[0] = f"{{@ {name}: the mesh {comment_text(source)}, {len(kept)} triangles }}"
+    body = [f"      DRAW POLY FROM {pts[a]} TO {pts[b]} TO {pts[c]}" for a, b, c in kept]
     return "\n".join(head + body + ["      RETURN", "      END", ""])
 
 

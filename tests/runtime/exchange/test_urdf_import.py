@@ -359,3 +359,17 @@ def test_a_revolute_joint_with_limits_that_bound_nothing_turns_freely(tmp_path):
         X_lig = K.pose_transforms(fig, lig_values(fig, robot, {"j1": q})[None])[0]
         T = ref.get_transform("arm", ref.base_link)
         np.testing.assert_allclose(X_lig[1, :3, :3], T[:3, :3], rtol=0, atol=1e-12)
+
+
+def test_a_mesh_sliver_that_rounding_closes_is_left_out(tmp_path):
+    # ANYmal C (example-robot-data) has triangles whose corners are a micrometre apart: written to six
+    # digits two corners were one, and the library did not compile ("a polygon needs three corners").
+    (tmp_path / "part.obj").write_text(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0.3886281 0.04685511 0.1612691\nv 0.3886279 0.04685509 0.1612689\nf 1 2 3\nf 4 2 5\n"
+    )
+    path = tmp_path / "part.urdf"
+    path.write_text(MESH.format(name="part.obj"))
+    fig, _ = imported(str(path), tmp_path)
+    assert fig.n_links == 2
+    text, _ = X.import_urdf(X.read_urdf(str(path)), X.UrdfImportOptions(model="BOT", mesh_triangles=24))
+    assert text.decode().count("DRAW POLY") == 1 and "part.obj, 1 triangles" in text.decode()
