@@ -18,6 +18,15 @@ model", lists every budget):
 * **frames**: the frames one scene of a render draws, ``ceil(LENGTH /
   SAMEFRAME)``. ``$LIGANIMATE_MAX_FRAMES``, default 1,000,000 (eleven hours of
   film at 24 frames a second).
+
+And one budget of a model:
+
+* **joints of a model**: a model is a value, so each JOINT that grows one
+  copies its joints (at C speed, but the copies of a model built one JOINT at
+  a time add up with the square of its joints: 20,000 joints take about 9 s
+  of CPU). A JOINT or STARTMODEL block that would make a model of more
+  joints is refused at its place. ``$LIGANIMATE_MAX_MODEL_JOINTS``, default
+  25,000.
 """
 
 from __future__ import annotations
@@ -34,6 +43,10 @@ DEFAULT_JOINT_TICKS = 50_000_000
 FRAMES_ENV = "LIGANIMATE_MAX_FRAMES"
 #: The default budget of frames of one scene.
 DEFAULT_FRAMES = 1_000_000
+#: The environment variable that sets the joints one model may have.
+MODEL_JOINTS_ENV = "LIGANIMATE_MAX_MODEL_JOINTS"
+#: The default budget of joints of one model (a 20,000-joint chain builds in about 9 s of CPU).
+DEFAULT_MODEL_JOINTS = 25_000
 
 
 def budget(env: str, default: int) -> int:
@@ -95,4 +108,26 @@ def check_frames(length: int, sameframe: int) -> None:
         raise LigError(
             f"this scene would draw {frames:,} frames, over the budget of {limit:,} frames for one scene",
             f"shorten the scene, show each frame longer with SAMEFRAME, or raise the budget with {FRAMES_ENV}={frames}",
+        )
+
+
+def check_model_joints(count: int) -> None:
+    """Refuse a model of more joints than the budget allows, before it is built.
+
+    Parameters
+    ----------
+    count : int
+        The joints the model would have.
+
+    Raises
+    ------
+    LigError
+        One sentence naming the count and the limit, and a hint naming the variable.
+    """
+    limit = budget(MODEL_JOINTS_ENV, DEFAULT_MODEL_JOINTS)
+    if count > limit:
+        raise LigError(
+            f"this model would have {count:,} joints, over the limit of {limit:,} joints for one model",
+            "each JOINT copies the model it grows, so the cost of building one grows with the square "
+            f"of its joints; split the figure, or raise the limit with {MODEL_JOINTS_ENV}={count}",
         )

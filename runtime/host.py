@@ -463,10 +463,13 @@ class Runtime(Arithmetic):
     def joint(self, jid, primary, loc1, secondary, loc2, extremes, names, at, kind=(False, None)):
         p = self._segment(primary, names[0], at)
         s = self._segment(secondary, names[1], at)
+        self._guard(at, budgets.check_model_joints, len(getattr(p, "joints", ())) + len(getattr(s, "joints", ())) + 1)
         fig = self._guard(at, F.join, jid, p, loc1, s, loc2, extremes, _joint_kind(kind))
         return self._guard(at, limits.check_joined, fig, p, s, "the joined model")
 
     def model_block(self, name, specs, at):
+        sizes = (len(getattr(j.secondary, "joints", ())) for j in specs)  # submodels bring their joints
+        self._guard(at, budgets.check_model_joints, len(specs) + sum(sizes))
         shapes = {}
         out = []
         for index, j in enumerate(specs):

@@ -75,3 +75,38 @@ def test_a_repeated_joint_identifier_is_still_refused_when_grafting():
         program, _ = load_program(text=CHAIN.format(n=3).replace("JOINT I,", "JOINT 1 + I MOD 2,"), name="c.lig")
         program.check()
     assert "joint identifier 2 is used twice in one model" in info.value.diagnostics[0].message
+
+
+def test_a_model_over_the_joint_budget_is_refused_at_the_joint_that_grows_it(monkeypatch):
+    monkeypatch.setenv("LIGANIMATE_MAX_MODEL_JOINTS", "50")
+    program, _ = load_program(text=CHAIN.format(n=60), name="chain.lig")
+    with pytest.raises(LigDiagnostics) as info:
+        program.execute("check")
+    d = info.value.diagnostics[0]
+    assert d.pos.line == 7  # the JOINT inside the loop
+    assert "51 joints, over the limit of 50 joints" in d.message
+    assert "LIGANIMATE_MAX_MODEL_JOINTS=51" in d.hint
+    monkeypatch.setenv("LIGANIMATE_MAX_MODEL_JOINTS", "61")
+    program.execute("check")  # 61 joints: within the raised budget
+
+
+def test_a_model_block_over_the_joint_budget_is_refused_at_the_block(monkeypatch):
+    monkeypatch.setenv("LIGANIMATE_MAX_MODEL_JOINTS", "2")
+    text = """\
+      GRAPHICAL A, B, C, D
+      MODEL M
+      A :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0
+      B :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0
+      C :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0
+      D :- BOX WIDTH 1.0, HEIGHT 1.0, DEPTH 1.0
+      STARTMODEL M
+        JOINT 1, A, (0.0, 0.0, 0.0), B, (0.0, 0.0, 0.0), (-10, 10)
+        JOINT 2, B, (0.0, 1.0, 0.0), C, (0.0, 0.0, 0.0), (-10, 10)
+        JOINT 3, C, (0.0, 1.0, 0.0), D, (0.0, 0.0, 0.0), (-10, 10)
+      ENDMODEL
+"""
+    program, _ = load_program(text=text, name="block.lig")
+    with pytest.raises(LigDiagnostics) as info:
+        program.execute("check")
+    d = info.value.diagnostics[0]
+    assert d.pos.line == 7 and "3 joints, over the limit of 2" in d.message
