@@ -254,6 +254,8 @@ class Program:
             raise TypeError(f"render() got unknown options: {', '.join(unknown)}") from None
         if not checked:
             self.execute("check", stdout=io.StringIO(), drawing=True)
+        if progress is None and chosen.progress:
+            progress = True  # RenderOptions.progress: shown even when stderr is not a terminal
         renderer = Renderer(chosen, progress=progress, executor=executor)
         try:
             rt = self.execute("render", renderer=renderer, stdout=stdout)
@@ -733,7 +735,7 @@ class Runtime(Arithmetic):
                     rate = (done - mark[1]) / (t - mark[0])
                     self._guard(at, budgets.check_joint_ticks, length, t, done, rate)
                     mark = (t, done)
-                if progress is not None:
+                if progress is not None and not t % PROGRESS_TICKS:  # t == 1 only estimates
                     progress(state.id, t, length)
             yield t
         if progress is not None and length >= PROGRESS_TICKS:

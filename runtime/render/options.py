@@ -134,6 +134,9 @@ class RenderOptions:
         The address of a Dask scheduler to draw the frames on (``tcp://host:8786``).
     quiet : bool
         No progress bar.
+    progress : bool
+        Show the check's and the render's progress on stderr even when it is
+        not a terminal (a line a second), e.g. into a log.
     """
 
     out: str | None = None
@@ -149,6 +152,7 @@ class RenderOptions:
     workers: int | None = None
     scheduler: str | None = None
     quiet: bool = False
+    progress: bool = False
 
     def movies(self) -> list[tuple[Movie, str]]:
         """The movies asked for, with their paths, in the order of :data:`MOVIES`."""

@@ -190,7 +190,7 @@ class LoadedProgram:
             line's options: ``size=(640, 480)``, ``gif=``, ``mp4=``,
             ``poses=``, ``fps=``, ``aa=``, ``look=`` (``"modern"``, the
             default, or ``"thesis"``), ``crf=``, ``preset=``,
-            ``workers=``, ``scheduler=``, ``quiet=``.
+            ``workers=``, ``scheduler=``, ``quiet=``, ``progress=``.
 
         Raises
         ------

@@ -254,10 +254,11 @@ NO_SCENE = "the program shoots no scene, so there is nothing to {doing}"
 NO_SCENE_HINT = "define a scene with INITIALIZE SCENE ... ENDSCENE and SHOOTSCENES"
 
 
-def _render(program, warnings, options, asked: bool = False) -> int:
+def _render(program, warnings, options) -> int:
     from liganimate.runtime.render.options import MOVIES
 
     _print_diagnostics(warnings)
+    asked = options.progress  # --progress: a line a second wherever stderr goes
     checked = _checked(program, options.quiet, asked=asked, drawing=True)
     _print_diagnostics(checked.warnings)
     if not checked.shot:
@@ -266,7 +267,7 @@ def _render(program, warnings, options, asked: bool = False) -> int:
         sys.stderr.write(f"liganimate: warning: {NO_SCENE.format(doing='render')}; nothing was written\n")
         sys.stderr.write(f"  hint: {NO_SCENE_HINT}\n")
         return 0
-    program.render(checked=True, options=options, progress=True if asked else None)
+    program.render(checked=True, options=options)
     if not options.quiet:
         written = [f"frames written to {options.out}"] if options.out is not None else []
         written += [f"{m.label} written to {path}" for m in MOVIES if (path := getattr(options, m.name))]
@@ -359,7 +360,7 @@ def cmd_run(args) -> int:
         from liganimate.compiler import load_program
 
         program, warnings = load_program(args.file)
-        return _render(program, warnings, options, asked=args.progress)
+        return _render(program, warnings, options)
 
     return guarded(go)
 
