@@ -50,7 +50,7 @@ def lig_values(fig, robot, cfg: dict) -> np.ndarray:
     for k, joint in enumerate(fig.joints):
         name = fig.links[joint.secondary].source.joint
         j = by_name[name]
-        if j.mimic is not None:
+        if j.mimic is not None and j.type != "fixed":  # a fixed joint with a <mimic> (Talos) never moves
             q = j.mimic[1] * cfg[j.mimic[0]] + j.mimic[2]
         else:
             q = cfg.get(name, 0.0)
