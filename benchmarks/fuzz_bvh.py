@@ -166,7 +166,9 @@ def mutate(rng: random.Random, text: str) -> str:
                 head, _, rest = lines[i].partition(word)
                 parts = rest.split()
                 if parts:
-                    parts[0] = rng.choice(("0", "-1", "7", "99999999999", "2.5", str(int(parts[0] or 0) + 1)))
+                    # An earlier mutation may have left any text there (a value, a word): count on from digits only.
+                    after = str(int(parts[0]) + 1) if parts[0].isdigit() else "1"
+                    parts[0] = rng.choice(("0", "-1", "7", "99999999999", "2.5", after))
                 lines[i] = head + word + " " + " ".join(parts)
     elif r < 0.94:
         at = rng.randrange(len(lines[i]) + 1)
