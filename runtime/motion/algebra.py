@@ -382,13 +382,7 @@ class Motion:
             In the model's own units and axes; ``world = placement @
             Trans(offset) @ pose``.
         """
-        t = self._times(times)
-        if self._root is None:
-            return np.zeros((len(t), 3))
-        with np.errstate(all="ignore"):  # see evaluate
-            out = self._root.sample_x(t)
-        _finite(out)
-        return out
+        return self._sample_root(self._root, times)
 
     @property
     def turn(self) -> tr.Track | None:
@@ -408,11 +402,15 @@ class Motion:
             Degrees; ``world = placement @ Trans(offset) @ Rot(angles) @ pose``
             with ``Rot`` :func:`.turning.orientation_matrix`.
         """
+        return self._sample_root(self._turn, times)
+
+    def _sample_root(self, track: tr.Track | None, times) -> np.ndarray:
+        """A root track's three values at ``times`` ``(T,)`` as ``(T, 3)``; zeros for a motion without that track."""
         t = self._times(times)
-        if self._turn is None:
+        if track is None:
             return np.zeros((len(t), 3))
         with np.errstate(all="ignore"):  # see evaluate
-            out = self._turn.sample_x(t)
+            out = track.sample_x(t)
         _finite(out)
         return out
 
