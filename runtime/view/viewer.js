@@ -326,6 +326,11 @@
     } else if (e.key === 'ArrowLeft') setFrame(state.image - 1);
   });
   window.addEventListener('resize', function () { layout(); draw(); });
+  // A notebook's <iframe srcdoc> can run this script before the frame has its size, and
+  // no resize event follows when the size arrives: the stage's own size is what to follow.
+  if (window.ResizeObserver) {
+    new ResizeObserver(function () { if (!fixed) { layout(); draw(); } }).observe(el('stage'));
+  }
 
   if (/^\d+x\d+$/.test(opts.size || '')) fixed = opts.size.split('x').map(Number);
   layout();

@@ -270,6 +270,17 @@ def test_the_notebook_display_draws_the_shadow_from_runs_camera(pages, browser, 
         )
         start = browser.driver.execute_script("return ligViewer.sceneCamera()")
         assert start == expected, (start, expected)
+        # The frame's script can run before the frame has its size (no resize event follows):
+        # the picture must still grow to the largest 4:3 the frame's stage holds.
+        fits = (
+            "var b = document.getElementById('stage').getBoundingClientRect(), c = document.getElementById('view');"
+            "var w = Math.floor(Math.min(b.width, b.height * 4 / 3));"
+            "return w > 64 && c.width === w ? w : null;"
+        )
+        WebDriverWait(browser.driver, 30, poll_frequency=0.05).until(
+            lambda d: d.execute_script(fits),
+            "the notebook's viewer did not grow to fill its frame",
+        )
         img = browser.canvas().astype(int)
         rows, cols = np.nonzero(img < 200)
         assert len(rows), "the notebook's viewer drew no figure"
@@ -278,6 +289,26 @@ def test_the_notebook_display_draws_the_shadow_from_runs_camera(pages, browser, 
         assert img[0, 0] == 244 and below.min() < 240, (img.shape, img[0, 0], below.min())
     finally:
         browser.driver.switch_to.default_content()
+
+
+def test_the_picture_follows_its_stage_without_a_window_resize(pages, browser):
+    # The stage can change size with no resize event: a notebook frame getting its size late,
+    # or the read-out line growing.  The picture must follow the stage, not the window.
+    _open(browser, pages["walk"][0], size="")
+    fits = (
+        "var b = document.getElementById('stage').getBoundingClientRect(), c = document.getElementById('view');"
+        "return [Math.floor(Math.min(b.width, b.height * 4 / 3)), c.width];"
+    )
+    first, have = browser.driver.execute_script(fits)
+    assert first == have > 300, (first, have)
+    browser.driver.execute_script("document.getElementById('info').style.minHeight = '300px'")
+    deadline = time.time() + 30
+    while time.time() < deadline:
+        want, have = browser.driver.execute_script(fits)
+        if want == have:
+            break
+        time.sleep(0.05)
+    assert want == have < first - 100, (first, want, have)
 
 
 def test_moving_the_scrubber_changes_the_picture(pages, browser):
