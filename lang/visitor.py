@@ -27,13 +27,9 @@ LEAVES: set = set()
 # Field annotations (strings: lang/ast.py postpones them) that never hold a node.
 _SCALAR = {"str", "int", "float", "bool", "Pos", "int | float", "str | None", "int | None", "float | None"}
 
-#: Statements that hold statements, and the fields that hold their statement lists, in source order.
-BLOCKS: dict = {
-    A.Do: ("body",),
-    A.If: ("then", "orelse"),
-    A.Scene: ("init", "body"),
-    A.PrimitiveDef: ("body",),
-}
+#: Statements that hold statements, and the fields that hold their statement lists, in source order
+#: (the fields lang/ast.py declares with ``holds=True``).
+BLOCKS: dict = {cls: tuple(name for name, _ in marked) for cls, marked in A.statement_fields("holds").items()}
 
 
 def _node_fields(cls) -> tuple:
