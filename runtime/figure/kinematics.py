@@ -195,12 +195,16 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, shape (B, n_links, 4, 4)
-        ``root @ pose`` for every link: a view of other storage, not
-        C-contiguous (``np.ascontiguousarray`` makes it so).
+        ``root @ pose`` for every link: for more than one pose a view of
+        other storage, not C-contiguous (``np.ascontiguousarray`` makes it
+        so).
 
     Notes
     -----
-    A batch of fewer than :data:`SHORT` poses is walked by
+    One pose is computed by
+    :func:`liganimate.runtime.figure.single.placed_one` (the walk below laid
+    out once per figure as a fixed list of about thirty numpy calls, the
+    same numbers bit for bit).  A batch of fewer than :data:`SHORT` poses is walked by
     :func:`liganimate.runtime.figure.walk.placed` (all joints at once, one
     product per depth level of the tree: a few dozen numpy calls whatever
     the number of joints), a longer one by
