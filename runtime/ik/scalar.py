@@ -226,7 +226,7 @@ def _walk_of(model) -> _Walk:
         level = [(joints, parents, children)] if isinstance(joints, int) else zip(joints, parents, children)
         for k, parent, child in level:
             k = int(k)
-            variables = tuple(var_of.get((k, a), -1) for a in range(3))
+            var_axes = tuple(var_of.get((k, a), -1) for a in range(3))
             steps.append(
                 (
                     k,
@@ -236,7 +236,7 @@ def _walk_of(model) -> _Walk:
                     frames[k],
                     _nonzero(model._near[k]),
                     _nonzero(model._far[k]),
-                    variables,
+                    var_axes,
                 )
             )
     variables = tuple(
@@ -260,7 +260,7 @@ def _joint_kinds(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
     cos, sin = np.cos(base).tolist(), np.sin(base).tolist()
     trig = [c + s for c, s in zip(cos, sin)]
     zero = (base == 0.0).tolist()
-    kinds = []
+    kinds: list[tuple | None] = []
     for k, _parent, _child, rev, frame, _near, _far, variables in walk.steps:
         moving = [a for a in range(3) if variables[a] >= 0]
         if not moving:
@@ -472,11 +472,11 @@ def _damped(J: list, r: list, mu: float) -> list:
     if M == 3 and P > 3:
         # One point goal: the 3x3 system written out.
         j0, j1, j2 = J
-        y = _solve3(
+        y3 = _solve3(
             _dot(j0, j0) + mu, _dot(j0, j1), _dot(j0, j2), _dot(j1, j1) + mu, _dot(j1, j2), _dot(j2, j2) + mu, r
         )
-        if y is not None:
-            y0, y1, y2 = y
+        if y3 is not None:
+            y0, y1, y2 = y3
             return [a * y0 + b * y1 + c * y2 for a, b, c in zip(j0, j1, j2)]
     if M < P:
         A = [[_dot(a, b) for b in J] for a in J]
@@ -491,30 +491,39 @@ def _damped(J: list, r: list, mu: float) -> list:
     return [-v for v in _solve(A, [_dot(col, r) for col in cols])]
 
 
-def _step(x: list, r: list, J: list, mu: float, lower: list, upper: list, V: int, maxstep: float) -> tuple:
-    """``solvers._held_step`` in floats: held, damped, capped and projected; returns ``(dx, x + dx)``."""
-    at_lower = [a <= lo for a, lo in zip(x, lower)]
-    at_upper = [a >= hi for a, hi in zip(x, upper)]
-    at_limit = any(at_lower) or any(at_upper)
-    free: list = []
-    if at_limit:
-        g = [_dot(col, r) for col in zip(*J)]
-        free = [not ((lo and gi > 0) or (hi and gi < 0)) for lo, hi, gi in zip(at_lower, at_upper, g)]
+def _held_damped(r: list, J: list, mu: float, at_lower: list, at_upper: list) -> tuple[list, list]:
+    """The damped step holding the variables at a limit that the descent, then the step, pushes against.
+
+    Returns the step and which variables are free (at most three passes, as ``solvers._held_step``).
+    """
+    g = [_dot(col, r) for col in zip(*J)]
+    free = [not ((lo and gi > 0) or (hi and gi < 0)) for lo, hi, gi in zip(at_lower, at_upper, g)]
     for _pass in range(3):
-        Jf = [[v if f else 0.0 for v, f in zip(row, free)] for row in J] if at_limit else J
-        dx = _damped(Jf, r, mu)
-        if not at_limit:
-            break
+        dx = _damped([[v if f else 0.0 for v, f in zip(row, free)] for row in J], r, mu)
         out = [f and ((lo and d < 0) or (hi and d > 0)) for f, lo, hi, d in zip(free, at_lower, at_upper, dx)]
         if not any(out):
             break
         free = [f and not o for f, o in zip(free, out)]
+    return [d if f else 0.0 for d, f in zip(dx, free)], free
+
+
+def _step(x: list, r: list, J: list, mu: float, lower: list, upper: list, V: int, maxstep: float) -> tuple:
+    """``solvers._held_step`` in floats: held, damped, capped and projected; returns ``(dx, x + dx)``.
+
+    Only a variable at a limit can be held, so while none is (most
+    iterations) the step is the plain damped one.
+    """
+    at_lower = [a <= lo for a, lo in zip(x, lower)]
+    at_upper = [a >= hi for a, hi in zip(x, upper)]
+    if any(at_lower) or any(at_upper):
+        # Capping scales the held variables' zeros to zeros: hold first, then cap.
+        dx, _free = _held_damped(r, J, mu, at_lower, at_upper)
+    else:
+        dx = _damped(J, r, mu)
     big = max([abs(d) for d in dx[:V]], default=0.0)
     if big > maxstep:
         scale = maxstep / big
         dx = [d * scale for d in dx]
-    if at_limit:
-        dx = [d if f else 0.0 for d, f in zip(dx, free)]
     xn = [min(max(a + d, lo), hi) for a, d, lo, hi in zip(x, dx, lower, upper)]
     dx = [b - a for a, b in zip(x, xn)]
     return dx, [a + d for a, d in zip(x, dx)]

@@ -927,6 +927,15 @@ def _dls_one(
             attempt, attempts_left = _next_attempt(st, attempt, kern.native)
             x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = attempt
 
+    return _one_result(st, (x, f, dist, status, iterations), history)
+
+
+def _one_result(st: _State | None, end: tuple, history: list) -> SolveResult:
+    """:func:`_dls_one`'s result from its last attempt's ``(x, f, dist, status, iterations)``.
+
+    With restarts in play, the attempts' :class:`_State` chooses the attempt.
+    """
+    x, f, dist, status, iterations = end
     if st is None:
         return SolveResult(
             np.array(x, dtype=float)[None],
