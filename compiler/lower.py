@@ -16,15 +16,14 @@ import re
 
 from liganimate import __version__
 from liganimate.lang import ast as A
-from liganimate.lang import bindings, keyframe_table
+from liganimate.lang import bindings
 from liganimate.lang import numbers as N
-from liganimate.lang.source import spelling
 from liganimate.lang.visitor import NodeVisitor
 from liganimate.lang.vocabulary import FUNCTIONS, MODIFIERS, Operator, operators_for
-from liganimate.runtime.ik.names import DEFAULT_SOLVER, SOLVER_KEYWORDS
 
 from . import types as T
 from .check import Checked, expr_type
+from .rules import rule_for
 
 _ZERO = {
     T.INTEGER: "0",
@@ -69,7 +68,7 @@ _CMP = {"=": "==", "<>": "!=", "/=": "!=", "<": "<", ">": ">", "<=": "<=", ">=":
 
 
 class Lowerer(NodeVisitor):
-    """Emits Python source line by line: ``s_<Node>`` for a statement, ``e_<Node>`` returns an expression's code."""
+    """Emits Python source line by line: a statement's rule (compiler/rules/) emits it, ``e_<Node>`` returns an expression's code."""
 
     def __init__(self, checked: Checked, module_doc_name: str):
         self.c = checked
@@ -202,7 +201,7 @@ class Lowerer(NodeVisitor):
             self.emit(item)
             cut(CHUNK_LINES)
         for i, stmt in enumerate(body):
-            self.dispatch("s_", stmt)(stmt, "main")
+            rule_for(type(stmt)).lower(self, stmt, "main")
             if self.consume:
                 body[i] = stmt = None  # lowered: its part of the tree can go now
             cut(CHUNK_LINES)
@@ -279,246 +278,19 @@ class Lowerer(NodeVisitor):
     def block(self, stmts: list, where: str) -> None:
         start = len(self.lines)
         for s in stmts:
-            self.dispatch("s_", s)(s, where)
+            rule_for(type(s)).lower(self, s, where)
         if len(self.lines) == start:
             self.emit("pass")
 
-    def s_PrimitiveDef(self, s, where):
-        pass
-
-    def s_Assign(self, s, where):
-        target = s.target.name
-        value = self.expr(s.value)
-        scope_t = self.var_type(target)
-        if scope_t == T.REAL and self.type_of(s.value) == T.INTEGER:
-            value = _as_real(s.value, value)
-        if scope_t == T.GRAPHICAL and self.type_of(s.value) == T.MODEL:
-            value = f"rt.as_graphical({value}, {self.at(s.value)})"
-        self.emit(f"{target} = {value}")
+    def as_real(self, e, code: str) -> str:
+        """Code for an INTEGER expression's value as a REAL (a literal is converted here, once)."""
+        return _as_real(e, code)
 
     def var_type(self, name: str):
         return self.current_scope_types().get(name)
 
     def current_scope_types(self):
         return self.scope_types if getattr(self, "scope_types", None) is not None else self.c.main.types
-
-    def s_KeyframeAssign(self, s, where):
-        k = s.keyframe
-        method = repr(k.method.name) if k.method is not None else "None"
-        self.emit(
-            f"{s.target.name} = rt.set_keyframe({s.target.name}, {self.joint_or_root(s.joint)}, {self.expr(s.index)}, "
-            f"{self.expr(k.frame)}, {self.position(k.position)}, {method}, {self.at(s)})"
-        )
-
-    def joint_or_root(self, e) -> str:
-        """A keyframe's joint identifier: None for the ROOT track, 'ORIENTATION' for ROOT ORIENTATION, ``(kind, link)`` for a morph track."""
-        if isinstance(e, A.MorphTrack):
-            return repr((e.kind, e.link))
-        if isinstance(e, A.RootTrack):
-            return repr("ORIENTATION") if e.orientation else "None"
-        return self.expr(e)
-
-    def position(self, items: list) -> str:
-        if len(items) == 1:
-            return self.expr(items[0])
-        return f"rt.vec({', '.join(self.expr(i) for i in items)})"
-
-    def s_Do(self, s, where):
-        step = self.expr(s.step) if s.step is not None else "1"
-        start = self.expr(s.start)
-        if self.var_type(s.var.name) == T.REAL and self.type_of(s.start) == T.INTEGER:
-            start = _as_real(s.start, start)  # a REAL variable counts in REALs
-        self.emit(f"for {s.var.name} in rt.do_range({start}, {self.expr(s.stop)}, {step}, {self.at(s)}):")
-        self.indent += 1
-        self.hot += 1
-        self.block(s.body, where)
-        self.hot -= 1
-        self.indent -= 1
-
-    def s_If(self, s, where):
-        self.emit(f"if {self.cond(s.cond)}:")
-        self.indent += 1
-        self.block(s.then, where)
-        self.indent -= 1
-        if s.orelse:
-            self.emit("else:")
-            self.indent += 1
-            self.block(s.orelse, where)
-            self.indent -= 1
-
-    def s_ModelBlock(self, s, where):
-        specs = []
-        for j in s.joints:
-            a = j.args
-            pname = a[1].name if isinstance(a[1], A.Var) else None
-            sname = bindings.plain_name(a[3])
-            exts = ", ".join(self.expr(e) for e in a[5:])
-            specs.append(
-                f"_host.JointArgs(jid={self.expr(a[0])}, primary_name={pname!r}, primary={self.expr(a[1])}, "
-                f"primary_location={self.expr(a[2])}, secondary={self.expr(a[3])}, secondary_name={sname!r}, "
-                f"secondary_location={self.expr(a[4])}, extremes=({exts},), at={self.at(j)}"
-                f"{self.joint_kind(j, ', kind=')})"
-            )
-        self.emit(f"{s.name.name} = rt.model_block({s.name.name!r}, (")
-        for sp in specs:
-            self.emit(f"    {sp},")
-        self.emit(f"), {self.at(s)})")
-
-    def s_MotionBlock(self, s, where):
-        self.emit(f"{s.name.name} = rt.motion_block((")
-        for j in s.joints:
-            start = self.position(j.start) if j.start is not None else "None"
-            kfs = []
-            for k in j.keyframes:
-                method = repr(k.method.name) if k.method is not None else "None"
-                kfs.append(f"({self.expr(k.frame)}, {self.position(k.position)}, {method}, {self.at(k)})")
-            inner = "".join(x + ", " for x in kfs)
-            self.emit(f"    ({self.joint_or_root(j.joint)}, {start}, ({inner}), {self.at(j)}),")
-        tables = ""
-        for t in s.tables:
-            # The rows travel as one string of numbers (lang/keyframe_table.py), read in bulk at run time.
-            columns = "".join(self.joint_or_root(c) + ", " for c in t.columns)
-            packed = keyframe_table.pack(t.rows)
-            tables += f"_host.TableArgs(({columns}), {packed!r}, {self.at(t)}), "
-            self.table_spans.append((t.rows_pos.start, t.rows_pos.start + len(t.rows)))
-        self.emit(f"), {self.at(s)}" + (f", ({tables}))" if tables else ")"))
-
-    def s_ReachBlock(self, s, where):
-        def opt(e):
-            return "None" if e is None else self.expr(e)
-
-        goals = []
-        for g in s.goals:
-            link = repr(g.link.name) if g.link is not None else "None"
-            goals.append(
-                f"_host.GoalArgs(kind={g.kind!r}, link={link}, joint={opt(g.joint)}, point={opt(g.point)}, "
-                f"target={opt(g.target)}, normal={opt(g.normal)}, weight={opt(g.weight)}, at={self.at(g)})"
-            )
-        if s.joints is not None:
-            movable = "(" + "".join(self.expr(j) + ", " for j in s.joints) + ")"  # joint ids: a tuple
-        elif s.chain is not None:
-            movable = self.expr(s.chain)  # a chain length: an INTEGER
-        else:
-            movable = "None"
-        solver = SOLVER_KEYWORDS[s.solver.name] if s.solver is not None else DEFAULT_SOLVER
-        method = repr(s.method.name) if s.method is not None else "'LINEAR'"
-        target = f"{s.name.name}, {s.translate.name}" if s.translate is not None else f"{s.name.name}, _"
-        self.emit(f"{target} = rt.reach({self.expr(s.model)}, {opt(s.start)}, {self.expr(s.frames)}, {method}, (")
-        for g in goals:
-            self.emit(f"    {g},")
-        # The block's options, one frozen ReachOptions (runtime/ik/options.py) that every IK layer passes on.
-        self.emit(
-            f"), _host.ReachOptions(movable={movable}, translate={s.translate is not None!r}, solver={solver!r}, "
-            f"tolerance={opt(s.tolerance)}, max_iterations={opt(s.iterations)}), {self.at(s)})"
-        )
-
-    def s_FigureStmt(self, s, where):
-        if s.kind is None:
-            arg = "None"
-        elif s.kind == "LINK":
-            arg = repr(s.link.name)
-        else:
-            arg = self.expr(s.joint)
-        self.emit(f"{s.model.name} = rt.figure({s.model.name}, {s.kind!r}, {arg}, {self.at(s)})")
-
-    def s_Scene(self, s, where):
-        info = self.c.scenes[id(s)]
-        fn = f"_scene_{self.tmp}"
-        self.tmp += 1
-        snap = info.models
-        assigned = info.assigned | set(snap) | set(info.animated)
-        self.emit(f"def {fn}(_snap):")
-        self.indent += 1
-        if assigned:
-            self.emit(f"{'global' if self.chunked else 'nonlocal'} {', '.join(sorted(assigned))}")
-        if snap:
-            # The scene sees its models as they were where it was defined;
-            # the program's own variables get their values back afterwards.
-            self.emit(f"_saved = {_tuple_value(snap)}")
-            self.emit(f"{_tuple_target(snap)} = _snap")
-        self.block(s.init, "scene")
-        sameframe = self.expr(s.sameframe) if s.sameframe is not None else "1"
-        animated = info.animated
-        if animated:
-            self.emit(f"_base = {_tuple_value(animated)}")
-        sameframe_at = self.at(s.sameframe) if s.sameframe is not None else "None"
-        self.emit(f"for _tick in rt.ticks({self.expr(s.length)}, {sameframe}, {self.at(s.length)}, {sameframe_at}):")
-        self.indent += 1
-        if animated:
-            self.emit(f"{_tuple_target(animated)} = _base")
-        self.hot += 1
-        self.block(s.body, "scene-body")
-        self.hot -= 1
-        pairs = "".join(f"({n!r}, {n}), " for n in animated)
-        self.emit(f"rt.end_tick(({pairs}))")
-        self.indent -= 1
-        if snap:
-            self.emit(f"{_tuple_target(snap)} = _saved")
-        elif animated:
-            self.emit(f"{_tuple_target(animated)} = _base")
-        self.indent -= 1
-        self.emit(f"rt.define_scene({self.expr(s.scene_id)}, {fn}, {_tuple_value(snap)}, {self.at(s.start_pos)})")
-
-    def s_Animate(self, s, where):
-        m = s.model.name
-        self.emit(
-            f"{m} = rt.animate({m}, {m!r}, {self.expr(s.start)}, {self.expr(s.end)}, {self.expr(s.motion)}, "
-            f"{bool(s.repeat)}, {self.at(s)})"
-        )
-
-    def s_Background(self, s, where):
-        items = "".join(self.expr(i) + ", " for i in s.items)
-        self.emit(f"rt.background(({items}), {self.at(s)})")
-
-    def s_Print(self, s, where):
-        parts = []
-        for item in s.items:
-            if item.kind == "text":
-                parts.append(f"('text', {item.value!r}, None)")
-            elif item.kind == "table":
-                parts.append(f"('table', {item.value.name}, {item.value.name!r})")
-            else:
-                t = self.type_of(item.value)
-                label = spelling(self.c.program.source, item.value.pos)
-                kind = None if t is None else str(t)  # the type's name, as program text
-                parts.append(f"({kind!r}, {self.expr(item.value)}, {label!r})")
-        self.emit(f"rt.print_items(({''.join(p + ', ' for p in parts)}), {self.at(s)})")
-
-    def s_Declared(self, s, where):
-        # A declared statement (lang/ast.py) is one runtime call with its parts' values.
-        declaration = A.DECLARED[type(s)]
-        args = []
-        for name, part in declaration.parts:
-            value = getattr(s, name)
-            args.append("(" + "".join(self.expr(v) + ", " for v in value) + ")" if part.many else self.expr(value))
-        self.emit(f"rt.{declaration.runtime}({''.join(a + ', ' for a in args)}{self.at(s)})")
-
-    def s_Stop(self, s, where):
-        # In the main program, hand the variables over so Python users see them.
-        if where == "main" and getattr(self, "scope_types", None) is None:
-            self.emit("rt.stop(_variables())" if self.chunked else "rt.stop(locals())")
-        else:
-            self.emit("rt.stop(None)")
-
-    def s_Load(self, s, where):
-        index, names = self.c.loads.get(id(s), (None, ()))
-        for name in names:
-            if name not in self.c.loaded_primitives:
-                self.emit(f"{name} = _LIB{index}.value(rt, {name!r}, {self.at(s)})")
-        if not any(n not in self.c.loaded_primitives for n in names):
-            self.emit("pass")
-
-    def s_Return(self, s, where):
-        self.emit("return _g.result()")
-
-    def s_DrawWith(self, s, where):
-        for m in s.modifiers:
-            # The canvas has one setter per DRAW WITH modifier, named by its kind.
-            self.emit(f"_g.{m.kind}({self.expr(m.arg)})")
-
-    def s_DrawPoly(self, s, where):
-        pts = "".join(self.expr(p) + ", " for p in s.points)
-        self.emit(f"rt.poly(_g, ({pts}), {self.at(s)})")
 
     # -------------------------------------------------------- expressions
     def expr(self, e) -> str:
@@ -680,14 +452,6 @@ def _in_chain(e, t, lowerer) -> bool:
         return _in_chain(e.operand, t, lowerer)
     # Only rows the table computes with Python's own operator chain; a runtime method checks itself.
     return isinstance(e, A.BinOp) and e.op in _ARITH and lowerer._operator(e).runtime is None
-
-
-def _tuple_target(names) -> str:
-    return "(" + "".join(n + ", " for n in names) + ")"
-
-
-def _tuple_value(names) -> str:
-    return "(" + "".join(n + ", " for n in names) + ")"
 
 
 def lower(checked: Checked, name: str, consume: bool = False) -> str:
