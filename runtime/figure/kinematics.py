@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from liganimate.runtime.figure import folded as _folded
+from liganimate.runtime.figure import single as _single
 from liganimate.runtime.figure import walk as _walk
 from liganimate.runtime.figure.tree import Figure
 
@@ -117,8 +118,8 @@ def invert_transform(A) -> np.ndarray:
 
 
 def _check_angles(figure: Figure, angles) -> np.ndarray:
-    a = np.asarray(angles, dtype=float)
-    if a.ndim < 2 or a.shape[-2:] != (figure.n_joints, 3):
+    a = np.asarray(angles, dtype=np.float64)
+    if a.shape[-2:] != (figure.n_joints, 3) or a.ndim < 2:
         raise ValueError(f"angles must have shape (..., {figure.n_joints}, 3) for this figure, not {a.shape}")
     return a
 
@@ -172,8 +173,10 @@ def pose_transforms(figure: Figure, angles) -> np.ndarray:
     :func:`placed_transforms` for how it is computed.
     """
     a = _check_angles(figure, angles)
+    if a.ndim == 3:
+        return placed_transforms(figure, a, None)
     lead = a.shape[:-2]
-    a = a.reshape((int(np.prod(lead)), figure.n_joints, 3))  # -1 fails when n_joints == 0
+    a = a.reshape((math.prod(lead), figure.n_joints, 3))  # -1 fails when n_joints == 0
     return placed_transforms(figure, a, None).reshape(lead + (figure.n_links, 4, 4))
 
 
@@ -192,12 +195,16 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, shape (B, n_links, 4, 4)
-        ``root @ pose`` for every link: a view of other storage, not
-        C-contiguous (``np.ascontiguousarray`` makes it so).
+        ``root @ pose`` for every link: for more than one pose a view of
+        other storage, not C-contiguous (``np.ascontiguousarray`` makes it
+        so).
 
     Notes
     -----
-    A batch of fewer than :data:`SHORT` poses is walked by
+    One pose is computed by
+    :func:`liganimate.runtime.figure.single.placed_one` (the walk below laid
+    out once per figure as a fixed list of about thirty numpy calls, the
+    same numbers bit for bit).  A batch of fewer than :data:`SHORT` poses is walked by
     :func:`liganimate.runtime.figure.walk.placed` (all joints at once, one
     product per depth level of the tree: a few dozen numpy calls whatever
     the number of joints), a longer one by
@@ -209,7 +216,10 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     is the same on every machine and for any batch size (an exact zero
     may differ in sign).
     """
-    if angles.shape[0] < SHORT:
+    B = angles.shape[0]
+    if B == 1:
+        return _single.placed_one(figure, angles, None if root is None else np.asarray(root, dtype=np.float64))
+    if B < SHORT:
         return _walk.placed(figure, angles, root)
     return _folded.placed_long(figure, angles, root)
 

@@ -25,9 +25,10 @@ in the same order.  Then, for a batch of poses:
    (``tests/runtime/figure/test_walk.py`` checks the two agree).
 
 So the number of numpy calls depends on the depth of the tree, not on the
-number of joints or frames: about forty for a humanoid, which is what a
-single pose costs, while a large batch is worked through in blocks of
-:data:`BLOCK` frames, small enough for every intermediate to stay in cache.
+number of joints or frames: about forty for a humanoid (one pose takes
+:mod:`.single`, the same arithmetic in fewer and cheaper calls), while a
+large batch is worked through in blocks of :data:`BLOCK` frames, small
+enough for every intermediate to stay in cache.
 """
 
 from __future__ import annotations

@@ -49,6 +49,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .names import DEFAULT_SOLVER, SOLVER_KEYWORDS  # the names alone live there, for the compiler and the host
+from .scalar import Kernel  # numpy only
+from .scalar import kernel as float_kernel
 
 if TYPE_CHECKING:
     # Only for annotations: importing this module loads numpy and nothing
@@ -147,6 +149,7 @@ class _Problem:
         self.base_cos, self.base_sin = np.cos(flat), np.sin(flat)
         # For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint.
         self.base_cs = model.cos_sin_base(base[0]) if base.shape[0] == 1 else None
+        self.base = base
         P = model.n_params
         V = model.n_vars
         self.lower = np.full(P, -np.inf)
@@ -708,21 +711,21 @@ _ATTEMPT = ("x", "r", "J", "f", "dist", "status", "attempt_iter", "window_f", "f
 _ONE = np.zeros(1, dtype=np.intp)
 
 
-def _attempts_of_one(prob: _Problem, x0, first, evaluate, curvature, tol, max_iter, restarts, seed) -> _State:
+def _attempts_of_one(prob: _Problem, x0, first, kern: Kernel, tol, max_iter, restarts, seed) -> _State:
     """The :class:`_State` of a batch of one that :func:`_dls_one` hands its ended attempts to.
 
     It evaluates and resets a restarted attempt as :func:`_dls_one` does
-    (``evaluate(x) -> (r, J, dist, f)`` on one problem, ``curvature(J)``),
-    so a single solve's iterates do not depend on whether it restarted.
-    ``first`` is ``evaluate(x0)``.
+    (``kern.evaluate`` on one problem, ``kern.curvature``), so a single
+    solve's iterates do not depend on whether it restarted.  ``first`` is
+    ``kern.evaluate(x0)``.
     """
 
     def batch_of_one(values):
-        return tuple(np.array([v]) if np.ndim(v) == 0 else v[None] for v in values)
+        return tuple(np.asarray(v)[None] for v in values)
 
     st = _State(
         prob,
-        x0[None].copy(),
+        np.array(x0, dtype=float)[None],
         tol,
         False,
         jac=True,
@@ -730,12 +733,12 @@ def _attempts_of_one(prob: _Problem, x0, first, evaluate, curvature, tol, max_it
         restarts=restarts,
         seed=seed,
         first=batch_of_one(first),
-        evaluate=lambda idx, x: batch_of_one(evaluate(x[0])),
+        evaluate=lambda idx, x: batch_of_one(kern.evaluate(kern.native(x[0]))),
     )
     st.solver_arrays = {"curv": np.zeros(1), "mu": np.zeros(1), "nu": np.zeros(1)}
 
     def on_restart(idx):
-        c = curvature(st.J[0])
+        c = kern.curvature(kern.native(st.J[0]))
         status, mu, nu = _first_damping(_pick, int(st.status[0]), c)
         st.put(0, status=status, curv=c, mu=mu, nu=nu)
 
@@ -754,7 +757,34 @@ def _curvature_one(J: np.ndarray) -> float:
     return float((J * J).sum(axis=0).max(initial=0.0))
 
 
-def _judged_step(now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: float, inactive, tol: float):
+def _numpy_kernel(prob: _Problem, tol: float) -> Kernel:
+    """:func:`_dls_one`'s :class:`Kernel` on numpy arrays: the one-pose kinematics and 2-D products."""
+    V, P = prob.model.n_vars, prob.model.n_params
+    M = prob.stack.n_rows
+    inactive = ~prob.stack.active[0]
+    small = M < P
+    diagonal = slice(None, None, min(M, P) + 1)  # of the flattened normal matrix
+
+    def step(x, r, J, mu):
+        dx = _held_step(x, r, J, prob.lower, prob.upper, mu, small, diagonal, V)
+        return dx, x + dx
+
+    def linear_sq(r, J, dx):
+        lin = r + J @ dx
+        return float(lin @ lin)
+
+    return Kernel(
+        evaluate=functools.partial(_evaluate_one, prob),
+        step=step,
+        curvature=_curvature_one,
+        native=np.asarray,
+        linear_sq=linear_sq,
+        norm=lambda v: math.sqrt(float(v @ v)),
+        met=lambda dist: bool(_converged(dist, inactive, tol)),
+    )
+
+
+def _judged_step(kern: Kernel, now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: float):
     """Accept the step to ``xn`` or not, update the damping, and say how the attempt stands.
 
     ``now`` is ``(x, r, J, dist, f)`` before the step and ``then`` the
@@ -763,8 +793,7 @@ def _judged_step(now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: fl
     """
     x, r, J, dist, f = now
     rn, Jn, dn, fn = then
-    lin = r + J @ dx
-    predicted = f - 0.5 * float(lin @ lin)
+    predicted = f - 0.5 * kern.linear_sq(r, J, dx)
     gain = f - fn
     accept = gain > 0 and predicted > 0
     mu, nu = _damping(_pick, mu, nu, accept, gain / predicted if accept else 0.0)
@@ -772,12 +801,12 @@ def _judged_step(now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: fl
         x, r, J, dist = xn, rn, Jn, dn
     status = _step_status(
         _pick,
-        _converged(dist, inactive, tol),
+        kern.met(dist),
         accept,
         gain,
         f,
-        math.sqrt(float(dx @ dx)),
-        math.sqrt(float(x @ x)),
+        kern.norm(dx),
+        kern.norm(x),
         _damping_spent(_pick, mu, curv),
     )
     return (x, r, J, dist, fn if accept else f), mu, nu, status
@@ -819,11 +848,12 @@ def _held_step(x, r, J, lower, upper, mu: float, small: bool, diagonal: slice, V
     return np.minimum(np.maximum(xn, lower), upper) - x
 
 
-def _next_attempt(st: _State, attempt: tuple) -> tuple[tuple, int]:
+def _next_attempt(st: _State, attempt: tuple, native: Callable) -> tuple[tuple, int]:
     """Hand an attempt that ended unconverged to the attempts' :class:`_State`: the attempt to go on with, restarts left."""
     st.put(0, **dict(zip(_ATTEMPT, attempt)))
     st.end_attempts(_ONE)
-    return tuple(st.get(0, *_ATTEMPT)), int(st.attempts_left[0])
+    values = st.get(0, *_ATTEMPT)
+    return tuple(native(v) if isinstance(v, np.ndarray) else v for v in values), int(st.attempts_left[0])
 
 
 def _dls_one(
@@ -856,14 +886,13 @@ def _dls_one(
     SolveResult
         With a batch dimension of one, as :func:`solve` returns.
     """
-    V, P = prob.model.n_vars, prob.model.n_params
-    lower, upper = prob.lower, prob.upper
+    kern = float_kernel(prob, tol, MAXSTEP) or _numpy_kernel(prob, tol)
+    V = prob.model.n_vars
     active = prob.stack.active[0]
-    inactive = ~active
-    evaluate, curvature = functools.partial(_evaluate_one, prob), _curvature_one
     x0 = x
-    r, J, dist, f = first = evaluate(x)
-    status = CONVERGED if _converged(dist, inactive, tol) else RUNNING
+    x = kern.native(x)
+    r, J, dist, f = first = kern.evaluate(x)
+    status = CONVERGED if kern.met(dist) else RUNNING
     if max_iter <= 0 and status == RUNNING:
         status = LIMIT
     history = [np.array([f])] if trace else []
@@ -872,17 +901,14 @@ def _dls_one(
     attempts_left = restarts if V else 0
     gave_up = False
     giveup_floor = float(_giveup_floor(tol, active))
-    curv = curvature(J)
+    curv = kern.curvature(J)
     status, mu, nu = _first_damping(_pick, status, curv)
     st = None  # the attempts' _State, from the first attempt that ends while restarts are in play
-    small = r.size < P
-    diagonal = slice(None, None, min(r.size, P) + 1)  # of the flattened normal matrix
 
     while status == RUNNING:
-        dx = _held_step(x, r, J, lower, upper, mu, small, diagonal, V)
-        xn = x + dx
+        dx, xn = kern.step(x, r, J, mu)
         (x, r, J, dist, f), mu, nu, status = _judged_step(
-            (x, r, J, dist, f), xn, dx, evaluate(xn), mu, nu, curv, inactive, tol
+            kern, (x, r, J, dist, f), xn, dx, kern.evaluate(xn), mu, nu, curv
         )
         iterations += 1
         attempt_iter += 1
@@ -896,13 +922,29 @@ def _dls_one(
             # An attempt ended unconverged with restarts in play (some left, or
             # some taken): _State restarts or resumes it, as for a batch.
             if st is None:
-                st = _attempts_of_one(prob, x0, first, evaluate, curvature, tol, max_iter, restarts, seed)
+                st = _attempts_of_one(prob, x0, first, kern, tol, max_iter, restarts, seed)
             attempt = (x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu)
-            attempt, attempts_left = _next_attempt(st, attempt)
+            attempt, attempts_left = _next_attempt(st, attempt, kern.native)
             x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = attempt
 
+    return _one_result(st, (x, f, dist, status, iterations), history)
+
+
+def _one_result(st: _State | None, end: tuple, history: list) -> SolveResult:
+    """:func:`_dls_one`'s result from its last attempt's ``(x, f, dist, status, iterations)``.
+
+    With restarts in play, the attempts' :class:`_State` chooses the attempt.
+    """
+    x, f, dist, status, iterations = end
     if st is None:
-        return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None], history)
+        return SolveResult(
+            np.array(x, dtype=float)[None],
+            np.array([status]),
+            np.array([iterations]),
+            np.array([f]),
+            np.array(dist, dtype=float)[None],
+            history,
+        )
     st.put(0, x=x, f=f, dist=dist, status=status, iterations=iterations)
     st.history = history
     return st.finish()

@@ -1,0 +1,142 @@
+"""One pose a call (``single.py``) gives the numbers of the short-batch walk and of the previous kinematics (issue 22).
+
+``kinematics.placed_transforms`` sends a batch of one pose to
+``single.placed_one``, which lays the walk's arithmetic out once per figure
+and runs it as a fixed list of numpy calls.  It must give the same doubles
+as ``walk.placed`` bit for bit (``array_equal``: an exact zero may come out
+as -0.0), on hinges, fixed joints, joints turning about two or three axes,
+joints with their own AXIS, slides, joints walked backwards (a figure
+re-rooted by FIGURE ... MAIN) and root transforms that scale and mirror;
+and the previous implementation's numbers, bit for bit where it summed in
+a fixed order (no AXIS, no slide), else to 1e-12.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from previous_kinematics import placed_transforms as previous
+from test_slides_axes import random_robot
+from test_walk import hinges, poses, roots
+
+from liganimate.runtime.figure import kinematics as K
+from liganimate.runtime.figure import single, walk
+from liganimate.runtime.figure.tree import Figure, Joint, Link
+
+
+def check(fig: Figure, a: np.ndarray, root) -> None:
+    got = single.placed_one(fig, a, root)
+    assert got.shape == (1, fig.n_links, 4, 4)
+    np.testing.assert_array_equal(got, walk.placed(fig, a, root))
+    want = previous(fig, a, root)
+    if fig.has_frames.any() or fig.slides.any():
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+    else:
+        np.testing.assert_array_equal(got, want)
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 12), kind=st.sampled_from(["hinges", "robot"]))
+def test_one_pose_gives_the_walks_numbers(seed, n, kind):
+    rng = np.random.default_rng(seed)
+    fig = hinges(rng, n) if kind == "hinges" else random_robot(rng, n)
+    a = poses(rng, fig, 1)
+    check(fig, a, roots(rng, 1))
+    # The same tree re-rooted at another link: other joints walked backwards.
+    other = fig.with_main(int(rng.integers(fig.n_links)))
+    check(other, poses(rng, other, 1), roots(rng, 1))
+
+
+def test_slides_and_axes_are_exercised_by_the_random_robots():
+    # The property above is only as good as its figures: make sure they hold every kind of joint.
+    rng = np.random.default_rng(0)
+    figs = [random_robot(rng, 9) for _ in range(20)]
+    assert any(f.slides.any() for f in figs)
+    assert any((f.has_frames & ~f.slides).any() for f in figs)
+    assert any(f.reversed_joints.any() for f in figs)
+
+
+def test_angles_outside_the_extremes_and_on_locked_axes_are_not_folded_away():
+    # pose_transforms does not clamp: a locked axis given an angle must turn.
+    rng = np.random.default_rng(3)
+    fig = hinges(rng, 9)
+    a = rng.uniform(-400, 400, size=(1, fig.n_joints, 3))
+    check(fig, a, None)
+    assert not np.array_equal(single.placed_one(fig, a, None), single.placed_one(fig, np.zeros_like(a), None))
+
+
+def test_placed_transforms_takes_one_pose_here_and_pose_transforms_agrees():
+    rng = np.random.default_rng(8)
+    fig = random_robot(rng, 8)
+    a = poses(rng, fig, 1)
+    np.testing.assert_array_equal(K.placed_transforms(fig, a, None), walk.placed(fig, a, None))
+    np.testing.assert_array_equal(K.pose_transforms(fig, a), walk.placed(fig, a, None))
+    np.testing.assert_array_equal(K.pose_transforms(fig, a[0])[None], walk.placed(fig, a, None))
+    # A list, a non-contiguous view and a float32 copy are all taken.
+    b = np.repeat(a, 2, axis=2)[:, :, ::2]
+    np.testing.assert_array_equal(K.pose_transforms(fig, b), walk.placed(fig, a, None))
+    np.testing.assert_array_equal(K.pose_transforms(fig, a.tolist()), walk.placed(fig, a, None))
+    f32 = a.astype(np.float32)
+    np.testing.assert_array_equal(K.pose_transforms(fig, f32), walk.placed(fig, f32.astype(np.float64), None))
+
+
+def test_each_call_returns_its_own_array():
+    rng = np.random.default_rng(4)
+    fig = hinges(rng, 6)
+    a, b = poses(rng, fig, 1), poses(rng, fig, 1)
+    x = single.placed_one(fig, a, None)
+    keep = x.copy()
+    single.placed_one(fig, b, None)
+    np.testing.assert_array_equal(x, keep)
+    x[...] = 0.0  # the caller may write into it
+    np.testing.assert_array_equal(single.placed_one(fig, a, None), keep)
+
+
+def test_no_joints_and_a_single_link():
+    lone = Figure((Link("ONLY", None),), ())
+    np.testing.assert_array_equal(single.placed_one(lone, np.zeros((1, 0, 3)), None), np.eye(4)[None, None])
+    root = np.diag([2.0, -1.0, 3.0, 1.0])[None]
+    root[0, :3, 3] = (1, 2, 3)
+    np.testing.assert_array_equal(single.placed_one(lone, np.zeros((1, 0, 3)), root), root[:, None])
+    two = Figure((Link("A", None), Link("B", None)), (Joint(1, 0, 1, (1, 0, 0), (0, 0, 0), [(-90, 90)]),))
+    for f in (two, two.with_main(1)):
+        check(f, np.array([[[30.0, 0.0, 0.0]]]), None)
+
+
+def test_threads_never_share_a_work_array():
+    rng = np.random.default_rng(6)
+    fig = random_robot(rng, 10)
+    a = poses(rng, fig, 200)
+    want = [walk.placed(fig, a[i : i + 1], None) for i in range(len(a))]
+    errors: list = []
+
+    def run(offset: int) -> None:
+        for n in range(600):
+            i = (n * 7 + offset) % len(a)
+            if not np.array_equal(single.placed_one(fig, a[i : i + 1], None), want[i]):
+                errors.append(i)
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+
+
+def test_the_library_humanoid_rooted_where_built_and_at_a_foot(tmp_path):
+    from liganimate.compiler import load_program
+    from liganimate.runtime.host import Posed
+
+    path = tmp_path / "load.lig"
+    path.write_text("LOAD 'humanoid'\n")
+    program, _ = load_program(str(path))
+    fig = program.execute("check").variables["HUMANOID"]
+    fig = fig.figure if isinstance(fig, Posed) else fig
+    rng = np.random.default_rng(12)
+    for f in (fig, fig.with_main(fig.links_named("R_FOOT")[0])):
+        for _ in range(50):
+            check(f, poses(rng, f, 1), roots(rng, 1))
