@@ -45,8 +45,7 @@ whose token needs another one declares it beside its fields.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 #: One string per distinct upper-cased name: a million ``X = 1`` lines share one "X".
 _NAMES: dict = {}
@@ -63,9 +62,11 @@ def upper_name(text: str) -> str:
     return name
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Reader:
-    """How one field's value is found among a rule's children (made by the functions below)."""
+class Reader(NamedTuple):
+    """How one field's value is found among a rule's children (made by the functions below).
+
+    A named tuple, not a dataclass: lang/ast.py makes a hundred at import, on every start.
+    """
 
     kind: str
     types: tuple[str, ...] = ()
@@ -203,8 +204,7 @@ def POS(text: str, pos: Any) -> Any:
     return pos
 
 
-@dataclass(frozen=True, slots=True)
-class Syntax:
+class Syntax(NamedTuple):
     """How one grammar rule's value is made.
 
     A node: ``cls`` called with the position (``pos``'s reader, None for the
