@@ -71,6 +71,8 @@ class Kernel:
         ``norm(v) -> |v|``.
     met : callable
         ``met(dist) -> bool``: every goal that counts within the tolerance.
+    n_active : int
+        How many goals count (weight above 0).
     """
 
     evaluate: Callable
@@ -80,6 +82,7 @@ class Kernel:
     linear_sq: Callable
     norm: Callable
     met: Callable
+    n_active: int
 
 
 # ---------------------------------------------------------------- 3x3 rotations, row-major 9-tuples
@@ -211,6 +214,9 @@ class _Walk:
     variables: tuple  # per variable: (joint, axis, primary link, location on the primary, sign, frame)
     n_links: int
     main: int
+    lower: list  # the variables' bounds (radians; the translation's infinite)
+    upper: list
+    starts: dict  # start angles (bytes) -> :func:`_joint_kinds` of them, for the last few
 
 
 def _walk_of(model) -> _Walk:
@@ -245,7 +251,9 @@ def _walk_of(model) -> _Walk:
             model.var_joint.tolist(), model.var_axis.tolist(), model.var_primary, model.var_loc1, model.sign
         )
     )
-    walk = _Walk(tuple(steps), variables, fig.n_links, fig.main)
+    pad = [math.inf] * (model.n_params - model.n_vars)
+    lower, upper = model.lower.tolist() + [-v for v in pad], model.upper.tolist() + pad
+    walk = _Walk(tuple(steps), variables, fig.n_links, fig.main, lower, upper, {})
     model.__dict__["_scalar_walk"] = walk
     return walk
 
@@ -331,11 +339,10 @@ def _axes(walk: _Walk, R: list, p: list, full: dict) -> tuple[list, list]:
 
 @dataclass(frozen=True)
 class _Goals:
-    """A single solve's point goals and placement, in floats."""
+    """A single solve's point goals (all but their targets) and placement, in floats."""
 
     links: tuple
     points: tuple  # link points (:func:`_nonzero`), link frame
-    targets: tuple  # world, 3-tuples
     weights: tuple  # each goal's row weight (square root of its normalised weight)
     moves: tuple  # per goal, per variable: whether the variable moves the goal's link
     A: tuple | None  # the placement's 3x3 (row-major), None when it is the identity
@@ -343,17 +350,20 @@ class _Goals:
     translate: bool
     length: float
     n_vars: int
+    inactive: list  # per goal, whether its weight is 0
 
 
 def _goals_of(model, stack) -> _Goals:
-    """:class:`_Goals` of a batch of one's point goals."""
+    """:class:`_Goals` of a batch of one's point goals, kept in the stack's memo (shared by its re-targeted copies)."""
+    hit = stack.memo.get("float goals")
+    if hit is not None:
+        return hit
     G = len(stack.p_link)
     w = stack.row_weight[0].tolist()
     identity = model.placement_is_identity
-    return _Goals(
+    goals = _Goals(
         tuple(stack.p_link.tolist()),
         tuple(_nonzero(v) for v in stack.p_local),
-        tuple(tuple(t) for t in stack.p_target[0].tolist()),
         tuple(w[3 * g] for g in range(G)),
         tuple(tuple(row) for row in (stack._downstream_p > 0).tolist()),
         None if identity else tuple(model.A.ravel().tolist()),
@@ -361,7 +371,10 @@ def _goals_of(model, stack) -> _Goals:
         model.translate,
         float(model.length),
         model.n_vars,
+        (~stack.active[0]).tolist(),
     )
+    stack.memo["float goals"] = goals
+    return goals
 
 
 def _apply(A: tuple, v: tuple) -> tuple:
@@ -375,14 +388,16 @@ def _apply(A: tuple, v: tuple) -> tuple:
 _ZERO3 = (0.0, 0.0, 0.0)
 
 
-def _point_rows(goals: _Goals, R: list, p: list, omega: list, pivot: list, x: list) -> tuple[list, list, list]:
-    """Residual rows, Jacobian rows and distances of the point goals (as :meth:`GoalStack.evaluate_one`)."""
+def _point_rows(
+    goals: _Goals, targets: list, R: list, p: list, omega: list, pivot: list, x: list
+) -> tuple[list, list, list]:
+    """Residual rows, Jacobian rows and distances of the point goals at ``targets`` (as :meth:`GoalStack.evaluate_one`)."""
     A, V = goals.A, goals.n_vars
     t = [v * goals.length for v in x[V:]] if goals.translate else None
     r: list = []
     J: list = []
     dist = []
-    for link, point, target, w, moves in zip(goals.links, goals.points, goals.targets, goals.weights, goals.moves):
+    for link, point, target, w, moves in zip(goals.links, goals.points, targets, goals.weights, goals.moves):
         y = _moved(R[link], p[link], point)
         world = y if A is None else _apply(A, y)
         if A is not None:
@@ -554,24 +569,36 @@ def kernel(prob, tol: float, maxstep: float) -> Kernel | None:
     if not stack._points_only or M * P > MAX_SIZE or min(M, P) > MAX_SYSTEM or M == 0 or P == 0:
         return None
     walk = _walk_of(model)
-    kinds, trig = _joint_kinds(walk, prob.base[0])
+    base = prob.base[0]
+    key = base.tobytes()
+    start = walk.starts.get(key)
+    if start is None:
+        if len(walk.starts) >= 8:
+            walk.starts.clear()
+        start = walk.starts[key] = _joint_kinds(walk, base)
+    kinds, trig = start
     goals = _goals_of(model, stack)
-    inactive = (~stack.active[0]).tolist()
-    lower, upper = prob.lower.tolist(), prob.upper.tolist()
-    V = model.n_vars
+    targets = stack.p_target[0].tolist()
+    lower, upper, V, inactive = walk.lower, walk.upper, model.n_vars, goals.inactive
 
     def evaluate(x: list) -> tuple:
         R, p, full = _frames(walk, kinds, trig, x)
         omega, pivot = _axes(walk, R, p, full)
-        r, J, dist = _point_rows(goals, R, p, omega, pivot, x)
+        r, J, dist = _point_rows(goals, targets, R, p, omega, pivot, x)
         return r, J, dist, 0.5 * _dot(r, r)
 
     return Kernel(
         evaluate=evaluate,
         step=lambda x, r, J, mu: _step(x, r, J, mu, lower, upper, V, maxstep),
         curvature=_curvature,
-        native=lambda a: a.tolist() if isinstance(a, np.ndarray) else a,
+        native=_native,
         linear_sq=_linear_sq,
         norm=lambda v: math.sqrt(_dot(v, v)),
         met=lambda dist: all([d <= tol or off for d, off in zip(dist, inactive)]),
+        n_active=inactive.count(False),
     )
+
+
+def _native(a):
+    """A numpy value as Python floats (lists)."""
+    return a.tolist() if isinstance(a, np.ndarray) else a

@@ -144,11 +144,6 @@ class _Problem:
     def __init__(self, model: IKModel, stack: GoalStack, base: np.ndarray):
         self.model = model
         self.stack = stack
-        # (1 or B, J * 3): an unbatched start pose is shared, not copied B times.
-        flat = base.reshape(base.shape[0], -1)
-        self.base_cos, self.base_sin = np.cos(flat), np.sin(flat)
-        # For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint.
-        self.base_cs = model.cos_sin_base(base[0]) if base.shape[0] == 1 else None
         self.base = base
         P = model.n_params
         V = model.n_vars
@@ -156,6 +151,24 @@ class _Problem:
         self.upper = np.full(P, np.inf)
         self.lower[:V] = model.lower
         self.upper[:V] = model.upper
+
+    # The start angles' trigonometry, made when first asked for: a single
+    # solve in floats needs neither (runtime/ik/scalar.py).
+
+    @functools.cached_property
+    def base_cos(self) -> np.ndarray:
+        """Cosines of the start angles, (1 or B, J * 3): an unbatched start pose is shared, not copied B times."""
+        return np.cos(self.base.reshape(self.base.shape[0], -1))
+
+    @functools.cached_property
+    def base_sin(self) -> np.ndarray:
+        """Sines of the start angles, as :attr:`base_cos`."""
+        return np.sin(self.base.reshape(self.base.shape[0], -1))
+
+    @functools.cached_property
+    def base_cs(self) -> np.ndarray | None:
+        """For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint."""
+        return self.model.cos_sin_base(self.base[0]) if self.base.shape[0] == 1 else None
 
     def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         V = self.model.n_vars
@@ -261,9 +274,9 @@ def _converged(dist: np.ndarray, inactive: np.ndarray, tol: float) -> np.ndarray
     return ((dist <= tol) | inactive).all(axis=-1)
 
 
-def _giveup_floor(tol: float, active: np.ndarray):
-    """The cost below which an attempt is never given up, shape (...) for ``active`` (..., n_goals)."""
-    return GIVEUP_FLOOR * 0.5 * tol * tol * np.maximum(active.sum(axis=-1), 1)
+def _giveup_floor(where, tol: float, n_active):
+    """The cost below which an attempt is never given up, for ``n_active`` goals that count (a number or (B,))."""
+    return GIVEUP_FLOOR * 0.5 * tol * tol * where(n_active > 1, n_active, 1)
 
 
 def _step_status(where, converged, accept, gain, f_old, step, size, spent=False):
@@ -481,7 +494,7 @@ class _State:
         self.gave_up = np.zeros(B, dtype=bool)  # the current attempt was given up early
         self.resumed = np.zeros(B, dtype=bool)  # the first attempt was taken up again
         self.fast_f = self.f.copy()
-        self.giveup_floor = _giveup_floor(tol, self.active_goals)
+        self.giveup_floor = _giveup_floor(np.where, tol, self.active_goals.sum(axis=-1))
         # The solver's hook to reset its own per-element state.
         self.on_restart: Callable[[np.ndarray], None] | None = None
         self.solver_arrays: dict = {}  # the solver's own per-element state, (B,) arrays, saved with an attempt
@@ -761,7 +774,8 @@ def _numpy_kernel(prob: _Problem, tol: float) -> Kernel:
     """:func:`_dls_one`'s :class:`Kernel` on numpy arrays: the one-pose kinematics and 2-D products."""
     V, P = prob.model.n_vars, prob.model.n_params
     M = prob.stack.n_rows
-    inactive = ~prob.stack.active[0]
+    active = prob.stack.active[0]
+    inactive = ~active
     small = M < P
     diagonal = slice(None, None, min(M, P) + 1)  # of the flattened normal matrix
 
@@ -781,6 +795,7 @@ def _numpy_kernel(prob: _Problem, tol: float) -> Kernel:
         linear_sq=linear_sq,
         norm=lambda v: math.sqrt(float(v @ v)),
         met=lambda dist: bool(_converged(dist, inactive, tol)),
+        n_active=int(active.sum()),
     )
 
 
@@ -888,7 +903,6 @@ def _dls_one(
     """
     kern = float_kernel(prob, tol, MAXSTEP) or _numpy_kernel(prob, tol)
     V = prob.model.n_vars
-    active = prob.stack.active[0]
     x0 = x
     x = kern.native(x)
     r, J, dist, f = first = kern.evaluate(x)
@@ -900,7 +914,7 @@ def _dls_one(
     window_f = fast_f = f
     attempts_left = restarts if V else 0
     gave_up = False
-    giveup_floor = float(_giveup_floor(tol, active))
+    giveup_floor = float(_giveup_floor(_pick, tol, kern.n_active))
     curv = kern.curvature(J)
     status, mu, nu = _first_damping(_pick, status, curv)
     st = None  # the attempts' _State, from the first attempt that ends while restarts are in play
