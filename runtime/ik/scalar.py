@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from operator import mul
+from operator import add, ge, le, mul, sub
 
 import numpy as np
 
@@ -528,20 +528,18 @@ def _step(x: list, r: list, J: list, mu: float, lower: list, upper: list, V: int
     Only a variable at a limit can be held, so while none is (most
     iterations) the step is the plain damped one.
     """
-    at_lower = [a <= lo for a, lo in zip(x, lower)]
-    at_upper = [a >= hi for a, hi in zip(x, upper)]
-    if any(at_lower) or any(at_upper):
+    if any(map(le, x, lower)) or any(map(ge, x, upper)):
         # Capping scales the held variables' zeros to zeros: hold first, then cap.
-        dx, _free = _held_damped(r, J, mu, at_lower, at_upper)
+        dx, _free = _held_damped(r, J, mu, list(map(le, x, lower)), list(map(ge, x, upper)))
     else:
         dx = _damped(J, r, mu)
-    big = max([abs(d) for d in dx[:V]], default=0.0)
+    big = max(map(abs, dx[:V]), default=0.0)
     if big > maxstep:
         scale = maxstep / big
         dx = [d * scale for d in dx]
-    xn = [min(max(a + d, lo), hi) for a, d, lo, hi in zip(x, dx, lower, upper)]
-    dx = [b - a for a, b in zip(x, xn)]
-    return dx, [a + d for a, d in zip(x, dx)]
+    xn = list(map(min, map(max, map(add, x, dx), lower), upper))
+    dx = list(map(sub, xn, x))
+    return dx, list(map(add, x, dx))
 
 
 def _curvature(J) -> float:
