@@ -430,7 +430,7 @@ class GoalStack:
         self._points_only = Q == 0 and H == 0
         self._unit_rows = B == 1 and bool(np.all(self.row_weight == 1.0))
         self._p_local_h = np.concatenate((self.p_local, np.ones((G, 1))), axis=1)[:, :, None]
-        # What other modules derive from this packing (runtime/ik/scalar.py's
+        # What other modules derive from this packing (runtime/ik/entrywise.py's
         # float goals): shared with the re-targeted copies of
         # :meth:`_with_targets`, not with the sub-batches of :meth:`take`.
         self.memo: dict = {}

@@ -48,9 +48,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .entrywise import (
+    Kernel,  # numpy only
+    batch_evaluator,
+)
+from .entrywise import kernel as float_kernel
 from .names import DEFAULT_SOLVER, SOLVER_KEYWORDS  # the names alone live there, for the compiler and the host
-from .scalar import Kernel  # numpy only
-from .scalar import kernel as float_kernel
 
 if TYPE_CHECKING:
     # Only for annotations: importing this module loads numpy and nothing
@@ -153,7 +156,7 @@ class _Problem:
         self.upper[:V] = model.upper
 
     # The start angles' trigonometry, made when first asked for: a single
-    # solve in floats needs neither (runtime/ik/scalar.py).
+    # solve in floats needs neither (runtime/ik/entrywise.py).
 
     @functools.cached_property
     def base_cos(self) -> np.ndarray:
@@ -199,8 +202,16 @@ class _Problem:
         X, omega, pivot = model.forward_one(model.cos_sin_one(x[:V], self.base_cs))
         return self.stack.evaluate_one(X, t, omega, pivot)
 
+    @functools.cached_property
+    def walked(self) -> Callable | None:
+        """The entry-by-entry evaluation of a batch (:func:`entrywise.batch_evaluator`), or None."""
+        return batch_evaluator(self)
+
     def evaluate(self, idx, stack, x, jac=True):
         """``r (B', M)``, ``J (B', M, P)`` or None, ``dist (B', n_goals)``."""
+        if self.walked is not None:
+            r, J, dist = self.walked(stack, x)
+            return r, J if jac else None, dist
         (c, s), R, p, t = self.frames(idx, x)
         if jac:
             omega, pivot = self.model.axes_trig(c, s, R, p)
@@ -218,6 +229,10 @@ class _Problem:
             The angles' cosines and sines, link frames and translation; or,
             for a handful of trials, their Jacobian already.
         """
+        if self.walked is not None:
+            # The walk gives the Jacobian for a few more array operations than the residuals.
+            r, J, dist = self.walked(stack, x)
+            return r, dist, (J,)
         (c, s), R, p, t = self.frames(idx, x)
         if len(idx) <= SMALL_BATCH:
             # Few trials are nearly all kept, and then one evaluation with

@@ -19,7 +19,7 @@ evaluation and its step from here, written in Python floats:
 
 The values are those of the numpy formulas up to rounding; the tests check
 both against each other on random trees, placements, limits and
-translation (``tests/runtime/ik/test_scalar.py``).  Bigger problems, plane
+translation (``tests/runtime/ik/test_entrywise.py``).  Bigger problems, plane
 and axis goals stay with the numpy formulas, where the arithmetic, not the
 number of calls, is the cost.
 """
@@ -43,6 +43,7 @@ MAX_SIZE = 240
 MAX_SYSTEM = 6
 
 _IDENTITY = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+_ORIGIN = (_IDENTITY, (0.0, 0.0, 0.0))  # the main link's rotation and origin
 
 
 @dataclass(frozen=True)
@@ -197,9 +198,10 @@ def _moved(R: tuple, p: tuple, v: tuple) -> tuple:
     """``p + R v`` for ``v`` given by :func:`_nonzero`."""
     px, py, pz = p
     for i, x in v:
-        px += R[i] * x
-        py += R[3 + i] * x
-        pz += R[6 + i] * x
+        # Not +=: on a batch's arrays that would write into the parent's origin.
+        px = px + R[i] * x
+        py = py + R[3 + i] * x
+        pz = pz + R[6 + i] * x
     return (px, py, pz)
 
 
@@ -258,12 +260,17 @@ def _walk_of(model) -> _Walk:
     return walk
 
 
+# How a joint's rotation is made (see _joint_kinds).
+_TURN, _FIXED, _FULL = 1, 2, 3
+
+
 def _joint_kinds(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
     """Per walk step, how its rotation is made for start angles ``base`` (n_joints, 3), and every joint's trig.
 
-    A kind is ``("turn", axis, variable)`` (one variable axis, the others at
-    zero, no frame), ``("fixed", M)`` (no variable: its rotation, once) or
-    ``("full",)``.  The trig is ``[cx, cy, cz, sx, sy, sz]`` of the start angles.
+    A kind is ``(_TURN, axis, variable)`` (one variable axis, the others at
+    zero, no frame), ``(_FIXED, M)`` (no variable: its rotation, once; None
+    when that is the identity, all angles zero and no frame) or ``(_FULL,)``.
+    The trig is ``[cx, cy, cz, sx, sy, sz]`` of the start angles.
     """
     cos, sin = np.cos(base).tolist(), np.sin(base).tolist()
     trig = [c + s for c, s in zip(cos, sin)]
@@ -272,37 +279,39 @@ def _joint_kinds(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
     for k, _parent, _child, rev, frame, _near, _far, variables in walk.steps:
         moving = [a for a in range(3) if variables[a] >= 0]
         if not moving:
-            M = _joint_rotation(trig[k], frame, rev)
-            kinds.append(None if M == _IDENTITY else ("fixed", M))
+            still = frame is None and all(zero[k])
+            kinds.append(None if still else (_FIXED, _joint_rotation(trig[k], frame, rev)))
         elif len(moving) == 1 and frame is None and all(zero[k][a] for a in range(3) if a != moving[0]):
-            kinds.append(("turn", moving[0], variables[moving[0]]))
+            kinds.append((_TURN, moving[0], variables[moving[0]]))
         else:
-            kinds.append(("full",))
+            kinds.append((_FULL,))
     return kinds, trig
 
 
-def _frames(walk: _Walk, kinds: list, trig: list, x: list) -> tuple[list, list, dict]:
-    """Every link's rotation (9-tuple) and origin (3-tuple) at variables ``x``, and the trig of the full joints."""
+def _frames(walk: _Walk, kinds: list, trig: list, cv: list, sv: list, origin: tuple) -> tuple[list, list, dict]:
+    """Every link's rotation (9-tuple) and origin (3-tuple), and the trig of the full joints.
+
+    ``cv``, ``sv`` are the variables' cosines and sines; ``origin`` the main
+    link's rotation and origin (floats, or arrays for a batch).
+    """
     R: list = [None] * walk.n_links
     p: list = [None] * walk.n_links
-    R[walk.main], p[walk.main] = _IDENTITY, (0.0, 0.0, 0.0)
+    R[walk.main], p[walk.main] = origin
     full = {}
     for (k, parent, child, rev, frame, near, far, variables), kind in zip(walk.steps, kinds):
         RP = R[parent]
         if kind is None:
             RC = RP
-        elif kind[0] == "turn":
-            th = x[kind[2]]
-            s = math.sin(th)
-            RC = _turned(RP, kind[1], math.cos(th), -s if rev else s)
-        elif kind[0] == "fixed":
+        elif kind[0] == _TURN:
+            v = kind[2]
+            RC = _turned(RP, kind[1], cv[v], -sv[v] if rev else sv[v])
+        elif kind[0] == _FIXED:
             RC = _mul(RP, kind[1])
         else:
             cs = list(trig[k])
             for a in range(3):
                 if variables[a] >= 0:
-                    th = x[variables[a]]
-                    cs[a], cs[a + 3] = math.cos(th), math.sin(th)
+                    cs[a], cs[a + 3] = cv[variables[a]], sv[variables[a]]
             full[k] = cs
             RC = _mul(RP, _joint_rotation(cs, frame, rev))
         R[child] = RC
@@ -567,20 +576,13 @@ def kernel(prob, tol: float, maxstep: float) -> Kernel | None:
     if not stack._points_only or M * P > MAX_SIZE or min(M, P) > MAX_SYSTEM or M == 0 or P == 0:
         return None
     walk = _walk_of(model)
-    base = prob.base[0]
-    key = base.tobytes()
-    start = walk.starts.get(key)
-    if start is None:
-        if len(walk.starts) >= 8:
-            walk.starts.clear()
-        start = walk.starts[key] = _joint_kinds(walk, base)
-    kinds, trig = start
+    kinds, trig = _start_of(walk, prob.base[0])
     goals = _goals_of(model, stack)
     targets = stack.p_target[0].tolist()
     lower, upper, V, inactive = walk.lower, walk.upper, model.n_vars, goals.inactive
 
     def evaluate(x: list) -> tuple:
-        R, p, full = _frames(walk, kinds, trig, x)
+        R, p, full = _frames(walk, kinds, trig, list(map(math.cos, x)), list(map(math.sin, x)), _ORIGIN)
         omega, pivot = _axes(walk, R, p, full)
         r, J, dist = _point_rows(goals, targets, R, p, omega, pivot, x)
         return r, J, dist, 0.5 * _dot(r, r)
@@ -597,6 +599,98 @@ def kernel(prob, tol: float, maxstep: float) -> Kernel | None:
     )
 
 
+def _start_of(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
+    """:func:`_joint_kinds` of start angles ``base`` (n_joints, 3), remembered on the walk for the last few."""
+    key = base.tobytes()
+    start = walk.starts.get(key)
+    if start is None:
+        if len(walk.starts) >= 8:
+            walk.starts.clear()
+        start = walk.starts[key] = _joint_kinds(walk, base)
+    return start
+
+
 def _native(a):
     """A numpy value as Python floats (lists)."""
     return a.tolist() if isinstance(a, np.ndarray) else a
+
+
+# ---------------------------------------------------------------- batches
+
+
+def batch_evaluator(prob) -> Callable | None:
+    """``evaluate(stack, x) -> (r, J, dist)`` for sub-batches of ``solvers._Problem`` ``prob``, entry by entry; or None.
+
+    The same walk as a single solve's, each entry a numpy array over the
+    batch instead of a float: a hinge costs a few dozen operations on arrays
+    of ``B`` numbers, where the 4x4 products of :meth:`IKModel.forward_trig`
+    and the gathers of :meth:`IKModel.axes_trig` cost several times more.
+    None (the numpy formulas serve) unless every goal is a point goal, the
+    batch shares one start pose and most moving joints are hinges
+    (:data:`MAX_FULL_JOINTS` others at most).
+    """
+    model, stack = prob.model, prob.stack
+    if not stack._points_only or prob.base.shape[0] != 1 or stack.n_rows == 0 or model.n_vars == 0:
+        return None
+    walk = _walk_of(model)
+    kinds, trig = _start_of(walk, prob.base[0])
+    if sum(1 for kind in kinds if kind is not None and kind[0] != _TURN) > MAX_FULL_JOINTS:
+        return None
+    goals = _goals_of(model, stack)
+    V = model.n_vars
+
+    def evaluate(stack, x: np.ndarray) -> tuple:
+        B = x.shape[0]
+        xt = np.ascontiguousarray(x.T)
+        one, zero = np.ones(B), np.zeros(B)
+        origin = ((one, zero, zero, zero, one, zero, zero, zero, one), (zero, zero, zero))
+        R, p, full = _frames(walk, kinds, trig, list(np.cos(xt[:V])), list(np.sin(xt[:V])), origin)
+        omega, pivot = _axes(walk, R, p, full)
+        return _batch_point_rows(
+            goals, stack, R, p, np.array(omega), np.array(pivot), xt[V:] if model.translate else None
+        )
+
+    return evaluate
+
+
+#: A batch walks entry by entry when at most this many moving joints are not hinges
+#: (each costs a full 3x3 product, about 80 array operations).
+MAX_FULL_JOINTS = 4
+
+
+def _batch_point_rows(goals: _Goals, stack, R: list, p: list, omega, pivot, t) -> tuple:
+    """``r (B, M)``, ``J (B, M, P)`` and ``dist (B, G)`` of the point goals for a batch.
+
+    ``omega``, ``pivot``: (V, 3, B); ``t``: the translation variables (3, B) or None.
+    """
+    B = omega.shape[2]
+    V, G = goals.n_vars, len(goals.links)
+    P = V + (3 if t is not None else 0)
+    Y = np.array([_moved(R[link], p[link], point) for link, point in zip(goals.links, goals.points)])  # (G, 3, B)
+    world = (
+        Y if goals.A is None else np.einsum("ij,gjb->gib", np.reshape(goals.A, (3, 3)), Y) + np.reshape(goals.b, (3, 1))
+    )
+    if t is not None:
+        world = world + t * goals.length
+    res = world - stack.p_target.transpose(1, 2, 0)
+    dist = np.sqrt(np.einsum("gib,gib->bg", res, res))
+    w = stack.row_weight.T.reshape(G, 3, B)[:, :1]  # (G, 1, B): a goal's rows share its weight
+    J = np.zeros((G, 3, P, B))
+    for g, moves in enumerate(goals.moves):
+        D = Y[g] - pivot  # (V, 3, B)
+        u = np.stack(
+            (
+                omega[:, 1] * D[:, 2] - omega[:, 2] * D[:, 1],
+                omega[:, 2] * D[:, 0] - omega[:, 0] * D[:, 2],
+                omega[:, 0] * D[:, 1] - omega[:, 1] * D[:, 0],
+            )
+        )  # (3, V, B)
+        if not all(moves):
+            u *= np.array(moves, dtype=float)[:, None]
+        if goals.A is not None:
+            u = np.einsum("ij,jvb->ivb", np.reshape(goals.A, (3, 3)), u)
+        J[g, :, :V] = u * w[g]
+        if t is not None:
+            J[g, :, V:] = np.eye(3)[:, :, None] * (goals.length * w[g])
+    r = (res * w).reshape(3 * G, B).T
+    return r, J.reshape(3 * G, P, B).transpose(2, 0, 1), dist
