@@ -48,6 +48,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .entrywise import (
+    Kernel,  # numpy only
+    batch_evaluator,
+)
+from .entrywise import kernel as float_kernel
 from .names import DEFAULT_SOLVER, SOLVER_KEYWORDS  # the names alone live there, for the compiler and the host
 
 if TYPE_CHECKING:
@@ -142,17 +147,31 @@ class _Problem:
     def __init__(self, model: IKModel, stack: GoalStack, base: np.ndarray):
         self.model = model
         self.stack = stack
-        # (1 or B, J * 3): an unbatched start pose is shared, not copied B times.
-        flat = base.reshape(base.shape[0], -1)
-        self.base_cos, self.base_sin = np.cos(flat), np.sin(flat)
-        # For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint.
-        self.base_cs = model.cos_sin_base(base[0]) if base.shape[0] == 1 else None
+        self.base = base
         P = model.n_params
         V = model.n_vars
         self.lower = np.full(P, -np.inf)
         self.upper = np.full(P, np.inf)
         self.lower[:V] = model.lower
         self.upper[:V] = model.upper
+
+    # The start angles' trigonometry, made when first asked for: a single
+    # solve in floats needs neither (runtime/ik/entrywise.py).
+
+    @functools.cached_property
+    def base_cos(self) -> np.ndarray:
+        """Cosines of the start angles, (1 or B, J * 3): an unbatched start pose is shared, not copied B times."""
+        return np.cos(self.base.reshape(self.base.shape[0], -1))
+
+    @functools.cached_property
+    def base_sin(self) -> np.ndarray:
+        """Sines of the start angles, as :attr:`base_cos`."""
+        return np.sin(self.base.reshape(self.base.shape[0], -1))
+
+    @functools.cached_property
+    def base_cs(self) -> np.ndarray | None:
+        """For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint."""
+        return self.model.cos_sin_base(self.base[0]) if self.base.shape[0] == 1 else None
 
     def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         V = self.model.n_vars
@@ -183,8 +202,16 @@ class _Problem:
         X, omega, pivot = model.forward_one(model.cos_sin_one(x[:V], self.base_cs))
         return self.stack.evaluate_one(X, t, omega, pivot)
 
+    @functools.cached_property
+    def walked(self) -> Callable | None:
+        """The entry-by-entry evaluation of a batch (:func:`entrywise.batch_evaluator`), or None."""
+        return batch_evaluator(self)
+
     def evaluate(self, idx, stack, x, jac=True):
         """``r (B', M)``, ``J (B', M, P)`` or None, ``dist (B', n_goals)``."""
+        if self.walked is not None:
+            r, J, dist = self.walked(stack, x)
+            return r, J if jac else None, dist
         (c, s), R, p, t = self.frames(idx, x)
         if jac:
             omega, pivot = self.model.axes_trig(c, s, R, p)
@@ -202,6 +229,10 @@ class _Problem:
             The angles' cosines and sines, link frames and translation; or,
             for a handful of trials, their Jacobian already.
         """
+        if self.walked is not None:
+            # The walk gives the Jacobian for a few more array operations than the residuals.
+            r, J, dist = self.walked(stack, x)
+            return r, dist, (J,)
         (c, s), R, p, t = self.frames(idx, x)
         if len(idx) <= SMALL_BATCH:
             # Few trials are nearly all kept, and then one evaluation with
@@ -258,9 +289,9 @@ def _converged(dist: np.ndarray, inactive: np.ndarray, tol: float) -> np.ndarray
     return ((dist <= tol) | inactive).all(axis=-1)
 
 
-def _giveup_floor(tol: float, active: np.ndarray):
-    """The cost below which an attempt is never given up, shape (...) for ``active`` (..., n_goals)."""
-    return GIVEUP_FLOOR * 0.5 * tol * tol * np.maximum(active.sum(axis=-1), 1)
+def _giveup_floor(where, tol: float, n_active):
+    """The cost below which an attempt is never given up, for ``n_active`` goals that count (a number or (B,))."""
+    return GIVEUP_FLOOR * 0.5 * tol * tol * where(n_active > 1, n_active, 1)
 
 
 def _step_status(where, converged, accept, gain, f_old, step, size, spent=False):
@@ -478,7 +509,7 @@ class _State:
         self.gave_up = np.zeros(B, dtype=bool)  # the current attempt was given up early
         self.resumed = np.zeros(B, dtype=bool)  # the first attempt was taken up again
         self.fast_f = self.f.copy()
-        self.giveup_floor = _giveup_floor(tol, self.active_goals)
+        self.giveup_floor = _giveup_floor(np.where, tol, self.active_goals.sum(axis=-1))
         # The solver's hook to reset its own per-element state.
         self.on_restart: Callable[[np.ndarray], None] | None = None
         self.solver_arrays: dict = {}  # the solver's own per-element state, (B,) arrays, saved with an attempt
@@ -708,21 +739,21 @@ _ATTEMPT = ("x", "r", "J", "f", "dist", "status", "attempt_iter", "window_f", "f
 _ONE = np.zeros(1, dtype=np.intp)
 
 
-def _attempts_of_one(prob: _Problem, x0, first, evaluate, curvature, tol, max_iter, restarts, seed) -> _State:
+def _attempts_of_one(prob: _Problem, x0, first, kern: Kernel, tol, max_iter, restarts, seed) -> _State:
     """The :class:`_State` of a batch of one that :func:`_dls_one` hands its ended attempts to.
 
     It evaluates and resets a restarted attempt as :func:`_dls_one` does
-    (``evaluate(x) -> (r, J, dist, f)`` on one problem, ``curvature(J)``),
-    so a single solve's iterates do not depend on whether it restarted.
-    ``first`` is ``evaluate(x0)``.
+    (``kern.evaluate`` on one problem, ``kern.curvature``), so a single
+    solve's iterates do not depend on whether it restarted.  ``first`` is
+    ``kern.evaluate(x0)``.
     """
 
     def batch_of_one(values):
-        return tuple(np.array([v]) if np.ndim(v) == 0 else v[None] for v in values)
+        return tuple(np.asarray(v)[None] for v in values)
 
     st = _State(
         prob,
-        x0[None].copy(),
+        np.array(x0, dtype=float)[None],
         tol,
         False,
         jac=True,
@@ -730,12 +761,12 @@ def _attempts_of_one(prob: _Problem, x0, first, evaluate, curvature, tol, max_it
         restarts=restarts,
         seed=seed,
         first=batch_of_one(first),
-        evaluate=lambda idx, x: batch_of_one(evaluate(x[0])),
+        evaluate=lambda idx, x: batch_of_one(kern.evaluate(kern.native(x[0]))),
     )
     st.solver_arrays = {"curv": np.zeros(1), "mu": np.zeros(1), "nu": np.zeros(1)}
 
     def on_restart(idx):
-        c = curvature(st.J[0])
+        c = kern.curvature(kern.native(st.J[0]))
         status, mu, nu = _first_damping(_pick, int(st.status[0]), c)
         st.put(0, status=status, curv=c, mu=mu, nu=nu)
 
@@ -754,7 +785,36 @@ def _curvature_one(J: np.ndarray) -> float:
     return float((J * J).sum(axis=0).max(initial=0.0))
 
 
-def _judged_step(now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: float, inactive, tol: float):
+def _numpy_kernel(prob: _Problem, tol: float) -> Kernel:
+    """:func:`_dls_one`'s :class:`Kernel` on numpy arrays: the one-pose kinematics and 2-D products."""
+    V, P = prob.model.n_vars, prob.model.n_params
+    M = prob.stack.n_rows
+    active = prob.stack.active[0]
+    inactive = ~active
+    small = M < P
+    diagonal = slice(None, None, min(M, P) + 1)  # of the flattened normal matrix
+
+    def step(x, r, J, mu):
+        dx = _held_step(x, r, J, prob.lower, prob.upper, mu, small, diagonal, V)
+        return dx, x + dx
+
+    def linear_sq(r, J, dx):
+        lin = r + J @ dx
+        return float(lin @ lin)
+
+    return Kernel(
+        evaluate=functools.partial(_evaluate_one, prob),
+        step=step,
+        curvature=_curvature_one,
+        native=np.asarray,
+        linear_sq=linear_sq,
+        norm=lambda v: math.sqrt(float(v @ v)),
+        met=lambda dist: bool(_converged(dist, inactive, tol)),
+        n_active=int(active.sum()),
+    )
+
+
+def _judged_step(kern: Kernel, now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: float):
     """Accept the step to ``xn`` or not, update the damping, and say how the attempt stands.
 
     ``now`` is ``(x, r, J, dist, f)`` before the step and ``then`` the
@@ -763,8 +823,7 @@ def _judged_step(now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: fl
     """
     x, r, J, dist, f = now
     rn, Jn, dn, fn = then
-    lin = r + J @ dx
-    predicted = f - 0.5 * float(lin @ lin)
+    predicted = f - 0.5 * kern.linear_sq(r, J, dx)
     gain = f - fn
     accept = gain > 0 and predicted > 0
     mu, nu = _damping(_pick, mu, nu, accept, gain / predicted if accept else 0.0)
@@ -772,12 +831,12 @@ def _judged_step(now: tuple, xn, dx, then: tuple, mu: float, nu: float, curv: fl
         x, r, J, dist = xn, rn, Jn, dn
     status = _step_status(
         _pick,
-        _converged(dist, inactive, tol),
+        kern.met(dist),
         accept,
         gain,
         f,
-        math.sqrt(float(dx @ dx)),
-        math.sqrt(float(x @ x)),
+        kern.norm(dx),
+        kern.norm(x),
         _damping_spent(_pick, mu, curv),
     )
     return (x, r, J, dist, fn if accept else f), mu, nu, status
@@ -819,11 +878,12 @@ def _held_step(x, r, J, lower, upper, mu: float, small: bool, diagonal: slice, V
     return np.minimum(np.maximum(xn, lower), upper) - x
 
 
-def _next_attempt(st: _State, attempt: tuple) -> tuple[tuple, int]:
+def _next_attempt(st: _State, attempt: tuple, native: Callable) -> tuple[tuple, int]:
     """Hand an attempt that ended unconverged to the attempts' :class:`_State`: the attempt to go on with, restarts left."""
     st.put(0, **dict(zip(_ATTEMPT, attempt)))
     st.end_attempts(_ONE)
-    return tuple(st.get(0, *_ATTEMPT)), int(st.attempts_left[0])
+    values = st.get(0, *_ATTEMPT)
+    return tuple(native(v) if isinstance(v, np.ndarray) else v for v in values), int(st.attempts_left[0])
 
 
 def _dls_one(
@@ -856,14 +916,12 @@ def _dls_one(
     SolveResult
         With a batch dimension of one, as :func:`solve` returns.
     """
-    V, P = prob.model.n_vars, prob.model.n_params
-    lower, upper = prob.lower, prob.upper
-    active = prob.stack.active[0]
-    inactive = ~active
-    evaluate, curvature = functools.partial(_evaluate_one, prob), _curvature_one
+    kern = float_kernel(prob, tol, MAXSTEP) or _numpy_kernel(prob, tol)
+    V = prob.model.n_vars
     x0 = x
-    r, J, dist, f = first = evaluate(x)
-    status = CONVERGED if _converged(dist, inactive, tol) else RUNNING
+    x = kern.native(x)
+    r, J, dist, f = first = kern.evaluate(x)
+    status = CONVERGED if kern.met(dist) else RUNNING
     if max_iter <= 0 and status == RUNNING:
         status = LIMIT
     history = [np.array([f])] if trace else []
@@ -871,18 +929,15 @@ def _dls_one(
     window_f = fast_f = f
     attempts_left = restarts if V else 0
     gave_up = False
-    giveup_floor = float(_giveup_floor(tol, active))
-    curv = curvature(J)
+    giveup_floor = float(_giveup_floor(_pick, tol, kern.n_active))
+    curv = kern.curvature(J)
     status, mu, nu = _first_damping(_pick, status, curv)
     st = None  # the attempts' _State, from the first attempt that ends while restarts are in play
-    small = r.size < P
-    diagonal = slice(None, None, min(r.size, P) + 1)  # of the flattened normal matrix
 
     while status == RUNNING:
-        dx = _held_step(x, r, J, lower, upper, mu, small, diagonal, V)
-        xn = x + dx
+        dx, xn = kern.step(x, r, J, mu)
         (x, r, J, dist, f), mu, nu, status = _judged_step(
-            (x, r, J, dist, f), xn, dx, evaluate(xn), mu, nu, curv, inactive, tol
+            kern, (x, r, J, dist, f), xn, dx, kern.evaluate(xn), mu, nu, curv
         )
         iterations += 1
         attempt_iter += 1
@@ -896,13 +951,29 @@ def _dls_one(
             # An attempt ended unconverged with restarts in play (some left, or
             # some taken): _State restarts or resumes it, as for a batch.
             if st is None:
-                st = _attempts_of_one(prob, x0, first, evaluate, curvature, tol, max_iter, restarts, seed)
+                st = _attempts_of_one(prob, x0, first, kern, tol, max_iter, restarts, seed)
             attempt = (x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu)
-            attempt, attempts_left = _next_attempt(st, attempt)
+            attempt, attempts_left = _next_attempt(st, attempt, kern.native)
             x, r, J, f, dist, status, attempt_iter, window_f, fast_f, gave_up, curv, mu, nu = attempt
 
+    return _one_result(st, (x, f, dist, status, iterations), history)
+
+
+def _one_result(st: _State | None, end: tuple, history: list) -> SolveResult:
+    """:func:`_dls_one`'s result from its last attempt's ``(x, f, dist, status, iterations)``.
+
+    With restarts in play, the attempts' :class:`_State` chooses the attempt.
+    """
+    x, f, dist, status, iterations = end
     if st is None:
-        return SolveResult(x[None], np.array([status]), np.array([iterations]), np.array([f]), dist[None], history)
+        return SolveResult(
+            np.array(x, dtype=float)[None],
+            np.array([status]),
+            np.array([iterations]),
+            np.array([f]),
+            np.array(dist, dtype=float)[None],
+            history,
+        )
     st.put(0, x=x, f=f, dist=dist, status=status, iterations=iterations)
     st.history = history
     return st.finish()

@@ -51,13 +51,13 @@ from liganimate.runtime.figure.pose import (
     morphed,
     static_triangles,
     world_transforms,
-    world_triangles,
 )
 from liganimate.runtime.files import AtomicWriter, SyncBatch, os_error_words
 from liganimate.runtime.render.camera import Camera
 from liganimate.runtime.render.framing import framing_view
 from liganimate.runtime.render.imagefiles import encode_png, write_png_bytes
 from liganimate.runtime.render.look import DEFAULT_LOOK, draw_modern, look_params
+from liganimate.runtime.render.message import Keys, Missing, Posed, Shipping, Task, pack, resolve
 from liganimate.runtime.render.options import RenderOptions, checked, executor_for
 from liganimate.runtime.render.outputs import OutputLock
 from liganimate.runtime.render.raster import Framebuffer, rasterize
@@ -178,11 +178,14 @@ class Renderer:
         self.images = 0  # images handed over so far, all scenes
         self.written = 0  # images delivered to their files so far
         self.scenes: list = []  # [scene id, images]
-        self.futures: list = []  # (future, [(scene id, image number)]), in order
+        self.futures: list = []  # (future, [(scene id, image number)], task, its shapes), in order
         self._chunk: list = []
         self._angles: dict = {}
         self._statics: dict = {}  # id(background item) -> (item, its drawing); see _background
         self.angle_frames = 0  # frames whose joint angles were evaluated (see _joint_angles)
+        self._keys = Keys()  # the worker message's shape keys (see .message)
+        self._shipping = Shipping()
+        self.resent = 0  # tasks sent again because their worker lacked a shape
         self.scene_id = None
         self.scene_total = 0
         self.progress = progress if progress is not None else (not options.quiet and sys.stderr.isatty())
@@ -312,33 +315,7 @@ class Renderer:
     def flush(self) -> None:
         if not self.pending:
             return
-        requests = []  # (image slot, tick slot, order, name, posed, tick)
-        for i, img in enumerate(self.pending):
-            for j, (tick, _camera, drawn) in enumerate(img["ticks"]):
-                for order, (name, posed) in enumerate(drawn):
-                    requests.append((i, j, order, name, posed, tick))
-        groups: dict = {}
-        for r in requests:
-            fig, motion = r[4].figure, r[4].motion
-            key = (id(fig.links), id(fig.joints), fig.main, id(motion))
-            groups.setdefault(key, []).append(r)
-        # (image, tick, object) -> its drawing; (image, tick, object, "pose") -> its pose record.
-        results: dict[tuple, tuple] = {}
-        for reqs in groups.values():
-            fig, motion = reqs[0][4].figure, reqs[0][4].motion
-            frames = np.array([r[4].frame for r in reqs])
-            placements = np.stack([np.asarray(r[4].figure.placement, dtype=np.float64) for r in reqs])
-            angles = self._joint_angles(fig, motion, frames.tolist())
-            X, local = morphed(fig, motion, frames, world_transforms(fig, angles, placements))
-            table = mesh_table(fig)
-            tris = world_triangles(table, X, local)
-            mirrored = np.linalg.det(placements[:, :3, :3]) < 0
-            morphs = morph_record(fig, motion, frames) if self._poses_fh is not None else None
-            for n, r in enumerate(reqs):
-                cull = table.closed if not mirrored[n] else np.zeros(len(table.closed), dtype=bool)
-                results[(r[0], r[1], r[2])] = (tris[n], table.shade, cull)
-                if morphs is not None:
-                    results[(r[0], r[1], r[2], "pose")] = (angles[n], X[n], fig, morphs[n])
+        results = self._pose_batch()
         for i, img in enumerate(self.pending):
             draws = [(img["background"][0], img["background"][1])]
             for j, (tick, camera, drawn) in enumerate(img["ticks"]):
@@ -350,6 +327,45 @@ class Renderer:
                         self._write_pose(img["scene"], tick, img["image"], name, fig, angles, X, morph)
             self._submit((img["scene"], img["image"]), draws)
         self.pending = []
+
+    def _pose_batch(self) -> dict:
+        """Pose the pending images' figures, per (model, motion) for all their frames at once.
+
+        Returns
+        -------
+        dict
+            (image, tick, object) -> its :class:`.message.Posed` (link
+            matrices, not triangles: the worker forms those); and, with a
+            pose record, (image, tick, object, "pose") -> what it records.
+        """
+        requests = []  # (image slot, tick slot, order, name, posed, tick)
+        for i, img in enumerate(self.pending):
+            for j, (tick, _camera, drawn) in enumerate(img["ticks"]):
+                for order, (name, posed) in enumerate(drawn):
+                    requests.append((i, j, order, name, posed, tick))
+        groups: dict = {}
+        for r in requests:
+            fig, motion = r[4].figure, r[4].motion
+            key = (id(fig.links), id(fig.joints), fig.main, id(motion))
+            groups.setdefault(key, []).append(r)
+        results: dict[tuple, tuple] = {}
+        for reqs in groups.values():
+            fig, motion = reqs[0][4].figure, reqs[0][4].motion
+            frames = np.array([r[4].frame for r in reqs])
+            placements = np.stack([np.asarray(r[4].figure.placement, dtype=np.float64) for r in reqs])
+            angles = self._joint_angles(fig, motion, frames.tolist())
+            X, local = morphed(fig, motion, frames, world_transforms(fig, angles, placements))
+            table = mesh_table(fig)
+            mirrored = np.linalg.det(placements[:, :3, :3]) < 0
+            rows, moved = _moved_rows(table, local)
+            morphs = morph_record(fig, motion, frames) if self._poses_fh is not None else None
+            for n, r in enumerate(reqs):
+                results[(r[0], r[1], r[2])] = Posed(
+                    table, X[n], bool(mirrored[n]), rows, None if moved is None else moved[n]
+                )
+                if morphs is not None:
+                    results[(r[0], r[1], r[2], "pose")] = (angles[n], X[n], fig, morphs[n])
+        return results
 
     def _joint_angles(self, fig, motion, frames: list) -> np.ndarray:
         """Clamped joint angles (T, J, 3) at ``frames``: a pose table per (model's joints, motion).
@@ -412,31 +428,42 @@ class Renderer:
         if not chunk:
             return
         names = [name for name, _ in chunk]
-        args = (self.size, [draws for _, draws in chunk], self.aa, *self._want, self.look)
+        task, shapes = pack([draws for _, draws in chunk], self._keys, (self.size, self.aa, *self._want, self.look))
         if self.pool is None and self.executor is not None:
             self.pool = self.executor
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
             self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init, initargs=(os.getpid(),))
+            task = task.shipping(self._shipping.pick(shapes, self._in_flight()))
             # The first submit forks the workers.  With SIGINT and SIGTERM blocked
             # meanwhile, a signal cannot reach a worker before it has set itself to
             # ignore them; this process receives it once the mask is restored.
             with _signals_blocked():
-                self.futures.append((self.pool.submit(draw_images, *args), names))
+                self.futures.append((self.pool.submit(draw_task, task), names, task, shapes))
                 self._worker_procs = list((getattr(self.pool, "_processes", None) or {}).values())
             return
         if self.pool is None:
-            self._deliver(names, draw_images(*args))
+            # Drawn here: every shape goes with the task (nothing is copied).
+            self._deliver(names, draw_task(task.shipping(shapes)))
             return
-        self.futures.append((self.pool.submit(draw_images, *args), names))
+        task = task.shipping(self._shipping.pick(shapes, self._in_flight()))
+        self.futures.append((self.pool.submit(draw_task, task), names, task, shapes))
         # Enough in flight to keep every worker busy, no more (memory stays flat);
         # results are taken in order as soon as they are ready.
-        limit = 2 * max(int(getattr(self.pool, "workers", 0) or self.workers), 2)
-        while self.futures and (len(self.futures) > limit or self.futures[0][0].done()):
+        while self.futures and (len(self.futures) > self._in_flight() or self.futures[0][0].done()):
             self._take()
 
+    def _in_flight(self) -> int:
+        """How many tasks may be in flight: twice the workers (at least four)."""
+        return 2 * max(int(getattr(self.pool, "workers", 0) or self.workers), 2)
+
     def _take(self) -> None:
-        future, names = self.futures.pop(0)
-        self._deliver(names, _result(future))
+        future, names, task, shapes = self.futures.pop(0)
+        images = _result(future)
+        if isinstance(images, Missing):
+            # Its worker had not been shipped a shape: again, with every shape it names.
+            self.resent += 1
+            images = _result(self.pool.submit(draw_task, task.shipping(shapes)))
+        self._deliver(names, images)
 
     def _deliver(self, names, images) -> None:
         """Write the images of one task, in order: PNG files, then frames of the movies."""
@@ -567,7 +594,7 @@ class Renderer:
         executor, self.executor = self.executor, None
         if executor is not None:
             # Not started: dropped; being drawn: waited for (their images are not written).
-            for f, _ in futures:
+            for f, *_ in futures:
                 f.cancel()
             executor.shutdown(wait=True, cancel_futures=True)
             return
@@ -643,6 +670,31 @@ def _worker_init(parent: int) -> None:
     M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
     mallopt(M_MMAP_THRESHOLD, 32 << 20)
     mallopt(M_TRIM_THRESHOLD, 256 << 20)
+
+
+def draw_task(task: Task) -> list | Missing:
+    """A worker's task: form the images' world triangles from their link matrices (:mod:`.message`), draw them.
+
+    Returns
+    -------
+    list or Missing
+        What :func:`draw_images` returns, or :class:`.message.Missing` when
+        the task names a shape this process has not been shipped.
+    """
+    draws = resolve(task)
+    if isinstance(draws, Missing):
+        return draws
+    return draw_images(task.size, draws, task.aa, task.png, task.raw, task.look)
+
+
+def _moved_rows(table, local) -> tuple:
+    """The mesh table's rows a SHAPE morph changed in any frame (bit for bit), and their triangles per frame."""
+    if local is None:
+        return None, None
+    own = np.ascontiguousarray(table.triangles).view(np.uint64)
+    changed = np.ascontiguousarray(local).view(np.uint64) != own[None]
+    rows = np.flatnonzero(changed.reshape(len(local), len(table.triangles), -1).any(axis=(0, 2)))
+    return rows, local[:, rows]
 
 
 def draw_images(size, draws_list, aa=1, png=True, raw=False, look=DEFAULT_LOOK) -> list:

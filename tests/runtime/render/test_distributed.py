@@ -8,6 +8,7 @@ processes, which can be killed.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import os
 import pathlib
 import signal
@@ -112,12 +113,12 @@ def _hook(flag: str):
     need not import this test module.
     """
 
-    def hook(fn, size, draws_list, *rest):
+    def hook(fn, task):
         try:
             fd = os.open(flag, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
         except FileExistsError:
-            return fn(size, draws_list, *rest)
-        fn(size, draws_list[: len(draws_list) // 2], *rest)
+            return fn(task)
+        fn(dataclasses.replace(task, images=task.images[: len(task.images) // 2]))
         os.write(fd, f"{os.getpid()}\n".encode())
         os.close(fd)
         time.sleep(60)  # the test kills this process meanwhile
