@@ -274,8 +274,7 @@ def _figures(task: Task, shapes: dict) -> dict:
     out = {}
     for (key, links, morphing), members in groups.items():
         table = shapes[key]
-        starts = np.array([part[1] for _, part in members])
-        X = task.matrices[starts[:, None] + np.arange(links)]
+        X = _matrices(task.matrices, [part[1] for _, part in members], links)
         local = None
         if morphing:
             local = np.broadcast_to(table.triangles, (len(members), *table.triangles.shape)).copy()
@@ -287,3 +286,11 @@ def _figures(task: Task, shapes: dict) -> dict:
         for n, (where, part) in enumerate(members):
             out[where] = (tris[n], table.shade, unculled if part[3] else table.closed)
     return out
+
+
+def _matrices(matrices: np.ndarray, starts: list, links: int) -> np.ndarray:
+    """The (n, links, 4, 4) link matrices of parts starting at ``starts``: a view when they lie end to end."""
+    first = starts[0]
+    if starts == list(range(first, first + links * len(starts), links)):
+        return matrices[first : first + links * len(starts)].reshape(len(starts), links, 4, 4)
+    return matrices[np.asarray(starts)[:, None] + np.arange(links)]
