@@ -159,7 +159,9 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     count, rounds = (24, 9) if args.quick else (64, 15)
     print(load_text())
-    print(f"scene: five humans on a ground BOX, {count} images, {SIZE[0]}x{SIZE[1]}, CPU ms an image (best of {rounds})")
+    print(
+        f"scene: five humans on a ground BOX, {count} images, {SIZE[0]}x{SIZE[1]}, CPU ms an image (best of {rounds})"
+    )
     out: dict = {"images": count, "size": f"{SIZE[0]}x{SIZE[1]}"}
     with tempfile.TemporaryDirectory() as folder:
         program = program_of(folder, count)

@@ -236,8 +236,15 @@ def _keep(shapes: dict) -> None:
         _kept_bytes[0] += size
 
 
-def resolve(task: Task) -> list | Missing:
+def resolve(task: Task, keep: bool = True) -> list | Missing:
     """A task's draws, as :func:`.frames.draw` takes them, or :class:`Missing` if a shape is not here.
+
+    Parameters
+    ----------
+    task : Task
+    keep : bool
+        Keep the shapes the task ships for later tasks (a worker); the main
+        process, drawing a task with every shape it names, keeps none.
 
     Returns
     -------
@@ -248,7 +255,8 @@ def resolve(task: Task) -> list | Missing:
     lacking = tuple(sorted(k for k in task.keys() if k not in task.shapes and k not in _kept))
     if lacking:
         return Missing(lacking)
-    _keep(task.shapes)
+    if keep:
+        _keep(task.shapes)
     shapes = {k: task.shapes[k] if k in task.shapes else _kept[k] for k in task.keys()}
     drawn = _figures(task, shapes)
     out = []
