@@ -142,7 +142,7 @@ import resource, sys
 sys.path.insert(0, {bench!r})
 import compile as bench
 from liganimate.compiler import compile_text
-from liganimate.lang.parser import build_parser
+from liganimate.lang.parser import driver
 
 def peak():
     try:
@@ -151,7 +151,7 @@ def peak():
     except (OSError, StopIteration):
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 
-build_parser()
+driver()
 text = bench.STYLES[{style!r}]({lines})
 before = peak()
 compile_text(text, "scale.lig")
@@ -210,7 +210,7 @@ def main(argv=None) -> int:
 
     with open(APPENDIX_A, encoding="utf-8") as fh:
         text = fh.read()
-    P.build_parser()
+    P.driver()
     compiled = compile_text(text, APPENDIX_A)
     stock = stock_parser()
     lexed = prepare(text, APPENDIX_A).lexed

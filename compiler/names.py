@@ -20,19 +20,19 @@ _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 @functools.lru_cache(maxsize=1)
 def reserved() -> frozenset:
     """Every upper-case word a program may not define: the grammar's keywords and the built-in functions."""
-    from liganimate.lang.parser import _driver
+    from liganimate.lang.parser import driver
 
     # BOX and its pattern's words are the built-in primitive's, not the grammar's.
-    return frozenset(_driver().scanner.tables.keywords) | frozenset(BUILTINS) | {"BOX", "HEIGHT", "DEPTH"}
+    return frozenset(driver().scanner.tables.keywords) | frozenset(BUILTINS) | {"BOX", "HEIGHT", "DEPTH"}
 
 
 @functools.lru_cache(maxsize=1)
 def _strict() -> frozenset:
-    from liganimate.lang.parser import _driver
+    from liganimate.lang.parser import driver
 
     # Words such as MOVE or GOAL are keywords only where no assignment
     # follows, so a program may still define them (docs/language.md).
-    return reserved() - frozenset(_driver().scanner.tables.contextual)
+    return reserved() - frozenset(driver().scanner.tables.contextual)
 
 
 def definable(text: str) -> bool:

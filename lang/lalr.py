@@ -6,9 +6,10 @@ correctly; but it finds each rule's callback in a dict keyed by ``Rule``
 objects, whose hash and equality are Python methods, and it calls the
 callback of every one-child ``?rule`` (``?sum: product``) only to hand the
 child back. On a program of a million short lines that loop was most of
-the parse. Here the same tables are renumbered once: a state's actions map
-a symbol to an int (a shift's next state, or ``~rule``), rules are a list,
-and a one-child ``?rule`` only changes the state on top of the stack.
+the parse. Here the tables are numbered for the loop (lang/tables.py ships
+them so): a state's actions map a symbol to an int (a shift's next state,
+or ``~rule``), rules are a list, and a one-child ``?rule`` only changes the
+state on top of the stack.
 
 The tree is the one Lark's loop builds (tests/lang/test_lexer.py checks
 this against Lark's stock contextual lexer and loop), and errors are Lark's
@@ -21,13 +22,12 @@ import functools
 from operator import itemgetter
 from typing import NamedTuple
 
-from lark import Lark
 from lark.exceptions import UnexpectedToken
 from lark.lexer import Token
 from lark.parse_tree_builder import ChildFilterLALR_NoPlaceholders, ExpandSingleChild
-from lark.parsers.lalr_analysis import Shift
 
 from .lexer import DOLLAR, NUMBER, OPERATOR, ROWS, SCAN, STRING, WORD, Scanner, Tok
+from .tables import ParserTables, callbacks
 
 
 class _Inlined(tuple):
@@ -73,7 +73,7 @@ def _inlined(callback):
 
 
 class Driver:
-    """A Lark LALR parser's tables and callbacks, renumbered for :meth:`parse`.
+    """An LALR parser's tables and callbacks, ready for :meth:`parse`.
 
     :meth:`parse` cuts the text and runs the LALR loop in one loop: a
     generator between them cost a fifth of the time. What a word or an
@@ -81,37 +81,24 @@ class Driver:
 
     Parameters
     ----------
-    lark : lark.Lark
-        A parser built with ``parser="lalr"`` and a transformer (its
-        callbacks produce the values).
+    tables : liganimate.lang.tables.ParserTables
+        The states, rules and terminals (shipped in the package, or computed
+        from a Lark parser by :func:`liganimate.lang.tables.from_lark`).
+    transformer : lark.Transformer
+        Makes the values: Lark's tree builder wraps its methods into each
+        rule's callback, as ``Lark(..., transformer=transformer)`` would.
     """
 
-    def __init__(self, lark: Lark) -> None:
-        lalr = lark.parser.parser
-        table = lalr._parse_table
-        callbacks = lalr.parser.callbacks
-        if any(isinstance(key, str) for key in callbacks):
-            raise ValueError("terminal callbacks are not supported")
-        rule_index: dict = {}
-        self.rules: list = []  # (number of symbols, the rule's name, callback or None for "keep the child")
-        self.actions: list = []  # state -> {symbol: next state, or ~rule to reduce}
-        if sorted(table.states) != list(range(len(table.states))):
-            raise ValueError("the parse table's states are not numbered 0..n-1")
-        for _state, row in sorted(table.states.items()):
-            acts = {}
-            for symbol, (action, arg) in row.items():
-                if action is Shift:
-                    acts[symbol] = arg
-                else:
-                    i = rule_index.get(arg)
-                    if i is None:
-                        i = rule_index[arg] = len(self.rules)
-                        self.rules.append(self._rule(arg, callbacks[arg]))
-                    acts[symbol] = ~i
-            self.actions.append(acts)
-        self.start = table.start_states["start"]
-        self.end = table.end_states["start"]
-        self.scanner = Scanner(lark.terminals, table.states)
+    def __init__(self, tables: ParserTables, transformer) -> None:
+        #: (number of symbols, the rule's name, callback or None for "keep the child"), by rule number.
+        self.rules: list = [
+            self._rule(r, cb) for r, cb in zip(tables.rules, callbacks(tables, transformer), strict=True)
+        ]
+        #: state -> {symbol: next state, or ~rule to reduce}
+        self.actions: list = tables.actions
+        self.start = tables.start
+        self.end = tables.end
+        self.scanner = Scanner(tables.terminals, tables.actions)
         self._chains = _Chains(self)  # see _Chains
 
     @staticmethod

@@ -187,7 +187,7 @@ _new_tok = tuple.__new__
 class Scanner:
     """Cuts text into :class:`Tok` tokens, asking the parser's state which terminal each word is.
 
-    ``states`` is the LALR table (state -> the symbols it accepts). The
+    ``states`` is the LALR table (a list: state -> the symbols it accepts). The
     loop that cuts the text is :meth:`liganimate.lang.lalr.Driver.parse`
     (scanning and parsing in one loop, as a generator between them cost a
     fifth of the time); the decisions it asks for are here: which terminal
@@ -196,13 +196,13 @@ class Scanner:
     starts no token.
     """
 
-    def __init__(self, terminals: Collection[TerminalDef], states: dict) -> None:
+    def __init__(self, terminals: Collection[TerminalDef], states: list) -> None:
         self.tables = GrammarTables(terminals)
         self.states = states
         self._accepts: dict = {}  # parser state -> frozenset of terminal names
         self._choice: dict[tuple[object, str], str] = {}  # (state, word or operator) -> token type
         #: The parser states where a primitive's clause may start (they take CLAUSE_NAME).
-        self.clause_states = frozenset(state for state, acts in states.items() if "CLAUSE_NAME" in acts)
+        self.clause_states = frozenset(state for state, acts in enumerate(states) if "CLAUSE_NAME" in acts)
 
     def accepted(self, state) -> frozenset:
         """The symbols parser state ``state`` accepts."""
@@ -277,9 +277,9 @@ class TablesOnly(Lexer):
     The one loop that scans is :meth:`liganimate.lang.lalr.Driver.parse`,
     which asks :class:`Scanner` for its decisions; a second scanning loop for
     Lark's own ``Lark.parse`` would be the same rules written twice. Lark
-    builds this class when it loads the tables (cheaply, unlike its
-    contextual lexer, which compiles a scanner per parser state), and
-    ``Lark.parse`` is refused plainly.
+    builds this class when it computes the tables from the grammar (cheaply,
+    unlike its contextual lexer, which compiles a scanner per parser state),
+    and ``Lark.parse`` is refused plainly.
     """
 
     __future_interface__ = 2

@@ -1,8 +1,8 @@
 """Parsing: one cached LALR parser, syntax errors as diagnostics.
 
 :func:`parse` turns source text into a :class:`liganimate.lang.ast.Program`.
-The Lark parser is loaded once per process from tables shipped in the
-package (:mod:`.tables`); :mod:`.lalr` runs them with the transformer inside,
+The parser's tables are loaded once per process from the package
+(:mod:`.tables`); :mod:`.lalr` runs them with the transformer inside,
 and every Lark exception becomes a
 :class:`~liganimate.lang.diagnostics.LigDiagnostics`.
 """
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import re
+from typing import TYPE_CHECKING
 
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
@@ -18,7 +19,6 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedTok
 from . import ast as A
 from . import collector, tables
 from .diagnostics import Diagnostic, LigDiagnostics
-from .incremental import Reparser
 from .lalr import Driver
 from .lexer import TablesOnly
 from .messages import did_you_mean
@@ -26,6 +26,9 @@ from .source import Source, prepare
 from .structure import group_blocks
 from .transform import ToAst
 from .vocabulary import BLOCKS, GRAPHICAL, INTEGER, MODEL, MOTION, REAL, VECTOR
+
+if TYPE_CHECKING:  # imported when a reparser is made: only the language server edits a text
+    from .incremental import Reparser
 
 #: Primitives every program knows without defining them.
 BUILTIN_PRIMITIVES = frozenset({"BOX"})
@@ -41,20 +44,31 @@ def grammar_parts() -> tuple:
 
 
 @functools.lru_cache(maxsize=1)
-def build_parser() -> Lark:
-    """The LALR parser with the AST transformer inside, once per process.
+def grammar() -> tables.ParserTables:
+    """The parser's tables (states, rules, terminals), once per process.
 
-    Its tables come from the package (lang/_tables.py, see
+    They come from the package (lang/_tables.py, see
     :mod:`liganimate.lang.tables`), never from a cache a user could write;
     when they were not made from this lig.lark, from the grammar itself.
     """
-    parts = grammar_parts()
-    return tables.load(*parts) or tables.build(*parts)
+    return tables.load() or tables.from_lark(tables.build(*grammar_parts()))
 
 
 @functools.lru_cache(maxsize=1)
-def _driver() -> Driver:
-    return Driver(build_parser())
+def build_parser() -> Lark:
+    """Lark's own parser object for lig.lark, computed from the grammar (about 0.3 s).
+
+    liganimate never parses with it (:func:`parse` runs :func:`driver`);
+    it is here for tools and tests that compare with Lark's view of the
+    grammar. Its ``parse`` is refused (see :class:`.lexer.TablesOnly`).
+    """
+    return tables.build(*grammar_parts())
+
+
+@functools.lru_cache(maxsize=1)
+def driver() -> Driver:
+    """The LALR loop over :func:`grammar`, with the syntax tree's transformer, once per process."""
+    return Driver(grammar(), ToAst())
 
 
 def parse_source(
@@ -79,7 +93,7 @@ def parse_source(
             if reparser is not None:
                 body = reparser.parse(source.lexed, names)
             else:
-                body = _driver().parse(source.lexed, names, tokens)
+                body = driver().parse(source.lexed, names, tokens)
         except UnexpectedInput as exc:
             raise LigDiagnostics([_syntax_diagnostic(exc, source)]) from None
         if reparser is None:
@@ -93,7 +107,9 @@ def parse_source(
 
 def reparser() -> Reparser:
     """A parser for the successive versions of one text (a document being edited): see :mod:`.incremental`."""
-    return Reparser(_driver(), ToAst().start)
+    from .incremental import Reparser  # only the language server edits; a command parses once
+
+    return Reparser(driver(), ToAst().start)
 
 
 def parse(text: str, filename: str = "<string>", primitives: frozenset | set = frozenset()) -> A.Program:
@@ -151,7 +167,7 @@ def _terminal_text(name: str) -> str:
     friendly = _FRIENDLY.get(name)
     if friendly is not None:
         return friendly
-    term = build_parser().get_terminal(name) if name.isidentifier() else None
+    term = grammar().terminal(name) if name.isidentifier() else None
     if term is not None and term.pattern.type == "str":
         return term.pattern.value.upper()
     if name.isalpha():

@@ -1,26 +1,32 @@
-"""The parser's tables, shipped in the package as plain data.
+"""The parser's tables, shipped in the package as plain data, in the form the parse loop runs.
 
 Building the LALR tables from ``lig.lark`` takes about 0.3 s, which every
 ``liganimate`` command would pay at start. Lark's own remedy (``cache=True``)
 pickles the tables into the temporary folder and unpickles them on the next
 start, and unpickling a file another user planted there runs their code.
-Instead the tables are generated once, by Lark's own serializer, into
-``lang/_tables.py``: a module holding nothing but literals (dicts, lists,
-strings, numbers), committed with the grammar and installed with the
-package. Loading it builds Lark objects only from classes Lark's
-deserializer allows by name.
+Instead the tables are computed once, by Lark, and written into
+``lang/_tables.py``: a module holding nothing but one JSON text (names,
+numbers, flags), committed with the grammar and installed with the package.
+
+They are written in the form :class:`liganimate.lang.lalr.Driver` runs
+(:class:`ParserTables`): the terminals, the rules, and for each state a map
+from a symbol's name to the next state (a shift or a goto) or ``~rule`` (a
+reduction). Loading them builds those maps and the rules' few Lark objects
+directly; Lark's generic deserializer, which rebuilt its own parse table and
+then had it renumbered for the loop, was most of a cold ``liganimate
+check`` beyond importing Lark itself (about 40 of 45 ms; now about 5).
 
 The module records the SHA-256 of the grammar and the Lark version it was
 made from; when either differs (the grammar was edited, or another Lark is
-installed) :func:`load` returns None and the parser is built from the
+installed) :func:`load` returns None and the tables are computed from the
 grammar instead, so editing ``lig.lark`` keeps working, only slower to start
 until the tables are regenerated with::
 
     python -m liganimate.lang.tables          # rewrite lang/_tables.py
     python -m liganimate.lang.tables --check  # exit 1 if it is stale
 
-tests/test_parser_scale.py fails while the committed tables differ from
-freshly generated ones.
+tests/lang/test_parser_scale.py fails while the committed tables differ
+from freshly generated ones.
 """
 
 from __future__ import annotations
@@ -32,17 +38,42 @@ import json
 import sys
 from importlib import resources
 from pathlib import Path
+from typing import NamedTuple
 
 import lark
 from lark import Lark
-from lark.grammar import Rule
-from lark.lexer import TerminalDef
-
-#: Stand-in for the objects the tables cannot hold (the lexer class, the
-#: transformer, the post-lexer); :func:`load` puts the real ones back.
-PLACEHOLDER = "<supplied when loading>"
+from lark.grammar import NonTerminal, Rule, RuleOptions, Terminal
+from lark.lexer import PatternRE, PatternStr, TerminalDef
+from lark.parse_tree_builder import ParseTreeBuilder
+from lark.parsers.lalr_analysis import Shift
+from lark.tree import Tree
 
 _MODULE = "_tables.py"
+
+
+class ParserTables(NamedTuple):
+    """An LALR parser's tables, numbered for :class:`liganimate.lang.lalr.Driver`'s loop.
+
+    States are numbered breadth first from the start state, taking each
+    state's transitions by symbol name, and rules by name, so that the same
+    grammar always gives the same numbers (Lark's own numbering follows set
+    order, which changes with Python's string hashing).
+    """
+
+    terminals: tuple  # lark TerminalDef, in Lark's order (the lexer's keyword decisions follow it)
+    rules: tuple  # lark Rule; the reduction code ~i names rules[i]
+    actions: list  # state -> {symbol name: next state (shift or goto), or ~rule (reduce)}
+    start: int  # the start state
+    end: int  # the state after the start rule: reaching it accepts
+
+    def terminal(self, name: str) -> TerminalDef | None:
+        """The terminal called ``name``, or None."""
+        return _terminals_by_name(self.terminals).get(name)
+
+
+@functools.lru_cache(maxsize=4)
+def _terminals_by_name(terminals: tuple) -> dict:
+    return {t.name: t for t in terminals}
 
 
 def grammar_text() -> str:
@@ -56,7 +87,7 @@ def grammar_hash(text: str | None = None) -> str:
 
 
 def options(lexer, postlex, transformer) -> dict:
-    """The Lark options of liganimate's parser (one place, for building and for loading)."""
+    """The Lark options of liganimate's parser (one place, for building and for the callbacks)."""
     return {
         "parser": "lalr",
         "lexer": lexer,
@@ -67,98 +98,150 @@ def options(lexer, postlex, transformer) -> dict:
 
 
 def build(lexer, postlex, transformer, text: str | None = None) -> Lark:
-    """Build the parser from the grammar (slow: computes the LALR tables)."""
+    """Build Lark's parser from the grammar (slow: computes the LALR tables)."""
     return Lark(grammar_text() if text is None else text, **options(lexer, postlex, transformer))
 
 
-def serialize(parser: Lark) -> dict:
-    """Lark's own serialization of ``parser``, with its Python objects replaced by :data:`PLACEHOLDER`."""
-    data, memo = parser.memo_serialize([TerminalDef, Rule])
-    data["options"] = {
-        k: (PLACEHOLDER if k in ("lexer", "postlex", "transformer") else v) for k, v in data["options"].items()
-    }
-    data["parser"]["lexer_conf"]["lexer_type"] = PLACEHOLDER
-    data["parser"]["parser"] = _canonical(data["parser"]["parser"])
-    return {"data": data, "memo": memo}
-
-
-def _canonical(table: dict) -> dict:
-    """The parse table numbered in a fixed order: symbols by name, states breadth first.
-
-    Lark numbers states and symbols in the order they come out of sets,
-    which changes with Python's string hashing from one run to the next;
-    the same grammar must give the same file. States are renumbered in the
-    order a breadth-first walk from the start state meets them, taking each
-    state's transitions by symbol name.
-    """
-    names = sorted(table["tokens"].values())
-    symbol = {name: i for i, name in enumerate(names)}
-    old_names = table["tokens"]
-    states = table["states"]
-    order: dict[int, int] = {}  # old state number -> new
-    queue = list(table["start_states"].values())
+def from_lark(parser: Lark) -> ParserTables:
+    """The tables of a Lark LALR ``parser``, numbered as :class:`ParserTables` says."""
+    table = parser.parser.parser._parse_table
+    states = table.states
+    rules = sorted(
+        {arg for row in states.values() for kind, arg in row.values() if kind is not Shift},
+        key=lambda r: (r.origin.name, r.order, [s.name for s in r.expansion]),
+    )
+    rule_index = {rule: i for i, rule in enumerate(rules)}
+    start = table.start_states["start"]
+    order = {start: 0}  # old state number -> new
+    queue = [start]
     for s in queue:
-        order.setdefault(s, len(order))
-    i = 0
-    while i < len(queue):
-        for _, (kind, arg) in sorted((old_names[t], act) for t, act in states[queue[i]].items()):
-            if kind == 0 and arg not in order:
+        for _, (kind, arg) in sorted(states[s].items()):
+            if kind is Shift and arg not in order:
                 order[arg] = len(order)
                 queue.append(arg)
-        i += 1
     for s in states:  # unreachable states would be a Lark bug; keep them, numbered last
         order.setdefault(s, len(order))
-    renumbered = {}
-    for s in sorted(states, key=order.__getitem__):
-        renumbered[order[s]] = dict(
-            sorted(
-                (symbol[old_names[t]], (kind, order[arg] if kind == 0 else arg)) for t, (kind, arg) in states[s].items()
-            )
-        )
-    return dict(
-        table,
-        tokens=dict(enumerate(names)),
-        states=renumbered,
-        start_states={k: order[v] for k, v in table["start_states"].items()},
-        end_states={k: order[v] for k, v in table["end_states"].items()},
+    actions = [
+        {
+            symbol: (order[arg] if kind is Shift else ~rule_index[arg])
+            for symbol, (kind, arg) in sorted(states[s].items())
+        }
+        for s in sorted(states, key=order.__getitem__)
+    ]
+    return ParserTables(tuple(parser.terminals), tuple(rules), actions, 0, order[table.end_states["start"]])
+
+
+def callbacks(tables: ParserTables, transformer) -> list:
+    """Each rule's callback (Lark's tree builder around ``transformer``'s method), in rule order.
+
+    The same callbacks ``Lark(..., transformer=transformer)`` makes with
+    :func:`options`.
+    """
+    for t in tables.terminals:
+        if getattr(transformer, t.name, None):
+            raise ValueError(f"terminal callbacks are not supported ({t.name})")
+    made = ParseTreeBuilder(list(tables.rules), Tree, False, False, False).create_callback(transformer)
+    return [made[rule] for rule in tables.rules]
+
+
+# ------------------------------------------------------------ the file
+
+
+def _terminal_json(t: TerminalDef) -> list:
+    p = t.pattern
+    width = getattr(p, "_width", None)  # a regular expression's (min, max) length, once Lark has measured it
+    width = list(width) if width is not None else None
+    return [t.name, p.type, p.value, sorted(p.flags), p.raw, t.priority, width]
+
+
+def _terminal(name, kind, value, flags, raw, priority, width) -> TerminalDef:
+    if kind == "str":
+        return TerminalDef(name, PatternStr(value, flags, raw), priority)
+    pattern = PatternRE(value, flags, raw)
+    if width is not None:
+        pattern._width = tuple(width)  # type: ignore[assignment] # Lark declares it None until measured
+    return TerminalDef(name, pattern, priority)
+
+
+def _rule_json(r: Rule) -> list:
+    o = r.options
+    # A symbol as its name, with "!" before a terminal whose token the tree drops, "'" before any other terminal.
+    expansion = [(("!" if getattr(s, "filter_out", False) else "'") if s.is_term else "") + s.name for s in r.expansion]
+    options_ = [o.keep_all_tokens, o.expand1, o.priority, o.template_source, list(o.empty_indices)]
+    return [r.origin.name, expansion, r.order, r.alias, options_]
+
+
+class _Symbols(dict):
+    """Each symbol spelled as :func:`_rule_json` spells it, made once (rules share their symbols)."""
+
+    def __missing__(self, spelled: str):
+        made = self[spelled] = _symbol(spelled)
+        return made
+
+
+def _symbol(spelled: str):
+    if spelled[0] == "!":
+        return Terminal(spelled[1:], True)
+    if spelled[0] == "'":
+        return Terminal(spelled[1:], False)
+    return NonTerminal(spelled)
+
+
+def _rule(symbols: _Symbols, origin, expansion, order, alias, options_) -> Rule:
+    keep_all_tokens, expand1, priority, template_source, empty = options_
+    return Rule(
+        symbols[origin],
+        [symbols[s] for s in expansion],
+        order,
+        alias,
+        RuleOptions(keep_all_tokens, expand1, priority, template_source, tuple(empty)),
     )
 
 
-def _json_lines(tables: dict) -> list:
-    """The tables as JSON text, one state or memo entry a line (a grammar change reads as a small diff).
+def _json_lines(tables: ParserTables) -> list:
+    """The tables as JSON text, one state, rule or terminal a line (a grammar change reads as a small diff).
 
-    JSON has no int keys, so the parse table's symbols and states and the
-    memo go in as lists of pairs; :func:`_from_json` turns them back.
+    A state is a flat list ``[symbol, code, symbol, code, ...]``, each
+    symbol the index of its name in ``"symbols"``.
     """
-    data = tables["data"]
-    table = data["parser"]["parser"]
-    states, tokens = table["states"], table["tokens"]
-    data["parser"]["parser"] = dict(table, states=PLACEHOLDER, tokens=PLACEHOLDER)
     dump = functools.partial(json.dumps, ensure_ascii=True, separators=(",", ":"))
-    assert list(tokens) == list(range(len(tokens))) and list(states) == list(range(len(states)))
-    lines = ['{"data":' + dump(data) + ",", '"tokens":' + dump(list(tokens.values())) + ",", '"states":[']
-    lines += [dump([[sym, kind, arg] for sym, (kind, arg) in acts.items()]) + "," for acts in states.values()]
-    lines[-1] = lines[-1][:-1]
-    lines += ["],", '"memo":[']
-    lines += [dump([k, v]) + "," for k, v in tables["memo"].items()]
-    lines[-1] = lines[-1][:-1]
-    lines += ["]}"]
+    symbols = sorted({s for row in tables.actions for s in row})
+    number = {s: i for i, s in enumerate(symbols)}
+
+    def block(key: str, rows: list) -> list:
+        out = [f'"{key}":[']
+        out += [dump(row) + "," for row in rows]
+        out[-1] = out[-1][:-1]
+        return [*out, "],"]
+
+    lines = ["{" + f'"start":{tables.start},"end":{tables.end},']
+    lines += block("terminals", [_terminal_json(t) for t in tables.terminals])
+    lines += block("rules", [_rule_json(r) for r in tables.rules])
+    lines += ['"symbols":' + dump(symbols) + ","]
+    lines += block("states", [[x for s, code in row.items() for x in (number[s], code)] for row in tables.actions])
+    lines[-1] = "]}"
     return lines
 
 
-def _from_json(text: str) -> tuple:
-    """(data, memo) for ``Lark._load_from_dict`` from the text :func:`_json_lines` wrote."""
+def _from_json(text: str) -> ParserTables:
+    """The tables from the text :func:`_json_lines` wrote."""
     raw = json.loads(text)
-    data = raw["data"]
-    table = data["parser"]["parser"]
-    table["tokens"] = dict(enumerate(raw["tokens"]))
-    table["states"] = {i: {sym: (kind, arg) for sym, kind, arg in acts} for i, acts in enumerate(raw["states"])}
-    return data, {k: v for k, v in raw["memo"]}
+    symbols = raw["symbols"]
+    name = symbols.__getitem__
+    actions = [dict(zip(map(name, row[::2]), row[1::2], strict=True)) for row in raw["states"]]
+    symbols = _Symbols()
+    return ParserTables(
+        tuple(_terminal(*t) for t in raw["terminals"]),
+        tuple(_rule(symbols, *r) for r in raw["rules"]),
+        actions,
+        raw["start"],
+        raw["end"],
+    )
 
 
-def module_text(parser: Lark, text: str | None = None) -> str:
-    """The source of ``_tables.py`` for ``parser`` built from grammar ``text``."""
-    body = "\n".join(f"    {line + chr(10)!r}" for line in _json_lines(serialize(parser)))
+def module_text(tables: ParserTables, text: str | None = None) -> str:
+    """The source of ``_tables.py`` for ``tables`` computed from grammar ``text``."""
+    body = "\n".join(f"    {line + chr(10)!r}" for line in _json_lines(tables))
     return "\n".join(
         [
             '"""LALR tables of lig.lark, generated by ``python -m liganimate.lang.tables``: do not edit.',
@@ -179,8 +262,8 @@ def module_text(parser: Lark, text: str | None = None) -> str:
     )
 
 
-def load(lexer, postlex, transformer) -> Lark | None:
-    """The parser from the shipped tables, or None when they were not made from this grammar and Lark."""
+def load() -> ParserTables | None:
+    """The shipped tables, or None when they were not made from this grammar and Lark."""
     try:
         from . import _tables
     except ImportError:
@@ -190,17 +273,14 @@ def load(lexer, postlex, transformer) -> Lark | None:
         or getattr(_tables, "LARK_VERSION", None) != lark.__version__
     ):
         return None
-    data, memo = _from_json(_tables.TABLES_JSON)
-    data["options"]["lexer"] = lexer
-    data["parser"]["lexer_conf"]["lexer_type"] = lexer
-    return Lark._load_from_dict(data, memo, postlex=postlex, transformer=transformer)
+    return _from_json(_tables.TABLES_JSON)
 
 
 def fresh_module_text() -> str:
     """What ``_tables.py`` should hold for the grammar and Lark installed now."""
     from .parser import grammar_parts
 
-    return module_text(build(*grammar_parts()))
+    return module_text(from_lark(build(*grammar_parts())))
 
 
 def main(argv=None) -> int:

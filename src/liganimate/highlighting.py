@@ -56,9 +56,9 @@ def keywords() -> tuple[str, ...]:
     it is done when a lexer first needs them, not when this module is imported.
     """
     from liganimate.lang.lexer import GrammarTables
-    from liganimate.lang.parser import build_parser
+    from liganimate.lang.parser import grammar
 
-    tables = GrammarTables(build_parser().terminals)
+    tables = GrammarTables(grammar().terminals)
     found = frozenset(tables.plain) | frozenset(tables.strong)
     return tuple(sorted(found - {*CONTROL, *TYPES, *WORD_OPERATORS}))
 

@@ -23,7 +23,7 @@ from liganimate.lang.parser import (
     _FRIENDLY,
     _describe_expected,
     _terminal_text,
-    build_parser,
+    grammar,
     parse,
 )
 
@@ -418,7 +418,7 @@ INTERNAL = ("__", "$END", "_KW", "ANON", "Token(", "\n")
 
 
 def test_every_terminal_of_the_grammar_has_a_plain_name():
-    names = [t.name for t in build_parser().terminals] + ["$END", "PRIM_NAME"]
+    names = [t.name for t in grammar().terminals] + ["$END", "PRIM_NAME"]
     assert "__ANON_0" in names  # "::=": the grammar does have anonymous terminals
     for name in names:
         text = _terminal_text(name)

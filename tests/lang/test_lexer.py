@@ -34,7 +34,7 @@ def outcome(parser, text: str):
     names = frozenset(P.BUILTIN_PRIMITIVES | source.primitive_names() | loaded)
     try:
         if parser is None:
-            return ("tree", P._driver().parse(source.lexed, names))
+            return ("tree", P.driver().parse(source.lexed, names))
         with primitives(names):
             return ("tree", parser.parse(source.lexed))
     except UnexpectedInput as exc:

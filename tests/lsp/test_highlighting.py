@@ -25,7 +25,7 @@ from pygments.lexers import get_lexer_by_name, get_lexer_for_filename
 from pygments.token import Comment, Error, Keyword, Name, Number, Operator, String
 
 from liganimate import highlighting as H
-from liganimate.lang.parser import build_parser
+from liganimate.lang import parser as P
 from liganimate.lang.vocabulary import FUNCTIONS
 from liganimate.lsp import scan
 from liganimate.lsp.completion import keyword_terminals
@@ -68,7 +68,7 @@ def test_the_corpus_is_there():
 
 
 def test_word_classes_are_the_languages():
-    grammar = set(keyword_terminals(build_parser()))
+    grammar = set(keyword_terminals(P.grammar().terminals))
     classed = set(H.CONTROL) | set(H.TYPES) | set(H.keywords()) | set(H.WORD_OPERATORS)
     assert classed == grammar
     for group in (H.CONTROL, H.TYPES, H.keywords(), H.WORD_OPERATORS):
@@ -104,7 +104,7 @@ def test_the_textmate_grammar_is_written_from_the_word_classes():
 
 def pieces(text: str) -> list:
     """``(start, end, class)`` of each keyword, number, string, comment and name, as the language server's scan cuts them."""
-    keywords = set(keyword_terminals(build_parser()))
+    keywords = set(keyword_terminals(P.grammar().terminals))
     out = []
     for t in scan.tokens(text):
         if t.kind == "word":

@@ -24,13 +24,15 @@ from __future__ import annotations
 import functools
 import os
 import re
+from collections.abc import Collection
 from dataclasses import dataclass
 
-from lark import Lark
+from lark.lexer import TerminalDef
 
 from liganimate.lang.lalr import Driver
 from liganimate.lang.lexer import END, NUMBER, OPERATOR, SCAN, STRING, WORD, GrammarTables
-from liganimate.lang.parser import BUILTIN_PRIMITIVES, build_parser
+from liganimate.lang.parser import BUILTIN_PRIMITIVES, grammar
+from liganimate.lang.parser import driver as _compiler_driver
 
 from . import scan
 
@@ -54,19 +56,18 @@ class Item:
     detail: str = ""
 
 
-@functools.lru_cache(maxsize=1)
 def _driver() -> Driver:
-    return Driver(build_parser())
+    return _compiler_driver()  # the compiler's own loop and tables
 
 
 @functools.lru_cache(maxsize=1)
 def _tables() -> GrammarTables:
-    return GrammarTables(build_parser().terminals)
+    return GrammarTables(grammar().terminals)
 
 
-def keyword_terminals(lark: Lark) -> dict:
-    """``{WORD: frozenset of the terminals it may be}`` for every keyword of the grammar."""
-    tables = GrammarTables(lark.terminals)
+def keyword_terminals(terminals: Collection[TerminalDef]) -> dict:
+    """``{WORD: frozenset of the terminals it may be}`` for every keyword of the grammar, given its ``terminals``."""
+    tables = GrammarTables(terminals)
     out: dict = {}
     for word, term in tables.plain.items():
         out.setdefault(word, set()).add(term)
@@ -79,7 +80,7 @@ def keyword_terminals(lark: Lark) -> dict:
 @functools.lru_cache(maxsize=1)
 def _words_of_terminal() -> dict:
     out: dict = {}
-    for word, terms in keyword_terminals(build_parser()).items():
+    for word, terms in keyword_terminals(grammar().terminals).items():
         for t in terms:
             out.setdefault(t, set()).add(word)
     return out

@@ -141,14 +141,14 @@ def build(doc: str, keywords: list) -> dict:
 
 def grammar_keywords() -> list:
     """The grammar's keywords, the built-in functions, the interpolation methods and the solvers: what hover explains."""
-    from liganimate.lang.parser import build_parser
+    from liganimate.lang.parser import grammar
     from liganimate.lang.vocabulary import FUNCTIONS
     from liganimate.runtime.ik.solvers import SOLVER_KEYWORDS
     from liganimate.runtime.motion.interpolation import names
 
     from .completion import keyword_terminals
 
-    words = set(keyword_terminals(build_parser()).keys())
+    words = set(keyword_terminals(grammar().terminals).keys())
     return sorted(words | set(FUNCTIONS) | set(names()) | set(SOLVER_KEYWORDS))
 
 
