@@ -1,6 +1,7 @@
 """The typed syntax tree of a LIG ANIMATE program.
 
-Every node is a small dataclass with a :class:`Pos`; names are upper-cased
+Every node is a small dataclass with a :class:`Pos` (made by
+:func:`.node_methods.node`, whose methods are written out once); names are upper-cased
 (the language is case-insensitive) and numbers are already converted. The
 tree is produced by :mod:`liganimate.lang.transform` while the LALR parser
 runs, so building it never recurses.
@@ -22,6 +23,7 @@ from dataclasses import MISSING, dataclass, field, fields
 from typing import Any, Self
 
 from . import syntax as R
+from .node_methods import node
 from .numbers import literal
 from .syntax import SYNTAX, Syntax, upper_name, value_rule
 from .vocabulary import NUMBER, Type
@@ -158,7 +160,7 @@ def token_pos(line: int, column: int, end_column: int, start: int = 0, end: int 
 NOWHERE = Pos(0, 0, 0, 0)
 
 
-@dataclass(slots=True)
+@node
 class Node:
     pos: Pos
 
@@ -167,7 +169,7 @@ class Node:
 
 
 def syntax(rule: str, pos: R.Reader | None = None, **readers: R.Reader) -> Callable[[type], type]:
-    """Declare that grammar rule ``rule`` makes the decorated node class (put it above ``@dataclass``).
+    """Declare that grammar rule ``rule`` makes the decorated node class (put it above ``@node``).
 
     Parameters
     ----------
@@ -225,7 +227,7 @@ def read(reader: R.Reader | None = None, *, binds: str | None = None, holds: boo
 def statement_fields(key: str) -> dict[type, tuple[tuple[str, Any], ...]]:
     """Each node class with fields that declare ``key`` ("binds", "holds") -> those fields and what they say, in order."""
     found: dict[type, tuple[tuple[str, Any], ...]] = {}
-    # The module's classes, not Node.__subclasses__(): @dataclass(slots=True) leaves the class it replaced behind.
+    # The module's classes, not Node.__subclasses__(): a slots dataclass leaves the class it replaced behind.
     for cls in list(globals().values()):
         if isinstance(cls, type) and issubclass(cls, Node):
             marked = tuple((f.name, f.metadata[key]) for f in fields(cls) if key in f.metadata)
@@ -237,29 +239,29 @@ def statement_fields(key: str) -> dict[type, tuple[tuple[str, Any], ...]]:
 # --------------------------------------------------------------- expressions
 
 
-@dataclass(slots=True)
+@node
 class Num(Node):
     value: int | float
     text: str
 
 
-@dataclass(slots=True)
+@node
 class Var(Node):
     name: str
 
 
-@dataclass(slots=True)
+@node
 class Call(Node):
     name: str
     args: list
 
 
-@dataclass(slots=True)
+@node
 class Tuple(Node):
     items: list
 
 
-@dataclass(slots=True)
+@node
 class BinOp(Node):
     op: str  # one of + - * / MOD
     left: Node
@@ -267,12 +269,12 @@ class BinOp(Node):
     op_pos: Pos = NOWHERE
 
 
-@dataclass(slots=True)
+@node
 class Neg(Node):
     operand: Node
 
 
-@dataclass(slots=True)
+@node
 class Modifier(Node):
     """One entry of a ``< ... >`` list."""
 
@@ -281,19 +283,19 @@ class Modifier(Node):
     axis: str | None = None
 
 
-@dataclass(slots=True)
+@node
 class Modified(Node):
     target: Node
     modifiers: list
 
 
-@dataclass(slots=True)
+@node
 class Clause(Node):
     keyword: str
     value: Node
 
 
-@dataclass(slots=True)
+@node
 class PrimCall(Node):
     name: str
     clauses: list
@@ -309,39 +311,39 @@ value_rule("joint_args", R.rest(of=Node), R.flag("SLIDE"), R.item(1))
 
 
 @syntax("joint_expr", args=R.item(0), slide=R.item(1), axis=R.item(2))
-@dataclass(slots=True)
+@node
 class JointExpr(Node):
     args: list
     slide: bool = False  # SLIDE before the extremes: a prismatic joint
     axis: Node | None = None  # AXIS (x, y, z) after them
 
 
-@dataclass(slots=True)
+@node
 class Strip(Node):
     motion: Node
     joints: list
 
 
-@dataclass(slots=True)
+@node
 class Sync(Node):
     motions: list
 
 
-@dataclass(slots=True)
+@node
 class Compare(Node):
     op: str
     left: Node
     right: Node
 
 
-@dataclass(slots=True)
+@node
 class BoolOp(Node):
     op: str  # AND / OR
     left: Node
     right: Node
 
 
-@dataclass(slots=True)
+@node
 class Not(Node):
     operand: Node
 
@@ -349,7 +351,7 @@ class Not(Node):
 # ----------------------------------------------------------------- statements
 
 
-@dataclass(slots=True)
+@node
 class Name(Node):
     """A name written in a statement (declared, assigned, animated...)."""
 
@@ -386,14 +388,14 @@ value_rule("goal_link", R.token(("NAME", "NUMBER"), {"NAME": AS_NAME, "NUMBER": 
 
 
 @syntax("declaration", type=R.token("TYPE_KW", lambda text, pos: Type(upper_name(text))))
-@dataclass(slots=True)
+@node
 class Decl(Node):
     type: str  # a vocabulary.Type
     names: list = field(metadata=read(R.rest(), binds="declares"))  # of Name
 
 
 @syntax("assignment", op=R.token("ASSIGN_OP", R.TEXT))
-@dataclass(slots=True)
+@node
 class Assign(Node):
     target: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     op: str  # = := :-
@@ -401,7 +403,7 @@ class Assign(Node):
 
 
 @syntax("keyframe", position=R.value(), method=R.value())
-@dataclass(slots=True)
+@node
 class Keyframe(Node):
     frame: Node
     position: list  # 1 vector expression or 3 numbers
@@ -409,7 +411,7 @@ class Keyframe(Node):
 
 
 @syntax("keyframe_assign", op=R.token("ASSIGN_OP", R.TEXT))
-@dataclass(slots=True)
+@node
 class KeyframeAssign(Node):
     target: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     joint: Node
@@ -419,7 +421,7 @@ class KeyframeAssign(Node):
 
 
 @syntax("do_stmt", label=R.token("NUMBER", AS_LABEL), var=R.token("NAME", AS_NAME), step=R.value())
-@dataclass(slots=True)
+@node
 class DoHeader(Node):
     """``DO label var = a, b[, step]`` before loops are grouped."""
 
@@ -431,12 +433,12 @@ class DoHeader(Node):
 
 
 @syntax("continue_stmt", label=R.token("NUMBER", AS_LABEL))
-@dataclass(slots=True)
+@node
 class Continue(Node):
     label: int
 
 
-@dataclass(slots=True)
+@node
 class Do(Node):
     """A DO loop, made from a DoHeader, the statements after it and its CONTINUE (lang/structure.py)."""
 
@@ -450,7 +452,7 @@ class Do(Node):
 
 
 @syntax("if_stmt")
-@dataclass(slots=True)
+@node
 class If(Node):
     cond: Node
     then: list = field(metadata=read(R.block(), holds=True))
@@ -458,7 +460,7 @@ class If(Node):
 
 
 @syntax("joint_stmt", args=R.item(0), slide=R.item(1), axis=R.item(2))
-@dataclass(slots=True)
+@node
 class JointStmt(Node):
     args: list
     slide: bool = False  # as in JointExpr
@@ -466,14 +468,14 @@ class JointStmt(Node):
 
 
 @syntax("model_block", joints=R.rest())
-@dataclass(slots=True)
+@node
 class ModelBlock(Node):
     name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     joints: list  # of JointStmt
 
 
 @syntax("root_track", pos=R.where(1), orientation=R.flag("ORIENTATION"))
-@dataclass(slots=True)
+@node
 class RootTrack(Node):
     """The word ROOT where a joint identifier stands: the motion's root-translation track.
 
@@ -483,7 +485,7 @@ class RootTrack(Node):
     orientation: bool = False
 
 
-@dataclass(slots=True)
+@node
 class MorphTrack(Node):
     """``SCALE LINK name`` or ``SHAPE LINK name`` where a joint identifier stands: a link's morph track."""
 
@@ -499,7 +501,7 @@ class MorphTrack(Node):
     start=R.after("POSITION"),
     keyframes=R.rest(of=Keyframe),
 )
-@dataclass(slots=True)
+@node
 class MotionJoint(Node):
     joint: Node  # RootTrack for the ROOT entry, MorphTrack for SCALE and SHAPE
     start: list | None
@@ -507,7 +509,7 @@ class MotionJoint(Node):
 
 
 @syntax("motion_table", columns=R.rest(), rows=R.token("TABLE_ROWS", R.TEXT), rows_pos=R.token("TABLE_ROWS", R.POS))
-@dataclass(slots=True)
+@node
 class MotionTable(Node):
     """``TABLE 1, 2, ROOT`` and its ``| frame x y z ...`` rows: keyframes of several tracks at once.
 
@@ -522,7 +524,7 @@ class MotionTable(Node):
 
 
 @syntax("motion_block", joints=R.rest(of=MotionJoint), tables=R.rest(of=MotionTable))
-@dataclass(slots=True)
+@node
 class MotionBlock(Node):
     name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     joints: list  # of MotionJoint
@@ -532,7 +534,7 @@ class MotionBlock(Node):
 @syntax("goal_point", kind=R.const("point"), point=R.after("AT"), target=R.after("TO"), normal=R.const(None))
 @syntax("goal_plane", kind=R.const("plane"), point=R.after("AT"), target=R.after("PLANE"), normal=R.after("NORMAL"))
 @syntax("goal_axis", kind=R.const("axis"), point=R.const(None), target=R.after("ALONG"), normal=R.after("AXIS_KW"))
-@dataclass(slots=True)
+@node
 class GoalSpec(Node):
     """Where a GOAL wants its link (the parser's part, not the tree's: :class:`Goal` copies it)."""
 
@@ -552,7 +554,7 @@ class GoalSpec(Node):
     normal=R.inner(GoalSpec, "normal"),
     weight=R.after("WEIGHT"),
 )
-@dataclass(slots=True)
+@node
 class Goal(Node):
     """One goal of a REACH block: ``kind`` is "point", "plane" or "axis"."""
 
@@ -571,7 +573,7 @@ class Goal(Node):
 @syntax("reach_solver", word=R.const("SOLVER"), value=R.token("NAME", AS_NAME))
 @syntax("reach_tolerance", word=R.const("TOLERANCE"))
 @syntax("reach_iterations", word=R.const("ITERATIONS"))
-@dataclass(slots=True)
+@node
 class Option(Node):
     """One option line of a block (REACH's MOVE JOINTS, SOLVER...): its block copies the value to a field of its own."""
 
@@ -591,7 +593,7 @@ class Option(Node):
     iterations=R.option("ITERATIONS"),
     options=R.options(),
 )
-@dataclass(slots=True)
+@node
 class ReachBlock(Node):
     name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     model: Node
@@ -611,7 +613,7 @@ class ReachBlock(Node):
 
 
 @syntax("figure_stmt", kind=R.which(("LINK", "JOINT")), link=R.after("LINK", AS_NAME), joint=R.after("JOINT"))
-@dataclass(slots=True)
+@node
 class FigureStmt(Node):
     model: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="figure"))
     kind: str | None  # None, LINK or JOINT
@@ -620,7 +622,7 @@ class FigureStmt(Node):
 
 
 @syntax("scene_block", length=R.after("LENGTH"), sameframe=R.after("SAMEFRAME"), start_pos=R.where(3))
-@dataclass(slots=True)
+@node
 class Scene(Node):
     scene_id: Node
     init: list = field(metadata=read(R.rest(until="STARTSCENE"), holds=True))
@@ -631,7 +633,7 @@ class Scene(Node):
 
 
 @syntax("animate_stmt", model=R.token("NAME", AS_NAME), repeat=R.flag("REPEAT"))
-@dataclass(slots=True)
+@node
 class Animate(Node):
     model: Name
     start: Node
@@ -641,7 +643,7 @@ class Animate(Node):
 
 
 @syntax("background_stmt", items=R.rest())
-@dataclass(slots=True)
+@node
 class Background(Node):
     items: list
 
@@ -653,7 +655,7 @@ def _dollar_name(text: str, pos: Pos) -> Name:
 
 @syntax("print_table", kind=R.const("table"), value=R.token("DOLLAR_NAME", _dollar_name))
 @syntax("print_text", kind=R.const("text"), value=R.token("STRING", R.UNQUOTE))
-@dataclass(slots=True)
+@node
 class PrintItem(Node):
     kind: str  # value, table, text
     value: object  # Node for value, Name for table, str for text
@@ -665,7 +667,7 @@ def _print_value(item: Node) -> PrintItem:
 
 
 @syntax("print_stmt", items=R.rest(convert=_print_value))
-@dataclass(slots=True)
+@node
 class Print(Node):
     items: list
 
@@ -717,7 +719,7 @@ class Declaration:
 DECLARED: dict[type, Declaration] = {}
 
 
-@dataclass(slots=True)
+@node
 class Declared(Node):
     """Base of the declared statements (compiler/rules/declared.py is the rule of them all)."""
 
@@ -754,57 +756,57 @@ def declared(
 
 
 @declared("view_point", "set_view_point")
-@dataclass(slots=True)
+@node
 class ViewPoint(Declared):
     point: Node = part(Type.VECTOR, what="a view point (x, y, z)")
 
 
 @declared("view_width", "set_view_width")
-@dataclass(slots=True)
+@node
 class ViewWidth(Declared):
     width: Node = part(*NUMBER, what="a view width")
 
 
 @declared("shoot_stmt", "shoot", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
-@dataclass(slots=True)
+@node
 class Shoot(Declared):
     pass
 
 
 # A Shoot, so that a library refuses it and an archive leaves it out as it does SHOOTSCENES.
 @declared("shoot_range", "shoot_range", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
-@dataclass(slots=True)
+@node
 class ShootRange(Shoot):
     first: Node = part(Type.INTEGER, what="the first scene to shoot")
     last: Node = part(Type.INTEGER, what="the last scene to shoot")
 
 
 @syntax("stop_stmt")
-@dataclass(slots=True)
+@node
 class Stop(Node):
     pass
 
 
 @syntax("return_stmt")
-@dataclass(slots=True)
+@node
 class Return(Node):
     pass
 
 
 @syntax("program_end")
-@dataclass(slots=True)
+@node
 class ProgramEnd(Node):
     pass
 
 
 @syntax("draw_with", pos=R.through("modifiers"), modifiers=R.value(convert=lambda mods: mods[1:-1]))
-@dataclass(slots=True)
+@node
 class DrawWith(Node):
     modifiers: list
 
 
 @syntax("draw_poly", points=R.rest())
-@dataclass(slots=True)
+@node
 class DrawPoly(Node):
     points: list
 
@@ -815,7 +817,7 @@ class DrawPoly(Node):
     library_pos=R.token("STRING", R.POS),
     names=R.token(("NAME", "PRIM_NAME"), AS_NAME, many=True),
 )
-@dataclass(slots=True)
+@node
 class Load(Node):
     library: str  # as written, without its quotes
     library_pos: Pos
@@ -823,13 +825,13 @@ class Load(Node):
 
 
 @syntax("pat_word", word=R.token("STRING", lambda text, pos: text[1:-1].strip().upper()))
-@dataclass(slots=True)
+@node
 class PatWord(Node):
     word: str
 
 
 @syntax("pat_param", name=R.token("NAME", R.UPPER))
-@dataclass(slots=True)
+@node
 class PatParam(Node):
     name: str
 
@@ -839,28 +841,28 @@ value_rule("pat_default", R.token("NAME", AS_NAME), R.value())
 
 
 @syntax("pat_optional", defaults=R.rest())
-@dataclass(slots=True)
+@node
 class PatOptional(Node):
     items: list
     defaults: list  # of (Name, expr)
 
 
 @syntax("pattern_def", name=R.token(("NAME", "PRIM_NAME"), R.UPPER))
-@dataclass(slots=True)
+@node
 class PatternDef(Node):
     name: str
     items: list
 
 
 @syntax("primitive_def", name=R.token(("NAME", "PRIM_NAME"), AS_NAME), pattern=R.find(PatternDef))
-@dataclass(slots=True)
+@node
 class PrimitiveDef(Node):
     name: Name
     body: list = field(metadata=read(R.rest(), holds=True))
     pattern: PatternDef | None = None
 
 
-@dataclass(slots=True)
+@node
 class Program(Node):
     filename: str
     source: str

@@ -430,6 +430,10 @@ class GoalStack:
         self._points_only = Q == 0 and H == 0
         self._unit_rows = B == 1 and bool(np.all(self.row_weight == 1.0))
         self._p_local_h = np.concatenate((self.p_local, np.ones((G, 1))), axis=1)[:, :, None]
+        # What other modules derive from this packing (runtime/ik/entrywise.py's
+        # float goals): shared with the re-targeted copies of
+        # :meth:`_with_targets`, not with the sub-batches of :meth:`take`.
+        self.memo: dict = {}
 
     @classmethod
     def cached(cls, model: IKModel, goals: Sequence[Goal], batch: int) -> GoalStack:
@@ -508,6 +512,7 @@ class GoalStack:
         out = object.__new__(GoalStack)
         out.__dict__.update(self.__dict__)
         out.batch = len(idx)
+        out.memo = {}
         for name in ("p_target", "q_origin", "q_normal", "h_dir", "weights", "_active_packed", "row_weight"):
             setattr(out, name, getattr(self, name)[idx])
         return out

@@ -48,9 +48,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .entrywise import (
+    Kernel,  # numpy only
+    batch_evaluator,
+)
+from .entrywise import kernel as float_kernel
 from .names import DEFAULT_SOLVER, SOLVER_KEYWORDS  # the names alone live there, for the compiler and the host
-from .scalar import Kernel  # numpy only
-from .scalar import kernel as float_kernel
 
 if TYPE_CHECKING:
     # Only for annotations: importing this module loads numpy and nothing
@@ -144,11 +147,6 @@ class _Problem:
     def __init__(self, model: IKModel, stack: GoalStack, base: np.ndarray):
         self.model = model
         self.stack = stack
-        # (1 or B, J * 3): an unbatched start pose is shared, not copied B times.
-        flat = base.reshape(base.shape[0], -1)
-        self.base_cos, self.base_sin = np.cos(flat), np.sin(flat)
-        # For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint.
-        self.base_cs = model.cos_sin_base(base[0]) if base.shape[0] == 1 else None
         self.base = base
         P = model.n_params
         V = model.n_vars
@@ -156,6 +154,24 @@ class _Problem:
         self.upper = np.full(P, np.inf)
         self.lower[:V] = model.lower
         self.upper[:V] = model.upper
+
+    # The start angles' trigonometry, made when first asked for: a single
+    # solve in floats needs neither (runtime/ik/entrywise.py).
+
+    @functools.cached_property
+    def base_cos(self) -> np.ndarray:
+        """Cosines of the start angles, (1 or B, J * 3): an unbatched start pose is shared, not copied B times."""
+        return np.cos(self.base.reshape(self.base.shape[0], -1))
+
+    @functools.cached_property
+    def base_sin(self) -> np.ndarray:
+        """Sines of the start angles, as :attr:`base_cos`."""
+        return np.sin(self.base.reshape(self.base.shape[0], -1))
+
+    @functools.cached_property
+    def base_cs(self) -> np.ndarray | None:
+        """For :meth:`one` (a batch of one): the start angles' cosines and sines laid out per joint."""
+        return self.model.cos_sin_base(self.base[0]) if self.base.shape[0] == 1 else None
 
     def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         V = self.model.n_vars
@@ -186,8 +202,16 @@ class _Problem:
         X, omega, pivot = model.forward_one(model.cos_sin_one(x[:V], self.base_cs))
         return self.stack.evaluate_one(X, t, omega, pivot)
 
+    @functools.cached_property
+    def walked(self) -> Callable | None:
+        """The entry-by-entry evaluation of a batch (:func:`entrywise.batch_evaluator`), or None."""
+        return batch_evaluator(self)
+
     def evaluate(self, idx, stack, x, jac=True):
         """``r (B', M)``, ``J (B', M, P)`` or None, ``dist (B', n_goals)``."""
+        if self.walked is not None:
+            r, J, dist = self.walked(stack, x)
+            return r, J if jac else None, dist
         (c, s), R, p, t = self.frames(idx, x)
         if jac:
             omega, pivot = self.model.axes_trig(c, s, R, p)
@@ -205,6 +229,10 @@ class _Problem:
             The angles' cosines and sines, link frames and translation; or,
             for a handful of trials, their Jacobian already.
         """
+        if self.walked is not None:
+            # The walk gives the Jacobian for a few more array operations than the residuals.
+            r, J, dist = self.walked(stack, x)
+            return r, dist, (J,)
         (c, s), R, p, t = self.frames(idx, x)
         if len(idx) <= SMALL_BATCH:
             # Few trials are nearly all kept, and then one evaluation with
@@ -261,9 +289,9 @@ def _converged(dist: np.ndarray, inactive: np.ndarray, tol: float) -> np.ndarray
     return ((dist <= tol) | inactive).all(axis=-1)
 
 
-def _giveup_floor(tol: float, active: np.ndarray):
-    """The cost below which an attempt is never given up, shape (...) for ``active`` (..., n_goals)."""
-    return GIVEUP_FLOOR * 0.5 * tol * tol * np.maximum(active.sum(axis=-1), 1)
+def _giveup_floor(where, tol: float, n_active):
+    """The cost below which an attempt is never given up, for ``n_active`` goals that count (a number or (B,))."""
+    return GIVEUP_FLOOR * 0.5 * tol * tol * where(n_active > 1, n_active, 1)
 
 
 def _step_status(where, converged, accept, gain, f_old, step, size, spent=False):
@@ -481,7 +509,7 @@ class _State:
         self.gave_up = np.zeros(B, dtype=bool)  # the current attempt was given up early
         self.resumed = np.zeros(B, dtype=bool)  # the first attempt was taken up again
         self.fast_f = self.f.copy()
-        self.giveup_floor = _giveup_floor(tol, self.active_goals)
+        self.giveup_floor = _giveup_floor(np.where, tol, self.active_goals.sum(axis=-1))
         # The solver's hook to reset its own per-element state.
         self.on_restart: Callable[[np.ndarray], None] | None = None
         self.solver_arrays: dict = {}  # the solver's own per-element state, (B,) arrays, saved with an attempt
@@ -761,7 +789,8 @@ def _numpy_kernel(prob: _Problem, tol: float) -> Kernel:
     """:func:`_dls_one`'s :class:`Kernel` on numpy arrays: the one-pose kinematics and 2-D products."""
     V, P = prob.model.n_vars, prob.model.n_params
     M = prob.stack.n_rows
-    inactive = ~prob.stack.active[0]
+    active = prob.stack.active[0]
+    inactive = ~active
     small = M < P
     diagonal = slice(None, None, min(M, P) + 1)  # of the flattened normal matrix
 
@@ -781,6 +810,7 @@ def _numpy_kernel(prob: _Problem, tol: float) -> Kernel:
         linear_sq=linear_sq,
         norm=lambda v: math.sqrt(float(v @ v)),
         met=lambda dist: bool(_converged(dist, inactive, tol)),
+        n_active=int(active.sum()),
     )
 
 
@@ -888,7 +918,6 @@ def _dls_one(
     """
     kern = float_kernel(prob, tol, MAXSTEP) or _numpy_kernel(prob, tol)
     V = prob.model.n_vars
-    active = prob.stack.active[0]
     x0 = x
     x = kern.native(x)
     r, J, dist, f = first = kern.evaluate(x)
@@ -900,7 +929,7 @@ def _dls_one(
     window_f = fast_f = f
     attempts_left = restarts if V else 0
     gave_up = False
-    giveup_floor = float(_giveup_floor(tol, active))
+    giveup_floor = float(_giveup_floor(_pick, tol, kern.n_active))
     curv = kern.curvature(J)
     status, mu, nu = _first_damping(_pick, status, curv)
     st = None  # the attempts' _State, from the first attempt that ends while restarts are in play

@@ -1,4 +1,4 @@
-"""The single solve's float path (runtime/ik/scalar.py) against the numpy formulas it replaces.
+"""The single solve's float path (runtime/ik/entrywise.py) against the numpy formulas it replaces.
 
 Small point-goal problems solved one at a time run their kinematics, goals
 and damped step in Python floats.  Each piece is checked here against the
@@ -13,8 +13,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure.tree import Figure, Joint, Link, frame_from_axis
-from liganimate.runtime.ik import scalar
+from liganimate.runtime.ik import entrywise as scalar
 from liganimate.runtime.ik import solvers as S
 from liganimate.runtime.ik.goals import GoalStack, PlaneGoal, PointGoal
 from liganimate.runtime.ik.model import IKModel
@@ -206,3 +207,106 @@ def test_which_problems_take_the_float_path():
     big_base = np.zeros((1, 90, 3))
     prob = S._Problem(big_model, GoalStack(big_model, [PointGoal(90, (0.1, 0.2, 0.3))], 1), big_base)
     assert scalar.kernel(prob, 1e-4, S.MAXSTEP) is None  # 3 rows x 90 variables: numpy's products win
+
+
+# ------------------------------------------------------------------ batches
+
+
+def no_walk(monkeypatch):
+    """Make batches take the numpy formulas (IKModel.forward_trig, axes_trig, GoalStack.evaluate)."""
+    monkeypatch.setattr(S, "batch_evaluator", lambda prob: None)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_batch_walk_equals_the_numpy_evaluation(seed, monkeypatch):
+    """Random trees (hinges, ball joints, AXIS frames, start poses off zero), placements, translation,
+    batched targets and weights (some zero): residuals, Jacobian and distances agree to 1e-11."""
+    rng = np.random.default_rng(300 + seed)
+    fig = random_figure(rng, int(rng.integers(2, 8)))
+    B = int(rng.integers(1, 7))
+    link = lambda: int(rng.integers(fig.n_links))  # noqa: E731
+    goals = [PointGoal(link(), rng.normal(size=(B, 3)), point=rng.normal(size=3), weight=2.0)]
+    if seed % 3 == 0:
+        goals.append(PointGoal(link(), rng.normal(size=(B, 3)), weight=rng.choice([0.0, 0.5, 3.0], size=B)))
+    model = IKModel(fig, rng.uniform(size=(fig.n_joints, 3)) < 0.8, translate=seed % 4 == 1)
+    stack = GoalStack(model, goals, B)
+    base = np.deg2rad(rng.uniform(fig.extremes[..., 0], fig.extremes[..., 1]))[None]
+    if seed % 2 == 0:
+        base = np.where(rng.uniform(size=base.shape) < 0.8, 0.0, base)
+    prob = S._Problem(model, stack, base)
+    if model.n_vars == 0:
+        return
+    walked = prob.walked
+    if walked is None:  # too many ball joints for the walk: nothing to compare
+        assert (
+            sum(k is not None and k[0] != scalar._TURN for k in scalar._start_of(scalar._walk_of(model), base[0])[0])
+            > scalar.MAX_FULL_JOINTS
+        )
+        return
+    lo = np.where(np.isfinite(prob.lower), prob.lower, -3.0)
+    hi = np.where(np.isfinite(prob.upper), prob.upper, 3.0)
+    x = rng.uniform(lo, hi, size=(B, model.n_params))
+    idx = np.arange(B)
+    a = prob.evaluate(idx, stack, x)
+    prob.__dict__["walked"] = None
+    b = prob.evaluate(idx, stack, x)
+    for got, want in zip(a, b):
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-11)
+    sub = np.array([0, B - 1]) if B > 1 else idx  # a sub-batch, as the loops take when some have stopped
+    prob.__dict__["walked"] = walked
+    a = prob.evaluate(sub, stack.take(sub), x[sub])
+    np.testing.assert_allclose(a[0], b[0][sub], rtol=0, atol=1e-11)
+
+
+@pytest.mark.parametrize("method", ["dls", "transpose", "ccd"])
+def test_batched_solves_with_the_walk_end_where_the_numpy_ones_end(method, monkeypatch):
+    """Batches on random chains (limits, reachable and unreachable targets, restarts, translation):
+    the same status per element, and where the goal is met the same iterations and angles to 1e-9 radian."""
+    rng = np.random.default_rng(400)
+    for case in range(4):
+        fig = chain_of(rng, int(rng.integers(3, 9)))
+        end = fig.n_links - 1
+        poses = rng.uniform(fig.extremes[..., 0], fig.extremes[..., 1], size=(40, fig.n_joints, 3))
+        targets = K.pose_transforms(fig, poses)[:, end, :3, 3]  # reachable: where random poses put the tip
+        targets[::5] *= 6.0  # out of reach
+        goals = [PointGoal(end, targets)]
+        opts = dict(tolerance=1e-4, restarts=case % 3, translate=case == 3, solver=method)
+        if method != "dls":
+            opts["max_iterations"] = 40
+        a = solve_pose(fig, goals, **opts)
+        with monkeypatch.context() as m:
+            no_walk(m)
+            b = solve_pose(fig, goals, **opts)
+        np.testing.assert_array_equal(a.status, b.status)
+        met = a.converged
+        assert met.sum() >= (20 if method == "dls" else 0)  # the others take thousands of iterations
+        np.testing.assert_array_equal(a.iterations[met], b.iterations[met])
+        np.testing.assert_allclose(np.deg2rad(a.angles[met]), np.deg2rad(b.angles[met]), rtol=0, atol=1e-9)
+        np.testing.assert_allclose(a.translation[met], b.translation[met], rtol=0, atol=1e-9)
+        # Out of reach, a solve creeps along its limits by steps of a hair for
+        # hundreds of iterations, and the iteration at which the progress
+        # window sees it stall is decided by the last digits: the pose and the
+        # distance left agree, the iteration count may not.
+        np.testing.assert_allclose(a.residuals, b.residuals, rtol=1e-7, atol=1e-9)
+        np.testing.assert_allclose(np.deg2rad(a.angles), np.deg2rad(b.angles), rtol=0, atol=1e-5)
+
+
+def test_which_batches_take_the_walk():
+    rng = np.random.default_rng(8)
+    fig = chain_of(rng, 6)
+    model = IKModel(fig, np.ones((6, 3), dtype=bool))
+    targets = rng.normal(size=(4, 3))
+
+    def walked(goals, base=None, model=model):
+        base = np.zeros((1, 6, 3)) if base is None else base
+        return S._Problem(model, GoalStack(model, goals, 4), base).walked is not None
+
+    assert walked([PointGoal(6, targets)])
+    assert not walked([PointGoal(6, targets), PlaneGoal(2, (0, 0, 0), (0, 1, 0))])  # only point goals
+    assert not walked([PointGoal(6, targets)], base=np.zeros((4, 6, 3)))  # one start pose for the batch
+    balls = Figure(
+        tuple(Link(f"B{i}", None) for i in range(7)),
+        tuple(Joint(i + 1, i, i + 1, (0, 0.2, 0), (0, 0, 0), [(-90, 90)] * 3) for i in range(6)),
+    )
+    ball_model = IKModel(balls, np.ones((6, 3), dtype=bool))
+    assert not walked([PointGoal(6, targets)], model=ball_model)  # six ball joints: numpy's 4x4 products win

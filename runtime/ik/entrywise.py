@@ -19,7 +19,7 @@ evaluation and its step from here, written in Python floats:
 
 The values are those of the numpy formulas up to rounding; the tests check
 both against each other on random trees, placements, limits and
-translation (``tests/runtime/ik/test_scalar.py``).  Bigger problems, plane
+translation (``tests/runtime/ik/test_entrywise.py``).  Bigger problems, plane
 and axis goals stay with the numpy formulas, where the arithmetic, not the
 number of calls, is the cost.
 """
@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from operator import mul
+from operator import add, ge, le, mul, sub
 
 import numpy as np
 
@@ -43,6 +43,7 @@ MAX_SIZE = 240
 MAX_SYSTEM = 6
 
 _IDENTITY = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+_ORIGIN = (_IDENTITY, (0.0, 0.0, 0.0))  # the main link's rotation and origin
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,8 @@ class Kernel:
         ``norm(v) -> |v|``.
     met : callable
         ``met(dist) -> bool``: every goal that counts within the tolerance.
+    n_active : int
+        How many goals count (weight above 0).
     """
 
     evaluate: Callable
@@ -80,6 +83,7 @@ class Kernel:
     linear_sq: Callable
     norm: Callable
     met: Callable
+    n_active: int
 
 
 # ---------------------------------------------------------------- 3x3 rotations, row-major 9-tuples
@@ -194,9 +198,10 @@ def _moved(R: tuple, p: tuple, v: tuple) -> tuple:
     """``p + R v`` for ``v`` given by :func:`_nonzero`."""
     px, py, pz = p
     for i, x in v:
-        px += R[i] * x
-        py += R[3 + i] * x
-        pz += R[6 + i] * x
+        # Not +=: on a batch's arrays that would write into the parent's origin.
+        px = px + R[i] * x
+        py = py + R[3 + i] * x
+        pz = pz + R[6 + i] * x
     return (px, py, pz)
 
 
@@ -211,6 +216,9 @@ class _Walk:
     variables: tuple  # per variable: (joint, axis, primary link, location on the primary, sign, frame)
     n_links: int
     main: int
+    lower: list  # the variables' bounds (radians; the translation's infinite)
+    upper: list
+    starts: dict  # start angles (bytes) -> :func:`_joint_kinds` of them, for the last few
 
 
 def _walk_of(model) -> _Walk:
@@ -245,17 +253,24 @@ def _walk_of(model) -> _Walk:
             model.var_joint.tolist(), model.var_axis.tolist(), model.var_primary, model.var_loc1, model.sign
         )
     )
-    walk = _Walk(tuple(steps), variables, fig.n_links, fig.main)
+    pad = [math.inf] * (model.n_params - model.n_vars)
+    lower, upper = model.lower.tolist() + [-v for v in pad], model.upper.tolist() + pad
+    walk = _Walk(tuple(steps), variables, fig.n_links, fig.main, lower, upper, {})
     model.__dict__["_scalar_walk"] = walk
     return walk
+
+
+# How a joint's rotation is made (see _joint_kinds).
+_TURN, _FIXED, _FULL = 1, 2, 3
 
 
 def _joint_kinds(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
     """Per walk step, how its rotation is made for start angles ``base`` (n_joints, 3), and every joint's trig.
 
-    A kind is ``("turn", axis, variable)`` (one variable axis, the others at
-    zero, no frame), ``("fixed", M)`` (no variable: its rotation, once) or
-    ``("full",)``.  The trig is ``[cx, cy, cz, sx, sy, sz]`` of the start angles.
+    A kind is ``(_TURN, axis, variable)`` (one variable axis, the others at
+    zero, no frame), ``(_FIXED, M)`` (no variable: its rotation, once; None
+    when that is the identity, all angles zero and no frame) or ``(_FULL,)``.
+    The trig is ``[cx, cy, cz, sx, sy, sz]`` of the start angles.
     """
     cos, sin = np.cos(base).tolist(), np.sin(base).tolist()
     trig = [c + s for c, s in zip(cos, sin)]
@@ -264,37 +279,39 @@ def _joint_kinds(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
     for k, _parent, _child, rev, frame, _near, _far, variables in walk.steps:
         moving = [a for a in range(3) if variables[a] >= 0]
         if not moving:
-            M = _joint_rotation(trig[k], frame, rev)
-            kinds.append(None if M == _IDENTITY else ("fixed", M))
+            still = frame is None and all(zero[k])
+            kinds.append(None if still else (_FIXED, _joint_rotation(trig[k], frame, rev)))
         elif len(moving) == 1 and frame is None and all(zero[k][a] for a in range(3) if a != moving[0]):
-            kinds.append(("turn", moving[0], variables[moving[0]]))
+            kinds.append((_TURN, moving[0], variables[moving[0]]))
         else:
-            kinds.append(("full",))
+            kinds.append((_FULL,))
     return kinds, trig
 
 
-def _frames(walk: _Walk, kinds: list, trig: list, x: list) -> tuple[list, list, dict]:
-    """Every link's rotation (9-tuple) and origin (3-tuple) at variables ``x``, and the trig of the full joints."""
+def _frames(walk: _Walk, kinds: list, trig: list, cv: list, sv: list, origin: tuple) -> tuple[list, list, dict]:
+    """Every link's rotation (9-tuple) and origin (3-tuple), and the trig of the full joints.
+
+    ``cv``, ``sv`` are the variables' cosines and sines; ``origin`` the main
+    link's rotation and origin (floats, or arrays for a batch).
+    """
     R: list = [None] * walk.n_links
     p: list = [None] * walk.n_links
-    R[walk.main], p[walk.main] = _IDENTITY, (0.0, 0.0, 0.0)
+    R[walk.main], p[walk.main] = origin
     full = {}
     for (k, parent, child, rev, frame, near, far, variables), kind in zip(walk.steps, kinds):
         RP = R[parent]
         if kind is None:
             RC = RP
-        elif kind[0] == "turn":
-            th = x[kind[2]]
-            s = math.sin(th)
-            RC = _turned(RP, kind[1], math.cos(th), -s if rev else s)
-        elif kind[0] == "fixed":
+        elif kind[0] == _TURN:
+            v = kind[2]
+            RC = _turned(RP, kind[1], cv[v], -sv[v] if rev else sv[v])
+        elif kind[0] == _FIXED:
             RC = _mul(RP, kind[1])
         else:
             cs = list(trig[k])
             for a in range(3):
                 if variables[a] >= 0:
-                    th = x[variables[a]]
-                    cs[a], cs[a + 3] = math.cos(th), math.sin(th)
+                    cs[a], cs[a + 3] = cv[variables[a]], sv[variables[a]]
             full[k] = cs
             RC = _mul(RP, _joint_rotation(cs, frame, rev))
         R[child] = RC
@@ -331,11 +348,10 @@ def _axes(walk: _Walk, R: list, p: list, full: dict) -> tuple[list, list]:
 
 @dataclass(frozen=True)
 class _Goals:
-    """A single solve's point goals and placement, in floats."""
+    """A single solve's point goals (all but their targets) and placement, in floats."""
 
     links: tuple
     points: tuple  # link points (:func:`_nonzero`), link frame
-    targets: tuple  # world, 3-tuples
     weights: tuple  # each goal's row weight (square root of its normalised weight)
     moves: tuple  # per goal, per variable: whether the variable moves the goal's link
     A: tuple | None  # the placement's 3x3 (row-major), None when it is the identity
@@ -343,17 +359,20 @@ class _Goals:
     translate: bool
     length: float
     n_vars: int
+    inactive: list  # per goal, whether its weight is 0
 
 
 def _goals_of(model, stack) -> _Goals:
-    """:class:`_Goals` of a batch of one's point goals."""
+    """:class:`_Goals` of a batch of one's point goals, kept in the stack's memo (shared by its re-targeted copies)."""
+    hit = stack.memo.get("float goals")
+    if hit is not None:
+        return hit
     G = len(stack.p_link)
     w = stack.row_weight[0].tolist()
     identity = model.placement_is_identity
-    return _Goals(
+    goals = _Goals(
         tuple(stack.p_link.tolist()),
         tuple(_nonzero(v) for v in stack.p_local),
-        tuple(tuple(t) for t in stack.p_target[0].tolist()),
         tuple(w[3 * g] for g in range(G)),
         tuple(tuple(row) for row in (stack._downstream_p > 0).tolist()),
         None if identity else tuple(model.A.ravel().tolist()),
@@ -361,7 +380,10 @@ def _goals_of(model, stack) -> _Goals:
         model.translate,
         float(model.length),
         model.n_vars,
+        (~stack.active[0]).tolist(),
     )
+    stack.memo["float goals"] = goals
+    return goals
 
 
 def _apply(A: tuple, v: tuple) -> tuple:
@@ -375,14 +397,16 @@ def _apply(A: tuple, v: tuple) -> tuple:
 _ZERO3 = (0.0, 0.0, 0.0)
 
 
-def _point_rows(goals: _Goals, R: list, p: list, omega: list, pivot: list, x: list) -> tuple[list, list, list]:
-    """Residual rows, Jacobian rows and distances of the point goals (as :meth:`GoalStack.evaluate_one`)."""
+def _point_rows(
+    goals: _Goals, targets: list, R: list, p: list, omega: list, pivot: list, x: list
+) -> tuple[list, list, list]:
+    """Residual rows, Jacobian rows and distances of the point goals at ``targets`` (as :meth:`GoalStack.evaluate_one`)."""
     A, V = goals.A, goals.n_vars
     t = [v * goals.length for v in x[V:]] if goals.translate else None
     r: list = []
     J: list = []
     dist = []
-    for link, point, target, w, moves in zip(goals.links, goals.points, goals.targets, goals.weights, goals.moves):
+    for link, point, target, w, moves in zip(goals.links, goals.points, targets, goals.weights, goals.moves):
         y = _moved(R[link], p[link], point)
         world = y if A is None else _apply(A, y)
         if A is not None:
@@ -513,20 +537,18 @@ def _step(x: list, r: list, J: list, mu: float, lower: list, upper: list, V: int
     Only a variable at a limit can be held, so while none is (most
     iterations) the step is the plain damped one.
     """
-    at_lower = [a <= lo for a, lo in zip(x, lower)]
-    at_upper = [a >= hi for a, hi in zip(x, upper)]
-    if any(at_lower) or any(at_upper):
+    if any(map(le, x, lower)) or any(map(ge, x, upper)):
         # Capping scales the held variables' zeros to zeros: hold first, then cap.
-        dx, _free = _held_damped(r, J, mu, at_lower, at_upper)
+        dx, _free = _held_damped(r, J, mu, list(map(le, x, lower)), list(map(ge, x, upper)))
     else:
         dx = _damped(J, r, mu)
-    big = max([abs(d) for d in dx[:V]], default=0.0)
+    big = max(map(abs, dx[:V]), default=0.0)
     if big > maxstep:
         scale = maxstep / big
         dx = [d * scale for d in dx]
-    xn = [min(max(a + d, lo), hi) for a, d, lo, hi in zip(x, dx, lower, upper)]
-    dx = [b - a for a, b in zip(x, xn)]
-    return dx, [a + d for a, d in zip(x, dx)]
+    xn = list(map(min, map(max, map(add, x, dx), lower), upper))
+    dx = list(map(sub, xn, x))
+    return dx, list(map(add, x, dx))
 
 
 def _curvature(J) -> float:
@@ -554,24 +576,121 @@ def kernel(prob, tol: float, maxstep: float) -> Kernel | None:
     if not stack._points_only or M * P > MAX_SIZE or min(M, P) > MAX_SYSTEM or M == 0 or P == 0:
         return None
     walk = _walk_of(model)
-    kinds, trig = _joint_kinds(walk, prob.base[0])
+    kinds, trig = _start_of(walk, prob.base[0])
     goals = _goals_of(model, stack)
-    inactive = (~stack.active[0]).tolist()
-    lower, upper = prob.lower.tolist(), prob.upper.tolist()
-    V = model.n_vars
+    targets = stack.p_target[0].tolist()
+    lower, upper, V, inactive = walk.lower, walk.upper, model.n_vars, goals.inactive
 
     def evaluate(x: list) -> tuple:
-        R, p, full = _frames(walk, kinds, trig, x)
+        R, p, full = _frames(walk, kinds, trig, list(map(math.cos, x)), list(map(math.sin, x)), _ORIGIN)
         omega, pivot = _axes(walk, R, p, full)
-        r, J, dist = _point_rows(goals, R, p, omega, pivot, x)
+        r, J, dist = _point_rows(goals, targets, R, p, omega, pivot, x)
         return r, J, dist, 0.5 * _dot(r, r)
 
     return Kernel(
         evaluate=evaluate,
         step=lambda x, r, J, mu: _step(x, r, J, mu, lower, upper, V, maxstep),
         curvature=_curvature,
-        native=lambda a: a.tolist() if isinstance(a, np.ndarray) else a,
+        native=_native,
         linear_sq=_linear_sq,
         norm=lambda v: math.sqrt(_dot(v, v)),
         met=lambda dist: all([d <= tol or off for d, off in zip(dist, inactive)]),
+        n_active=inactive.count(False),
     )
+
+
+def _start_of(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
+    """:func:`_joint_kinds` of start angles ``base`` (n_joints, 3), remembered on the walk for the last few."""
+    key = base.tobytes()
+    start = walk.starts.get(key)
+    if start is None:
+        if len(walk.starts) >= 8:
+            walk.starts.clear()
+        start = walk.starts[key] = _joint_kinds(walk, base)
+    return start
+
+
+def _native(a):
+    """A numpy value as Python floats (lists)."""
+    return a.tolist() if isinstance(a, np.ndarray) else a
+
+
+# ---------------------------------------------------------------- batches
+
+
+def batch_evaluator(prob) -> Callable | None:
+    """``evaluate(stack, x) -> (r, J, dist)`` for sub-batches of ``solvers._Problem`` ``prob``, entry by entry; or None.
+
+    The same walk as a single solve's, each entry a numpy array over the
+    batch instead of a float: a hinge costs a few dozen operations on arrays
+    of ``B`` numbers, where the 4x4 products of :meth:`IKModel.forward_trig`
+    and the gathers of :meth:`IKModel.axes_trig` cost several times more.
+    None (the numpy formulas serve) unless every goal is a point goal, the
+    batch shares one start pose and most moving joints are hinges
+    (:data:`MAX_FULL_JOINTS` others at most).
+    """
+    model, stack = prob.model, prob.stack
+    if not stack._points_only or prob.base.shape[0] != 1 or stack.n_rows == 0 or model.n_vars == 0:
+        return None
+    walk = _walk_of(model)
+    kinds, trig = _start_of(walk, prob.base[0])
+    if sum(1 for kind in kinds if kind is not None and kind[0] != _TURN) > MAX_FULL_JOINTS:
+        return None
+    goals = _goals_of(model, stack)
+    V = model.n_vars
+
+    def evaluate(stack, x: np.ndarray) -> tuple:
+        B = x.shape[0]
+        xt = np.ascontiguousarray(x.T)
+        one, zero = np.ones(B), np.zeros(B)
+        origin = ((one, zero, zero, zero, one, zero, zero, zero, one), (zero, zero, zero))
+        R, p, full = _frames(walk, kinds, trig, list(np.cos(xt[:V])), list(np.sin(xt[:V])), origin)
+        omega, pivot = _axes(walk, R, p, full)
+        return _batch_point_rows(
+            goals, stack, R, p, np.array(omega), np.array(pivot), xt[V:] if model.translate else None
+        )
+
+    return evaluate
+
+
+#: A batch walks entry by entry when at most this many moving joints are not hinges
+#: (each costs a full 3x3 product, about 80 array operations).
+MAX_FULL_JOINTS = 4
+
+
+def _batch_point_rows(goals: _Goals, stack, R: list, p: list, omega, pivot, t) -> tuple:
+    """``r (B, M)``, ``J (B, M, P)`` and ``dist (B, G)`` of the point goals for a batch.
+
+    ``omega``, ``pivot``: (V, 3, B); ``t``: the translation variables (3, B) or None.
+    """
+    B = omega.shape[2]
+    V, G = goals.n_vars, len(goals.links)
+    P = V + (3 if t is not None else 0)
+    Y = np.array([_moved(R[link], p[link], point) for link, point in zip(goals.links, goals.points)])  # (G, 3, B)
+    world = (
+        Y if goals.A is None else np.einsum("ij,gjb->gib", np.reshape(goals.A, (3, 3)), Y) + np.reshape(goals.b, (3, 1))
+    )
+    if t is not None:
+        world = world + t * goals.length
+    res = world - stack.p_target.transpose(1, 2, 0)
+    dist = np.sqrt(np.einsum("gib,gib->bg", res, res))
+    w = stack.row_weight.T.reshape(G, 3, B)[:, :1]  # (G, 1, B): a goal's rows share its weight
+    J = np.zeros((G, 3, P, B))
+    for g, moves in enumerate(goals.moves):
+        D = Y[g] - pivot  # (V, 3, B)
+        u = np.stack(
+            (
+                omega[:, 1] * D[:, 2] - omega[:, 2] * D[:, 1],
+                omega[:, 2] * D[:, 0] - omega[:, 0] * D[:, 2],
+                omega[:, 0] * D[:, 1] - omega[:, 1] * D[:, 0],
+            )
+        )  # (3, V, B)
+        if not all(moves):
+            u *= np.array(moves, dtype=float)[:, None]
+        if goals.A is not None:
+            u = np.einsum("ij,jvb->ivb", np.reshape(goals.A, (3, 3)), u)
+        J[g, :, :V] = u * w[g]
+        if t is not None:
+            J[g, :, V:] = np.eye(3)[:, :, None] * (goals.length * w[g])
+    r = (res * w).reshape(3 * G, B).T
+    return r, J.reshape(3 * G, P, B).transpose(2, 0, 1), dist
