@@ -635,8 +635,8 @@ def batch_evaluator(prob) -> Callable | None:
     of ``B`` numbers, where the 4x4 products of :meth:`IKModel.forward_trig`
     and the gathers of :meth:`IKModel.axes_trig` cost several times more.
     None (the numpy formulas serve) unless every goal is a point goal, the
-    batch shares one start pose and most moving joints are hinges
-    (:data:`MAX_FULL_JOINTS` others at most).
+    batch shares one start pose and at most :data:`MAX_FULL_JOINTS` moving
+    joints are not hinges.
     """
     model, stack = prob.model, prob.stack
     if not stack._points_only or prob.base.shape[0] != 1 or stack.n_rows == 0 or model.n_vars == 0:
@@ -663,8 +663,11 @@ def batch_evaluator(prob) -> Callable | None:
 
 
 #: A batch walks entry by entry when at most this many moving joints are not hinges
-#: (each costs a full 3x3 product, about 80 array operations).
-MAX_FULL_JOINTS = 4
+#: (each costs a full 3x3 product, about 80 array operations, where the 4x4
+#: products take a whole tree level at once).  Measured on batches of 1000:
+#: six ball joints 1.3 times as fast as the 4x4 products, the library's
+#: humanoid (19 joints) 1.0 to 1.3 times.
+MAX_FULL_JOINTS = 24
 
 
 def _batch_point_rows(goals: _Goals, stack, R: list, p: list, omega, pivot, t) -> tuple:

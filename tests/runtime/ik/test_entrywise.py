@@ -304,12 +304,17 @@ def test_which_batches_take_the_walk():
     assert walked([PointGoal(6, targets)])
     assert not walked([PointGoal(6, targets), PlaneGoal(2, (0, 0, 0), (0, 1, 0))])  # only point goals
     assert not walked([PointGoal(6, targets)], base=np.zeros((4, 6, 3)))  # one start pose for the batch
+    n = scalar.MAX_FULL_JOINTS + 1
     balls = Figure(
-        tuple(Link(f"B{i}", None) for i in range(7)),
-        tuple(Joint(i + 1, i, i + 1, (0, 0.2, 0), (0, 0, 0), [(-90, 90)] * 3) for i in range(6)),
+        tuple(Link(f"B{i}", None) for i in range(n + 1)),
+        tuple(Joint(i + 1, i, i + 1, (0, 0.2, 0), (0, 0, 0), [(-90, 90)] * 3) for i in range(n)),
     )
-    ball_model = IKModel(balls, np.ones((6, 3), dtype=bool))
-    assert not walked([PointGoal(6, targets)], model=ball_model)  # six ball joints: numpy's 4x4 products win
+    ball_model = IKModel(balls, np.ones((n, 3), dtype=bool))
+    base = np.zeros((1, n, 3))
+    assert not walked([PointGoal(n, targets)], base, model=ball_model)  # many ball joints: the 4x4 products win
+    assert walked(
+        [PointGoal(n, targets)], base, model=IKModel(balls, (np.arange(n) < n - 1)[:, None] & np.ones(3, dtype=bool))
+    )
 
 
 @pytest.mark.parametrize("P", [4, 6, 9])
