@@ -665,9 +665,9 @@ def _solve_damped(J: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray
         # One point goal: the 3x3 system's Cholesky written out over the batch
         # (np.linalg.solve on stacked 3x3s costs several times more).
         A = Jf @ np.swapaxes(Jf, 1, 2)
-        y = solve3(A[:, 0, 0] + mu, A[:, 0, 1], A[:, 0, 2], A[:, 1, 1] + mu, A[:, 1, 2], A[:, 2, 2] + mu, r.T, np.sqrt)
-        if y is not None:
-            return np.einsum("bmp,mb->bp", Jf, np.array(y))
+        y3 = solve3(A[:, 0, 0] + mu, A[:, 0, 1], A[:, 0, 2], A[:, 1, 1] + mu, A[:, 1, 2], A[:, 2, 2] + mu, r.T, np.sqrt)
+        if y3 is not None:
+            return np.einsum("bmp,mb->bp", Jf, np.array(y3))
     if M < P:
         A = Jf @ np.swapaxes(Jf, 1, 2)
         A[:, np.arange(M), np.arange(M)] += mu[:, None]
