@@ -21,7 +21,9 @@ Reported, the program compiled once outside the timing:
   (``frames.draw``), **encoding** (the ffmpeg child: x264 alone on the same
   frames), the **rest** of this process (running the program's ticks,
   feeding the stream); and **transport**: what the worker processes cost
-  beyond the one-process run (handing draws to them and images back);
+  beyond the one-process run (handing tasks to them and images back);
+* the worker message: bytes an image and CPU to pickle and unpickle it,
+  as sent (link matrices) and as world triangles (what it was before);
 * CPU a frame to PNG files alone (``-o DIR``), the same ticks (at most
   10,000);
 * the cost of drawing one image (the ``draw`` step alone, one process) at
@@ -43,6 +45,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import pickle
 import sys
 import tempfile
 import time
@@ -51,6 +54,7 @@ from _clock import Cost, cpu_seconds, load_text, measure
 
 from liganimate.compiler import load_program
 from liganimate.runtime.render import frames as R
+from liganimate.runtime.render import message as M
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, "five_humans.lig")
@@ -157,6 +161,45 @@ def captured_draws(program, count: int) -> list:
     return got
 
 
+def message_sizes(program, count: int) -> dict:
+    """What the first ``count`` images cost to send to a worker: the message as sent, and as world triangles.
+
+    The tasks are taken as ``Renderer`` packs them (link matrices;
+    :mod:`liganimate.runtime.render.message`), shapes not counted (they go
+    once a render); beside them, the same images' draws with every figure's
+    triangles in world coordinates, what a task carried before.  Bytes are
+    pickled sizes, CPU the best of 5 rounds of pickling and unpickling.
+    """
+    tasks: list = []
+    pack, original = R.pack, R.draw_images
+
+    def keep(*args):
+        got = pack(*args)
+        if len(tasks) * R.CHUNK < count:
+            tasks.append(got)
+        return got
+
+    R.pack = keep
+    R.draw_images = lambda size, draws_list, *options: [(None, None)] * len(draws_list)
+    try:
+        with tempfile.TemporaryDirectory() as out:
+            program.render(out, checked=True, size=SIZE, quiet=True, workers=1, look=LOOK)
+    finally:
+        R.pack, R.draw_images = pack, original
+    sent = [task for task, _shapes in tasks[: max(1, count // R.CHUNK)]]
+    triangles = [M.resolve(task.shipping(shapes)) for task, shapes in tasks[: len(sent)]]
+    images = sum(len(task.images) for task in sent)
+    out = {}
+    for name, objs in (("link_matrices", sent), ("world_triangles", triangles)):
+        size = sum(len(pickle.dumps(o, protocol=pickle.HIGHEST_PROTOCOL)) for o in objs)
+        cpu = min(measure(lambda o=objs: [pickle.loads(pickle.dumps(x, protocol=5)) for x in o]).cpu for _ in range(5))
+        out[name] = {
+            "kb_per_image": round(size / images / 1024, 2),
+            "pickling_us_per_image": round(cpu / images * 1e6, 1),
+        }
+    return out
+
+
 def draw_ratio(draws: list, rounds: int) -> tuple:
     """(CPU ms an image at 640x480, at 1920x1080): the draw step alone, best of ``rounds``."""
     best = {}
@@ -235,6 +278,13 @@ def main(argv=None) -> int:
             flush=True,
         )
         small = program if ticks <= 2_000 else scene_program(folder, 2_000)
+        message = message_sizes(small, 160)
+        lm, wt = message["link_matrices"], message["world_triangles"]
+        print(
+            f"worker message: {lm['kb_per_image']:.1f} kB an image, {lm['pickling_us_per_image']:.1f} us to pickle "
+            f"and unpickle (as world triangles: {wt['kb_per_image']:.1f} kB, {wt['pickling_us_per_image']:.1f} us)",
+            flush=True,
+        )
         draws = captured_draws(small, 40 if args.quick else 120)
         ms480, ms1080 = draw_ratio(draws, 5)
         print(
@@ -273,6 +323,7 @@ def main(argv=None) -> int:
                 "draw_ms_480p": round(ms480, 3),
                 "draw_ms_1080p": round(ms1080, 3),
                 "ratio_1080p_480p": round(ms1080 / ms480, 2),
+                "message": message,
                 "dask": dask,
             }
         )

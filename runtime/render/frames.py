@@ -5,7 +5,10 @@ batches so that poses are evaluated for a whole batch of frames at once,
 then the images are rasterized by a pool of worker processes (several
 images a task, so the cost of handing work over stays small), by an
 executor given by the caller (a Dask cluster), or in this process for
-scenes of only a few images.  Each task returns its images, PNG-encoded
+scenes of only a few images.  A task carries each figure's link matrices,
+not its triangles: the worker message (:mod:`.message`) sends a figure's
+geometry and the background's once a render, and the worker forms the
+world triangles.  Each task returns its images, PNG-encoded
 when frames are written and raw when a movie is, and this process writes
 them in order: PNG files, and the frames of the GIF and MP4 streams (whose
 encoders run beside the drawing, :mod:`.video`).  At most a few tasks are
@@ -443,7 +446,7 @@ class Renderer:
             return
         if self.pool is None:
             # Drawn here: every shape goes with the task (nothing is copied).
-            self._deliver(names, draw_task(task.shipping(shapes)))
+            self._deliver(names, draw_task(task.shipping(shapes), keep=False))
             return
         task = task.shipping(self._shipping.pick(shapes, self._in_flight()))
         self.futures.append((self.pool.submit(draw_task, task), names, task, shapes))
@@ -672,8 +675,10 @@ def _worker_init(parent: int) -> None:
     mallopt(M_TRIM_THRESHOLD, 256 << 20)
 
 
-def draw_task(task: Task) -> list | Missing:
+def draw_task(task: Task, keep: bool = True) -> list | Missing:
     """A worker's task: form the images' world triangles from their link matrices (:mod:`.message`), draw them.
+
+    ``keep``: keep the shapes the task ships for later tasks (see :func:`.message.resolve`).
 
     Returns
     -------
@@ -681,7 +686,7 @@ def draw_task(task: Task) -> list | Missing:
         What :func:`draw_images` returns, or :class:`.message.Missing` when
         the task names a shape this process has not been shipped.
     """
-    draws = resolve(task)
+    draws = resolve(task, keep)
     if isinstance(draws, Missing):
         return draws
     return draw_images(task.size, draws, task.aa, task.png, task.raw, task.look)

@@ -236,8 +236,15 @@ def _keep(shapes: dict) -> None:
         _kept_bytes[0] += size
 
 
-def resolve(task: Task) -> list | Missing:
+def resolve(task: Task, keep: bool = True) -> list | Missing:
     """A task's draws, as :func:`.frames.draw` takes them, or :class:`Missing` if a shape is not here.
+
+    Parameters
+    ----------
+    task : Task
+    keep : bool
+        Keep the shapes the task ships for later tasks (a worker); the main
+        process, drawing a task with every shape it names, keeps none.
 
     Returns
     -------
@@ -248,7 +255,8 @@ def resolve(task: Task) -> list | Missing:
     lacking = tuple(sorted(k for k in task.keys() if k not in task.shapes and k not in _kept))
     if lacking:
         return Missing(lacking)
-    _keep(task.shapes)
+    if keep:
+        _keep(task.shapes)
     shapes = {k: task.shapes[k] if k in task.shapes else _kept[k] for k in task.keys()}
     drawn = _figures(task, shapes)
     out = []
@@ -274,8 +282,7 @@ def _figures(task: Task, shapes: dict) -> dict:
     out = {}
     for (key, links, morphing), members in groups.items():
         table = shapes[key]
-        starts = np.array([part[1] for _, part in members])
-        X = task.matrices[starts[:, None] + np.arange(links)]
+        X = _matrices(task.matrices, [part[1] for _, part in members], links)
         local = None
         if morphing:
             local = np.broadcast_to(table.triangles, (len(members), *table.triangles.shape)).copy()
@@ -287,3 +294,11 @@ def _figures(task: Task, shapes: dict) -> dict:
         for n, (where, part) in enumerate(members):
             out[where] = (tris[n], table.shade, unculled if part[3] else table.closed)
     return out
+
+
+def _matrices(matrices: np.ndarray, starts: list, links: int) -> np.ndarray:
+    """The (n, links, 4, 4) link matrices of parts starting at ``starts``: a view when they lie end to end."""
+    first = starts[0]
+    if starts == list(range(first, first + links * len(starts), links)):
+        return matrices[first : first + links * len(starts)].reshape(len(starts), links, 4, 4)
+    return matrices[np.asarray(starts)[:, None] + np.arange(links)]

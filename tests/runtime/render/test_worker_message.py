@@ -76,7 +76,7 @@ def test_frames_from_link_matrices_are_the_bytes_drawn_in_one_process(tmp_path, 
     path = EXAMPLES / "mailbox.lig"
     again = render(path, tmp_path / "resent", look, workers=2)
     assert again == frames_of(tmp_path / "mailbox-1")
-    assert resent and resent[-1] >= 2  # at least one task for each of the two fresh workers
+    assert resent and resent[-1] >= 1  # the first task a fresh worker took came back Missing
 
 
 def _table(triangles: np.ndarray, link: np.ndarray) -> MeshTable:
