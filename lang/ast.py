@@ -1,6 +1,7 @@
 """The typed syntax tree of a LIG ANIMATE program.
 
-Every node is a small dataclass with a :class:`Pos`; names are upper-cased
+Every node is a small dataclass with a :class:`Pos` (made by
+:func:`.node_methods.node`, whose methods are written out once); names are upper-cased
 (the language is case-insensitive) and numbers are already converted. The
 tree is produced by :mod:`liganimate.lang.transform` while the LALR parser
 runs, so building it never recurses.
@@ -12,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 from typing import Any, Self
 
+from .node_methods import node
 from .vocabulary import NUMBER, Type
 
 _M12, _M24, _M28, _M32, _M64 = (1 << 12) - 1, (1 << 24) - 1, (1 << 28) - 1, (1 << 32) - 1, (1 << 64) - 1
@@ -146,7 +148,7 @@ def token_pos(line: int, column: int, end_column: int, start: int = 0, end: int 
 NOWHERE = Pos(0, 0, 0, 0)
 
 
-@dataclass(slots=True)
+@node
 class Node:
     pos: Pos
 
@@ -154,29 +156,29 @@ class Node:
 # --------------------------------------------------------------- expressions
 
 
-@dataclass(slots=True)
+@node
 class Num(Node):
     value: int | float
     text: str
 
 
-@dataclass(slots=True)
+@node
 class Var(Node):
     name: str
 
 
-@dataclass(slots=True)
+@node
 class Call(Node):
     name: str
     args: list
 
 
-@dataclass(slots=True)
+@node
 class Tuple(Node):
     items: list
 
 
-@dataclass(slots=True)
+@node
 class BinOp(Node):
     op: str  # one of + - * / MOD
     left: Node
@@ -184,12 +186,12 @@ class BinOp(Node):
     op_pos: Pos = NOWHERE
 
 
-@dataclass(slots=True)
+@node
 class Neg(Node):
     operand: Node
 
 
-@dataclass(slots=True)
+@node
 class Modifier(Node):
     """One entry of a ``< ... >`` list."""
 
@@ -198,57 +200,57 @@ class Modifier(Node):
     axis: str | None = None
 
 
-@dataclass(slots=True)
+@node
 class Modified(Node):
     target: Node
     modifiers: list
 
 
-@dataclass(slots=True)
+@node
 class Clause(Node):
     keyword: str
     value: Node
 
 
-@dataclass(slots=True)
+@node
 class PrimCall(Node):
     name: str
     clauses: list
 
 
-@dataclass(slots=True)
+@node
 class JointExpr(Node):
     args: list
     slide: bool = False  # SLIDE before the extremes: a prismatic joint
     axis: Node | None = None  # AXIS (x, y, z) after them
 
 
-@dataclass(slots=True)
+@node
 class Strip(Node):
     motion: Node
     joints: list
 
 
-@dataclass(slots=True)
+@node
 class Sync(Node):
     motions: list
 
 
-@dataclass(slots=True)
+@node
 class Compare(Node):
     op: str
     left: Node
     right: Node
 
 
-@dataclass(slots=True)
+@node
 class BoolOp(Node):
     op: str  # AND / OR
     left: Node
     right: Node
 
 
-@dataclass(slots=True)
+@node
 class Not(Node):
     operand: Node
 
@@ -256,34 +258,34 @@ class Not(Node):
 # ----------------------------------------------------------------- statements
 
 
-@dataclass(slots=True)
+@node
 class Name(Node):
     """A name written in a statement (declared, assigned, animated...)."""
 
     name: str
 
 
-@dataclass(slots=True)
+@node
 class Decl(Node):
     type: str  # a vocabulary.Type
     names: list  # of Name
 
 
-@dataclass(slots=True)
+@node
 class Assign(Node):
     target: Name
     op: str  # = := :-
     value: Node
 
 
-@dataclass(slots=True)
+@node
 class Keyframe(Node):
     frame: Node
     position: list  # 1 vector expression or 3 numbers
     method: Name | None
 
 
-@dataclass(slots=True)
+@node
 class KeyframeAssign(Node):
     target: Name
     joint: Node
@@ -292,7 +294,7 @@ class KeyframeAssign(Node):
     keyframe: Keyframe
 
 
-@dataclass(slots=True)
+@node
 class DoHeader(Node):
     """``DO label var = a, b[, step]`` before loops are grouped."""
 
@@ -303,12 +305,12 @@ class DoHeader(Node):
     step: Node | None
 
 
-@dataclass(slots=True)
+@node
 class Continue(Node):
     label: int
 
 
-@dataclass(slots=True)
+@node
 class Do(Node):
     label: int
     var: Name
@@ -319,27 +321,27 @@ class Do(Node):
     end_pos: Pos = NOWHERE
 
 
-@dataclass(slots=True)
+@node
 class If(Node):
     cond: Node
     then: list
     orelse: list | None
 
 
-@dataclass(slots=True)
+@node
 class JointStmt(Node):
     args: list
     slide: bool = False  # as in JointExpr
     axis: Node | None = None
 
 
-@dataclass(slots=True)
+@node
 class ModelBlock(Node):
     name: Name
     joints: list  # of JointStmt
 
 
-@dataclass(slots=True)
+@node
 class RootTrack(Node):
     """The word ROOT where a joint identifier stands: the motion's root-translation track.
 
@@ -349,7 +351,7 @@ class RootTrack(Node):
     orientation: bool = False
 
 
-@dataclass(slots=True)
+@node
 class MorphTrack(Node):
     """``SCALE LINK name`` or ``SHAPE LINK name`` where a joint identifier stands: a link's morph track."""
 
@@ -357,14 +359,14 @@ class MorphTrack(Node):
     link: str  # the link's name, in capitals (a name of the model's, not a variable)
 
 
-@dataclass(slots=True)
+@node
 class MotionJoint(Node):
     joint: Node  # RootTrack for the ROOT entry, MorphTrack for SCALE and SHAPE
     start: list | None
     keyframes: list
 
 
-@dataclass(slots=True)
+@node
 class MotionTable(Node):
     """``TABLE 1, 2, ROOT`` and its ``| frame x y z ...`` rows: keyframes of several tracks at once.
 
@@ -378,14 +380,14 @@ class MotionTable(Node):
     data: object = None
 
 
-@dataclass(slots=True)
+@node
 class MotionBlock(Node):
     name: Name
     joints: list  # of MotionJoint
     tables: list = field(default_factory=list)  # of MotionTable
 
 
-@dataclass(slots=True)
+@node
 class Goal(Node):
     """One goal of a REACH block: ``kind`` is "point", "plane" or "axis"."""
 
@@ -398,7 +400,7 @@ class Goal(Node):
     weight: Node | None
 
 
-@dataclass(slots=True)
+@node
 class ReachBlock(Node):
     name: Name
     model: Node
@@ -415,7 +417,7 @@ class ReachBlock(Node):
     options: dict = field(default_factory=dict)  # option word -> Pos of its first use (for duplicates)
 
 
-@dataclass(slots=True)
+@node
 class FigureStmt(Node):
     model: Name
     kind: str | None  # None, LINK or JOINT
@@ -423,7 +425,7 @@ class FigureStmt(Node):
     joint: Node | None = None
 
 
-@dataclass(slots=True)
+@node
 class Scene(Node):
     scene_id: Node
     init: list
@@ -433,7 +435,7 @@ class Scene(Node):
     start_pos: Pos = NOWHERE
 
 
-@dataclass(slots=True)
+@node
 class Animate(Node):
     model: Name
     start: Node
@@ -442,18 +444,18 @@ class Animate(Node):
     repeat: bool
 
 
-@dataclass(slots=True)
+@node
 class Background(Node):
     items: list
 
 
-@dataclass(slots=True)
+@node
 class PrintItem(Node):
     kind: str  # value, table, text
     value: object  # Node for value, Name for table, str for text
 
 
-@dataclass(slots=True)
+@node
 class Print(Node):
     items: list
 
@@ -506,7 +508,7 @@ class Declaration:
 DECLARED: dict[type, Declaration] = {}
 
 
-@dataclass(slots=True)
+@node
 class Declared(Node):
     """Base of the declared statements (the passes dispatch on it when a node has no method of its own)."""
 
@@ -543,93 +545,93 @@ def declared(
 
 
 @declared("view_point", "set_view_point")
-@dataclass(slots=True)
+@node
 class ViewPoint(Declared):
     point: Node = part(Type.VECTOR, what="a view point (x, y, z)")
 
 
 @declared("view_width", "set_view_width")
-@dataclass(slots=True)
+@node
 class ViewWidth(Declared):
     width: Node = part(*NUMBER, what="a view width")
 
 
 @declared("shoot_stmt", "shoot", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
-@dataclass(slots=True)
+@node
 class Shoot(Declared):
     pass
 
 
 # A Shoot, so that a library refuses it and an archive leaves it out as it does SHOOTSCENES.
 @declared("shoot_range", "shoot_range", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
-@dataclass(slots=True)
+@node
 class ShootRange(Shoot):
     first: Node = part(Type.INTEGER, what="the first scene to shoot")
     last: Node = part(Type.INTEGER, what="the last scene to shoot")
 
 
-@dataclass(slots=True)
+@node
 class Stop(Node):
     pass
 
 
-@dataclass(slots=True)
+@node
 class Return(Node):
     pass
 
 
-@dataclass(slots=True)
+@node
 class ProgramEnd(Node):
     pass
 
 
-@dataclass(slots=True)
+@node
 class DrawWith(Node):
     modifiers: list
 
 
-@dataclass(slots=True)
+@node
 class DrawPoly(Node):
     points: list
 
 
-@dataclass(slots=True)
+@node
 class Load(Node):
     library: str  # as written, without its quotes
     library_pos: Pos
     names: list  # of Name; empty means the library's models, motions, graphics and primitives
 
 
-@dataclass(slots=True)
+@node
 class PatWord(Node):
     word: str
 
 
-@dataclass(slots=True)
+@node
 class PatParam(Node):
     name: str
 
 
-@dataclass(slots=True)
+@node
 class PatOptional(Node):
     items: list
     defaults: list  # of (Name, expr)
 
 
-@dataclass(slots=True)
+@node
 class PatternDef(Node):
     name: str
     items: list
 
 
-@dataclass(slots=True)
+@node
 class PrimitiveDef(Node):
     name: Name
     body: list
     pattern: PatternDef | None = None
 
 
-@dataclass(slots=True)
+@node
 class Program(Node):
     filename: str
     source: str

@@ -1,0 +1,101 @@
+"""The syntax tree's node classes: dataclasses whose methods come from lang/_node_methods.py.
+
+* The generated module is the one the classes give today (as lang/_tables.py is for the grammar).
+* Every node class took its methods from it: none paid for compiling them at import.
+* The methods behave as ``@dataclass(slots=True)``'s own, class by class: the same
+  signature and docstring, repr, equality, hashing, defaults and factories.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import os
+
+from paths import ROOT_DIR
+
+from liganimate.lang import ast as A
+from liganimate.lang import node_methods as N
+
+
+def node_classes() -> list:
+    return [c for c in N.MADE if c.__module__ == "liganimate.lang.ast"]
+
+
+def test_generated_methods_are_the_ones_the_classes_give():
+    with open(os.path.join(ROOT_DIR, "lang", "_node_methods.py"), encoding="utf-8") as fh:
+        shipped = fh.read()
+    assert shipped == N.module_text(), "run: python -m liganimate.lang.node_methods"
+
+
+def test_every_node_class_took_its_methods_from_the_generated_module():
+    makers = N._makers()
+    classes = node_classes()
+    assert len(classes) > 50 and A.Program in classes and A.Num in classes
+    for cls in classes:
+        assert makers[cls.__qualname__][0] == N.shape(cls), cls.__qualname__
+        assert cls.__init__.__code__.co_filename.endswith("_node_methods.py"), cls.__qualname__
+
+
+def twin(cls: type) -> type:
+    """``cls`` as @dataclass(slots=True) makes it from the same fields (the reference)."""
+    spec = []
+    for f in dataclasses.fields(cls):
+        extra = {}
+        if f.default is not dataclasses.MISSING:
+            extra["default"] = f.default
+        if f.default_factory is not dataclasses.MISSING:
+            extra["default_factory"] = f.default_factory
+        spec.append((f.name, f.type, dataclasses.field(**extra)))
+    return dataclasses.make_dataclass(cls.__name__, spec, slots=True)
+
+
+def test_methods_behave_as_dataclass_ones():
+    for cls in node_classes():
+        ref = twin(cls)
+        name = cls.__qualname__
+        assert dataclasses.is_dataclass(cls) and "__slots__" in cls.__dict__, name
+        assert str(inspect.signature(cls)) == str(inspect.signature(ref)), name
+        if not cls.__doc__ or cls.__doc__.startswith(cls.__name__ + "("):  # no docstring of its own
+            assert cls.__doc__ == ref.__doc__, name
+        assert cls.__match_args__ == ref.__match_args__, name
+        assert cls.__hash__ is None and ref.__hash__ is None, name
+        names = [f.name for f in dataclasses.fields(cls)]
+        values = [f"v{i}" for i in range(len(names))]
+        mine, theirs = cls(*values), ref(*values)
+        assert repr(mine) == repr(theirs).replace(ref.__qualname__, cls.__qualname__, 1), name
+        assert mine == cls(*values) and not (mine != cls(*values)), name
+        assert mine != theirs, name  # another class: never equal, as dataclasses compare
+        if names:
+            other = cls(*values[:-1], "different")
+            assert mine != other and (mine == other) is False, name
+            assert dataclasses.replace(mine, **{names[-1]: "different"}) == other, name
+            assert cls(**dict(zip(names, values, strict=True))) == mine, name
+
+
+def test_defaults_and_factories():
+    a = A.Program(A.NOWHERE, "f.lig", "", [])
+    b = A.Program(A.NOWHERE, "f.lig", "", [])
+    assert a.primitives == [] and a.primitives is not b.primitives  # a fresh list each time
+    assert A.PrimitiveDef(A.NOWHERE, A.Name(A.NOWHERE, "P"), []).pattern is None
+    assert repr(A.Num(A.NOWHERE, 1, "1")) == f"Num(pos={A.NOWHERE!r}, value=1, text='1')"
+
+
+def test_a_changed_class_gets_compiled_methods(monkeypatch):
+    # An edited node whose module is stale still gets @dataclass's methods (compiled at import, as before).
+    monkeypatch.setattr(N, "_makers", lambda: {})
+
+    @N.node
+    class Edited(A.Node):
+        name: str
+        items: list = dataclasses.field(default_factory=list)
+
+    ref = twin(Edited)
+    assert str(inspect.signature(Edited)) == str(inspect.signature(ref))
+    assert Edited.__doc__ == ref.__doc__
+    e = Edited(A.NOWHERE, "X")
+    assert e == Edited(A.NOWHERE, "X", []) and e.items == [] and e.items is not Edited(A.NOWHERE, "X").items
+    assert (
+        repr(e) == f"test_a_changed_class_gets_compiled_methods.<locals>.Edited(pos={A.NOWHERE!r}, name='X', items=[])"
+    )
+    N.MADE.remove(Edited)
