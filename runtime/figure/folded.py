@@ -1,7 +1,7 @@
 """Forward kinematics for long batches: one joint at a time over contiguous frames, constants folded.
 
 The long-batch half of :func:`liganimate.runtime.figure.kinematics.placed_transforms`
-(:mod:`.walk` holds the short-batch half and the walk both use).  Storage is
+(:mod:`.short` holds the short-batch half; :mod:`.walk` the walk both use).  Storage is
 component-major, as it always was: entry ``(i, j)`` of link ``l``'s
 transform is one contiguous row over the frames, so every numpy call runs
 over thousands of numbers.  Joints are composed one by one, parents first,

@@ -23,8 +23,7 @@ import math
 import numpy as np
 
 from liganimate.runtime.figure import folded as _folded
-from liganimate.runtime.figure import single as _single
-from liganimate.runtime.figure import walk as _walk
+from liganimate.runtime.figure import short as _short
 from liganimate.runtime.figure.tree import Figure
 
 __all__ = [
@@ -201,13 +200,12 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
 
     Notes
     -----
-    One pose is computed by
-    :func:`liganimate.runtime.figure.single.placed_one` (the walk below laid
-    out once per figure as a fixed list of about thirty numpy calls, the
-    same numbers bit for bit).  A batch of fewer than :data:`SHORT` poses is walked by
-    :func:`liganimate.runtime.figure.walk.placed` (all joints at once, one
-    product per depth level of the tree: a few dozen numpy calls whatever
-    the number of joints), a longer one by
+    A batch of fewer than :data:`SHORT` poses (one pose, the renderer's
+    batches) is computed by
+    :func:`liganimate.runtime.figure.short.placed_short`: the walk down the
+    tree laid out once per figure as a fixed list of about thirty numpy
+    calls (gathers and elementwise products and sums; one product per depth
+    level of the tree), whatever the number of joints.  A longer one by
     :func:`liganimate.runtime.figure.folded.placed_long` (one joint at a
     time over contiguous rows of frames, the arithmetic of each joint's
     kind only).  Both compute every entry with the operations of a 4x4
@@ -217,15 +215,13 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     may differ in sign).
     """
     B = angles.shape[0]
-    if B == 1:
-        return _single.placed_one(figure, angles, None if root is None else np.asarray(root, dtype=np.float64))
-    if B < SHORT:
-        return _walk.placed(figure, angles, root)
+    if 0 < B < SHORT:
+        return _short.placed_short(figure, angles, None if root is None else np.asarray(root, dtype=np.float64))
     return _folded.placed_long(figure, angles, root)
 
 
 SHORT = 256
-"""Batches shorter than this take the short-batch walk: there the number of numpy calls is the cost."""
+"""Batches shorter than this take :mod:`.short`: there the number of numpy calls is the cost."""
 
 
 def _local_transforms(figure: Figure, joints: np.ndarray, values: np.ndarray):

@@ -3,9 +3,9 @@
 ``placed_transforms`` here is the previous
 ``liganimate.runtime.figure.kinematics.placed_transforms``, verbatim: every
 joint's local transform from the full three-axis formula, then one joint
-at a time down the tree with two ``einsum`` calls each.  The new walk
-(``runtime/figure/walk.py`` for short batches, ``runtime/figure/folded.py``
-for long ones) must give the same numbers (``test_walk.py``).
+at a time down the tree with two ``einsum`` calls each.  The new paths
+(``runtime/figure/short.py`` for short batches, ``runtime/figure/folded.py``
+for long ones) must give the same numbers (``test_walk.py``, ``test_short.py``).
 """
 
 from __future__ import annotations

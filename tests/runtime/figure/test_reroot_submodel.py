@@ -229,7 +229,7 @@ def test_figure_main_link_with_a_repeated_name_says_when_no_main_joint_chooses_t
 
 @pytest.mark.parametrize("frames", [1, 40, 3000])
 def test_every_batch_length_gives_the_hand_worked_positions(frames):
-    """Short and long batches take different walks (walk.py, folded.py): both by hand."""
+    """Short and long batches take different paths (short.py, folded.py): both by hand."""
     m = _variables(PLANAR)[0]["M"]
     rng = np.random.default_rng(frames)
     t = rng.uniform(-90.0, 90.0, size=(frames, 3))  # joints 1, 2, 3

@@ -4,8 +4,9 @@ Two implementations that must agree, in the manner of pytransform3d's
 tests: ``previous_kinematics.placed_transforms`` is the walk as it was
 (every joint from the full three-axis formula, one joint at a time with
 ``einsum``), and ``kinematics.placed_transforms`` now takes the short-batch
-walk (``walk.py``: all joints at once, one product per tree level) or the
-long-batch one (``folded.py``: one joint at a time, constants folded).
+path (``short.py``: all joints at once, one product per tree level, as a
+fixed list of gathers and sums) or the long-batch one (``folded.py``: one
+joint at a time, constants folded).
 Both must give the same doubles, bit for bit (``array_equal``: an exact zero
 may come out as -0.0), for joints that turn about one, two or three axes,
 axes holding still or at zero, joints walked backwards, and placements that
@@ -23,7 +24,7 @@ import pytest
 from previous_kinematics import placed_transforms as previous
 from test_slides_axes import random_robot, random_values
 
-from liganimate.runtime.figure import folded, walk
+from liganimate.runtime.figure import folded, short
 from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure.tree import Figure, Joint, Link
 
@@ -67,25 +68,13 @@ def test_both_walks_give_the_previous_numbers(seed, frames):
     a = poses(rng, fig, frames)
     root = roots(rng, frames)
     want = previous(fig, a, root)
-    for got in (walk.placed(fig, a, root), folded.placed_long(fig, a, root), K.placed_transforms(fig, a, root)):
+    short_path = short.placed_short(fig, a, root) if frames else want
+    for got in (short_path, folded.placed_long(fig, a, root), K.placed_transforms(fig, a, root)):
         assert got.shape == (frames, fig.n_links, 4, 4)
         if fig.has_frames.any() or fig.slides.any():
             np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
         else:
             np.testing.assert_array_equal(got, want)
-
-
-def test_blocks_of_the_short_walk_change_nothing():
-    rng = np.random.default_rng(5)
-    fig = random_robot(rng, 9)
-    a = poses(rng, fig, 700)
-    want = walk.placed(fig, a, None)
-    old = walk.BLOCK
-    try:
-        walk.BLOCK = 37
-        np.testing.assert_array_equal(walk.placed(fig, a, None), want)
-    finally:
-        walk.BLOCK = old
 
 
 def test_a_single_link_and_the_library_humanoid(tmp_path):

@@ -95,7 +95,7 @@ def test_float_damped_step_equals_numpy_solve(M, P):
         np.testing.assert_allclose(scalar._damped(J.tolist(), r.tolist(), mu), want, rtol=0, atol=1e-9)
     # A matrix that is not definite (rounding can make one) goes to the elimination, as numpy would solve it.
     A = [[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-    assert scalar._solve3(1.0, 2.0, 0.0, 1.0, 0.0, 1.0, [1.0, 1.0, 1.0]) is None
+    assert scalar.solve3(1.0, 2.0, 0.0, 1.0, 0.0, 1.0, [1.0, 1.0, 1.0]) is None
     np.testing.assert_allclose(scalar._solve(A, [1.0, 1.0, 1.0]), np.linalg.solve(A, [1.0, 1.0, 1.0]), atol=1e-15)
 
 
@@ -304,9 +304,35 @@ def test_which_batches_take_the_walk():
     assert walked([PointGoal(6, targets)])
     assert not walked([PointGoal(6, targets), PlaneGoal(2, (0, 0, 0), (0, 1, 0))])  # only point goals
     assert not walked([PointGoal(6, targets)], base=np.zeros((4, 6, 3)))  # one start pose for the batch
+    n = scalar.MAX_FULL_JOINTS + 1
     balls = Figure(
-        tuple(Link(f"B{i}", None) for i in range(7)),
-        tuple(Joint(i + 1, i, i + 1, (0, 0.2, 0), (0, 0, 0), [(-90, 90)] * 3) for i in range(6)),
+        tuple(Link(f"B{i}", None) for i in range(n + 1)),
+        tuple(Joint(i + 1, i, i + 1, (0, 0.2, 0), (0, 0, 0), [(-90, 90)] * 3) for i in range(n)),
     )
-    ball_model = IKModel(balls, np.ones((6, 3), dtype=bool))
-    assert not walked([PointGoal(6, targets)], model=ball_model)  # six ball joints: numpy's 4x4 products win
+    ball_model = IKModel(balls, np.ones((n, 3), dtype=bool))
+    base = np.zeros((1, n, 3))
+    assert not walked([PointGoal(n, targets)], base, model=ball_model)  # many ball joints: the 4x4 products win
+    assert walked(
+        [PointGoal(n, targets)], base, model=IKModel(balls, (np.arange(n) < n - 1)[:, None] & np.ones(3, dtype=bool))
+    )
+
+
+@pytest.mark.parametrize("P", [4, 6, 9])
+def test_batched_damped_step_with_the_written_out_3x3_equals_numpy_solve(P):
+    """solvers._solve_damped's Cholesky over a batch against np.linalg.solve, with held variables."""
+    rng = np.random.default_rng(P)
+    B = 50
+    J = rng.normal(size=(B, 3, P)) * 2
+    r = rng.normal(size=(B, 3))
+    free = rng.uniform(size=(B, P)) < 0.8
+    mu = 10 ** rng.uniform(-3, 1, size=B)
+    Jf = J * free[:, None, :]
+    want = np.stack([Jf[b].T @ np.linalg.solve(Jf[b] @ Jf[b].T + mu[b] * np.eye(3), -r[b]) for b in range(B)])
+    np.testing.assert_allclose(S._solve_damped(J, r, free, mu), want, rtol=0, atol=1e-9)
+    # An element whose system is not definite (only rounding makes one) sends the batch to np.linalg.solve.
+    assert (
+        scalar.solve3(
+            np.ones(2), np.full(2, 2.0), np.zeros(2), np.ones(2), np.zeros(2), np.ones(2), np.ones((3, 2)), np.sqrt
+        )
+        is None
+    )

@@ -192,15 +192,30 @@ def test_plane_and_axis_goals_are_met(solver):
 
 
 def _record_iterates(monkeypatch):
-    """Every variable vector the solvers evaluate, collected through IKModel.trig."""
+    """Every variable vector the solvers evaluate, collected through IKModel.trig and the batch walk."""
+    from liganimate.runtime.ik import solvers as S
+
     seen = []
     original = IKModel.trig
+    original_walk = S.batch_evaluator
 
     def trig(self, q, base_cos, base_sin):
         seen.append((self, np.array(q)))
         return original(self, q, base_cos, base_sin)
 
+    def batch_evaluator(prob):
+        walk = original_walk(prob)
+        if walk is None:
+            return None
+
+        def evaluate(stack, x):
+            seen.append((prob.model, np.array(x[:, : prob.model.n_vars])))
+            return walk(stack, x)
+
+        return evaluate
+
     monkeypatch.setattr(IKModel, "trig", trig)
+    monkeypatch.setattr(S, "batch_evaluator", batch_evaluator)
     return seen
 
 
