@@ -582,6 +582,25 @@ def MotionBlock(_d, _f, FACTORY):
     return __init__, __repr__, __eq__
 
 
+def GoalSpec(_d, _f, FACTORY):
+    def __init__(self, pos, kind, point, target, normal):
+        self.pos = pos
+        self.kind = kind
+        self.point = point
+        self.target = target
+        self.normal = normal
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(pos={self.pos!r}, kind={self.kind!r}, point={self.point!r}, target={self.target!r}, normal={self.normal!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.pos,self.kind,self.point,self.target,self.normal,) == (other.pos,other.kind,other.point,other.target,other.normal,)
+        return NotImplemented
+
+    return __init__, __repr__, __eq__
+
+
 def Goal(_d, _f, FACTORY):
     def __init__(self, pos, kind, link, joint, point, target, normal, weight):
         self.pos = pos
@@ -599,6 +618,23 @@ def Goal(_d, _f, FACTORY):
     def __eq__(self, other):
         if other.__class__ is self.__class__:
             return (self.pos,self.kind,self.link,self.joint,self.point,self.target,self.normal,self.weight,) == (other.pos,other.kind,other.link,other.joint,other.point,other.target,other.normal,other.weight,)
+        return NotImplemented
+
+    return __init__, __repr__, __eq__
+
+
+def Option(_d, _f, FACTORY):
+    def __init__(self, pos, word, value):
+        self.pos = pos
+        self.word = word
+        self.value = value
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(pos={self.pos!r}, word={self.word!r}, value={self.value!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.pos,self.word,self.value,) == (other.pos,other.word,other.value,)
         return NotImplemented
 
     return __init__, __repr__, __eq__
@@ -1053,7 +1089,9 @@ MAKERS = {
     'MotionJoint': ((('pos', 'required', 'Pos'), ('joint', 'required', 'Node'), ('start', 'required', 'list | None'), ('keyframes', 'required', 'list')), MotionJoint, "MotionJoint(pos: 'Pos', joint: 'Node', start: 'list | None', keyframes: 'list')"),
     'MotionTable': ((('pos', 'required', 'Pos'), ('columns', 'required', 'list'), ('rows', 'required', 'str'), ('rows_pos', 'required', 'Pos'), ('data', 'default', 'object')), MotionTable, "MotionTable(pos: 'Pos', columns: 'list', rows: 'str', rows_pos: 'Pos', data: 'object' = None)"),
     'MotionBlock': ((('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('joints', 'required', 'list'), ('tables', 'factory', 'list')), MotionBlock, "MotionBlock(pos: 'Pos', name: 'Name', joints: 'list', tables: 'list' = <factory>)"),
+    'GoalSpec': ((('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('point', 'required', 'Node | None'), ('target', 'required', 'Node | None'), ('normal', 'required', 'Node | None')), GoalSpec, "GoalSpec(pos: 'Pos', kind: 'str', point: 'Node | None', target: 'Node | None', normal: 'Node | None')"),
     'Goal': ((('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('link', 'required', 'Name | None'), ('joint', 'required', 'Node | None'), ('point', 'required', 'Node | None'), ('target', 'required', 'Node | None'), ('normal', 'required', 'Node | None'), ('weight', 'required', 'Node | None')), Goal, "Goal(pos: 'Pos', kind: 'str', link: 'Name | None', joint: 'Node | None', point: 'Node | None', target: 'Node | None', normal: 'Node | None', weight: 'Node | None')"),
+    'Option': ((('pos', 'required', 'Pos'), ('word', 'required', 'str'), ('value', 'required', 'Node')), Option, "Option(pos: 'Pos', word: 'str', value: 'Node')"),
     'ReachBlock': ((('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('model', 'required', 'Node'), ('frames', 'required', 'Node'), ('method', 'required', 'Name | None'), ('start', 'required', 'Node | None'), ('goals', 'required', 'list'), ('joints', 'default', 'list | None'), ('chain', 'default', 'Node | None'), ('translate', 'default', 'Name | None'), ('solver', 'default', 'Name | None'), ('tolerance', 'default', 'Node | None'), ('iterations', 'default', 'Node | None'), ('options', 'factory', 'dict')), ReachBlock, "ReachBlock(pos: 'Pos', name: 'Name', model: 'Node', frames: 'Node', method: 'Name | None', start: 'Node | None', goals: 'list', joints: 'list | None' = None, chain: 'Node | None' = None, translate: 'Name | None' = None, solver: 'Name | None' = None, tolerance: 'Node | None' = None, iterations: 'Node | None' = None, options: 'dict' = <factory>)"),
     'FigureStmt': ((('pos', 'required', 'Pos'), ('model', 'required', 'Name'), ('kind', 'required', 'str | None'), ('link', 'default', 'Name | None'), ('joint', 'default', 'Node | None')), FigureStmt, "FigureStmt(pos: 'Pos', model: 'Name', kind: 'str | None', link: 'Name | None' = None, joint: 'Node | None' = None)"),
     'Scene': ((('pos', 'required', 'Pos'), ('scene_id', 'required', 'Node'), ('init', 'required', 'list'), ('length', 'required', 'Node'), ('sameframe', 'required', 'Node | None'), ('body', 'required', 'list'), ('start_pos', 'default', 'Pos')), Scene, "Scene(pos: 'Pos', scene_id: 'Node', init: 'list', length: 'Node', sameframe: 'Node | None', body: 'list', start_pos: 'Pos' = Pos(line=0, column=0, end_line=0, end_column=0))"),

@@ -5,15 +5,27 @@ Every node is a small dataclass with a :class:`Pos` (made by
 (the language is case-insensitive) and numbers are already converted. The
 tree is produced by :mod:`liganimate.lang.transform` while the LALR parser
 runs, so building it never recurses.
+
+Every statement's node, and each node its parts are made of, is declared
+once, here, as pycparser declares its node shapes once: ``@syntax(rule,
+field=reader, ...)`` names the grammar rule (lang/lig.lark) that makes it and
+how each field is read from the rule's children (lang/syntax.py), and the
+transformer is made from that. A field also says what the other passes
+need to know of it: the names a statement binds (``binds``, read by
+lang/bindings.py) and the statement lists it holds (``holds``, read by
+lang/visitor.py's ``BLOCKS``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from dataclasses import MISSING, dataclass, field, fields
 from typing import Any, Self
 
+from . import syntax as R
 from .node_methods import node
+from .numbers import literal
+from .syntax import SYNTAX, Syntax, upper_name, value_rule
 from .vocabulary import NUMBER, Type
 
 _M12, _M24, _M28, _M32, _M64 = (1 << 12) - 1, (1 << 24) - 1, (1 << 28) - 1, (1 << 32) - 1, (1 << 64) - 1
@@ -153,6 +165,77 @@ class Node:
     pos: Pos
 
 
+# ------------------------------------------------------------ declarations
+
+
+def syntax(rule: str, pos: R.Reader | None = None, **readers: R.Reader) -> Callable[[type], type]:
+    """Declare that grammar rule ``rule`` makes the decorated node class (put it above ``@node``).
+
+    Parameters
+    ----------
+    rule : str
+        The rule or alias of lang/lig.lark; a class may be made by several.
+    pos : Reader, optional
+        How the node's position is read (lang/syntax.py); by default the
+        span of all the rule's children.
+    **readers : Reader
+        How each field is read; a field not named here is read by the
+        reader its own declaration gives (:func:`read`, :func:`part`), or
+        keeps its default, or else takes the next value (``R.value()``).
+    """
+
+    def register(cls: type) -> type:
+        chosen = []
+        for f in fields(cls):
+            if f.name == "pos":
+                continue
+            reader = readers.get(f.name) or f.metadata.get("read")
+            if reader is None and "part" in f.metadata:
+                reader = R.rest() if f.metadata["part"].many else R.value()
+            if reader is None:
+                if f.default is not MISSING:
+                    reader = R.const(f.default)
+                elif f.default_factory is not MISSING:
+                    reader = R.factory(f.default_factory)
+                else:
+                    reader = R.value()
+            chosen.append((f.name, reader))
+        unknown = set(readers) - {name for name, _ in chosen}
+        assert not unknown and rule not in SYNTAX, (rule, unknown)
+        SYNTAX[rule] = Syntax(rule, cls, tuple(chosen), pos)
+        return cls
+
+    return register
+
+
+def read(reader: R.Reader | None = None, *, binds: str | None = None, holds: bool = False) -> dict[str, Any]:
+    """A field's metadata: read by ``reader``, binding names (``binds``) or holding statements (``holds``).
+
+    Write ``field(metadata=read(...))``. ``binds`` is "assigns" (the
+    statement gives the names a value), "figure" (FIGURE's new value of its
+    model, which some questions leave out) or "declares" (a declaration: a
+    type, no value).
+    """
+    metadata: dict[str, Any] = {"read": reader} if reader is not None else {}
+    if binds is not None:
+        metadata["binds"] = binds
+    if holds:
+        metadata["holds"] = True
+    return metadata
+
+
+def statement_fields(key: str) -> dict[type, tuple[tuple[str, Any], ...]]:
+    """Each node class with fields that declare ``key`` ("binds", "holds") -> those fields and what they say, in order."""
+    found: dict[type, tuple[tuple[str, Any], ...]] = {}
+    # The module's classes, not Node.__subclasses__(): a slots dataclass leaves the class it replaced behind.
+    for cls in list(globals().values()):
+        if isinstance(cls, type) and issubclass(cls, Node):
+            marked = tuple((f.name, f.metadata[key]) for f in fields(cls) if key in f.metadata)
+            if marked:
+                found[cls] = marked
+    return found
+
+
 # --------------------------------------------------------------- expressions
 
 
@@ -218,6 +301,16 @@ class PrimCall(Node):
     clauses: list
 
 
+# JOINT's AXIS part: ("AXIS", the direction).
+value_rule("joint_axis", R.const("AXIS"), R.value())
+
+
+# What follows the word JOINT (in a JOINT statement and a JOINT expression):
+# (the expressions, whether SLIDE is written, the AXIS direction or None).
+value_rule("joint_args", R.rest(of=Node), R.flag("SLIDE"), R.item(1))
+
+
+@syntax("joint_expr", args=R.item(0), slide=R.item(1), axis=R.item(2))
 @node
 class JointExpr(Node):
     args: list
@@ -265,19 +358,51 @@ class Name(Node):
     name: str
 
 
+def AS_NAME(text: str, pos: Pos) -> Name:
+    """A name token's conversion (lang/syntax.py): a :class:`Name`, upper-cased."""
+    return Name(pos, upper_name(text))
+
+
+def AS_NUM(text: str, pos: Pos) -> Num:
+    """A number token's conversion: a :class:`Num`.
+
+    lang/numbers.py decides what a literal means; one outside the language's
+    numbers comes back marked, and the checker reports it.
+    """
+    return Num(pos, literal(text.rstrip("°")), text)
+
+
+def AS_LABEL(text: str, pos: Pos) -> int | float:
+    """A DO label's conversion: the number's value."""
+    return AS_NUM(text, pos).value
+
+
+# The parts made of one token or a list of values.
+value_rule("decl_name", R.token("NAME", AS_NAME))
+value_rule("interpolate", R.token("NAME", AS_NAME))
+value_rule("position", R.rest())
+value_rule("block", R.rest())
+value_rule("table_column", R.value())
+value_rule("pattern", R.rest())
+value_rule("goal_link", R.token(("NAME", "NUMBER"), {"NAME": AS_NAME, "NUMBER": AS_NUM}))
+
+
+@syntax("declaration", type=R.token("TYPE_KW", lambda text, pos: Type(upper_name(text))))
 @node
 class Decl(Node):
     type: str  # a vocabulary.Type
-    names: list  # of Name
+    names: list = field(metadata=read(R.rest(), binds="declares"))  # of Name
 
 
+@syntax("assignment", op=R.token("ASSIGN_OP", R.TEXT))
 @node
 class Assign(Node):
-    target: Name
+    target: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     op: str  # = := :-
     value: Node
 
 
+@syntax("keyframe", position=R.value(), method=R.value())
 @node
 class Keyframe(Node):
     frame: Node
@@ -285,15 +410,17 @@ class Keyframe(Node):
     method: Name | None
 
 
+@syntax("keyframe_assign", op=R.token("ASSIGN_OP", R.TEXT))
 @node
 class KeyframeAssign(Node):
-    target: Name
+    target: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     joint: Node
     index: Node
     op: str
     keyframe: Keyframe
 
 
+@syntax("do_stmt", label=R.token("NUMBER", AS_LABEL), var=R.token("NAME", AS_NAME), step=R.value())
 @node
 class DoHeader(Node):
     """``DO label var = a, b[, step]`` before loops are grouped."""
@@ -305,6 +432,7 @@ class DoHeader(Node):
     step: Node | None
 
 
+@syntax("continue_stmt", label=R.token("NUMBER", AS_LABEL))
 @node
 class Continue(Node):
     label: int
@@ -312,22 +440,26 @@ class Continue(Node):
 
 @node
 class Do(Node):
+    """A DO loop, made from a DoHeader, the statements after it and its CONTINUE (lang/structure.py)."""
+
     label: int
-    var: Name
+    var: Name = field(metadata=read(binds="assigns"))
     start: Node
     stop: Node
     step: Node | None
-    body: list
+    body: list = field(metadata=read(holds=True))
     end_pos: Pos = NOWHERE
 
 
+@syntax("if_stmt")
 @node
 class If(Node):
     cond: Node
-    then: list
-    orelse: list | None
+    then: list = field(metadata=read(R.block(), holds=True))
+    orelse: list | None = field(metadata=read(R.block(), holds=True))
 
 
+@syntax("joint_stmt", args=R.item(0), slide=R.item(1), axis=R.item(2))
 @node
 class JointStmt(Node):
     args: list
@@ -335,12 +467,14 @@ class JointStmt(Node):
     axis: Node | None = None
 
 
+@syntax("model_block", joints=R.rest())
 @node
 class ModelBlock(Node):
-    name: Name
+    name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     joints: list  # of JointStmt
 
 
+@syntax("root_track", pos=R.where(1), orientation=R.flag("ORIENTATION"))
 @node
 class RootTrack(Node):
     """The word ROOT where a joint identifier stands: the motion's root-translation track.
@@ -359,6 +493,14 @@ class MorphTrack(Node):
     link: str  # the link's name, in capitals (a name of the model's, not a variable)
 
 
+@syntax("motion_joint", start=R.after("POSITION"), keyframes=R.rest(of=Keyframe))
+@syntax("motion_root", start=R.after("POSITION"), keyframes=R.rest(of=Keyframe))
+@syntax(
+    "motion_morph",
+    joint=R.made(MorphTrack, pos=R.where(3), kind=R.which(("SCALE", "SHAPE")), link=R.token("NAME", R.UPPER)),
+    start=R.after("POSITION"),
+    keyframes=R.rest(of=Keyframe),
+)
 @node
 class MotionJoint(Node):
     joint: Node  # RootTrack for the ROOT entry, MorphTrack for SCALE and SHAPE
@@ -366,6 +508,7 @@ class MotionJoint(Node):
     keyframes: list
 
 
+@syntax("motion_table", columns=R.rest(), rows=R.token("TABLE_ROWS", R.TEXT), rows_pos=R.token("TABLE_ROWS", R.POS))
 @node
 class MotionTable(Node):
     """``TABLE 1, 2, ROOT`` and its ``| frame x y z ...`` rows: keyframes of several tracks at once.
@@ -380,13 +523,37 @@ class MotionTable(Node):
     data: object = None
 
 
+@syntax("motion_block", joints=R.rest(of=MotionJoint), tables=R.rest(of=MotionTable))
 @node
 class MotionBlock(Node):
-    name: Name
+    name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     joints: list  # of MotionJoint
     tables: list = field(default_factory=list)  # of MotionTable
 
 
+@syntax("goal_point", kind=R.const("point"), point=R.after("AT"), target=R.after("TO"), normal=R.const(None))
+@syntax("goal_plane", kind=R.const("plane"), point=R.after("AT"), target=R.after("PLANE"), normal=R.after("NORMAL"))
+@syntax("goal_axis", kind=R.const("axis"), point=R.const(None), target=R.after("ALONG"), normal=R.after("AXIS_KW"))
+@node
+class GoalSpec(Node):
+    """Where a GOAL wants its link (the parser's part, not the tree's: :class:`Goal` copies it)."""
+
+    kind: str
+    point: Node | None
+    target: Node | None
+    normal: Node | None
+
+
+@syntax(
+    "reach_goal",
+    kind=R.inner(GoalSpec, "kind"),
+    link=R.value(of=Name),
+    joint=R.value(of=Num),
+    point=R.inner(GoalSpec, "point"),
+    target=R.inner(GoalSpec, "target"),
+    normal=R.inner(GoalSpec, "normal"),
+    weight=R.after("WEIGHT"),
+)
 @node
 class Goal(Node):
     """One goal of a REACH block: ``kind`` is "point", "plane" or "axis"."""
@@ -400,9 +567,35 @@ class Goal(Node):
     weight: Node | None
 
 
+@syntax("reach_move_joints", word=R.const("MOVE JOINTS"), value=R.rest())
+@syntax("reach_move_chain", word=R.const("MOVE CHAIN"))
+@syntax("reach_translate", word=R.const("TRANSLATE"), value=R.token("NAME", AS_NAME))
+@syntax("reach_solver", word=R.const("SOLVER"), value=R.token("NAME", AS_NAME))
+@syntax("reach_tolerance", word=R.const("TOLERANCE"))
+@syntax("reach_iterations", word=R.const("ITERATIONS"))
+@node
+class Option(Node):
+    """One option line of a block (REACH's MOVE JOINTS, SOLVER...): its block copies the value to a field of its own."""
+
+    word: str
+    value: Node
+
+
+@syntax(
+    "reach_block",
+    method=R.value(of=Name),
+    start=R.after("FROM"),
+    goals=R.rest(of=Goal),
+    joints=R.option("MOVE JOINTS"),
+    chain=R.option("MOVE CHAIN"),
+    solver=R.option("SOLVER"),
+    tolerance=R.option("TOLERANCE"),
+    iterations=R.option("ITERATIONS"),
+    options=R.options(),
+)
 @node
 class ReachBlock(Node):
-    name: Name
+    name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
     model: Node
     frames: Node
     method: Name | None
@@ -410,31 +603,36 @@ class ReachBlock(Node):
     goals: list  # of Goal
     joints: list | None = None  # MOVE JOINTS ...
     chain: Node | None = None  # MOVE CHAIN n
-    translate: Name | None = None  # TRANSLATE INTO v
+    translate: Name | None = field(
+        default=None, metadata=read(R.option("TRANSLATE"), binds="assigns")
+    )  # TRANSLATE INTO v
     solver: Name | None = None
     tolerance: Node | None = None
     iterations: Node | None = None
-    options: dict = field(default_factory=dict)  # option word -> Pos of its first use (for duplicates)
+    options: dict = field(default_factory=dict)  # option word -> Pos of each line that gives it (for duplicates)
 
 
+@syntax("figure_stmt", kind=R.which(("LINK", "JOINT")), link=R.after("LINK", AS_NAME), joint=R.after("JOINT"))
 @node
 class FigureStmt(Node):
-    model: Name
+    model: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="figure"))
     kind: str | None  # None, LINK or JOINT
     link: Name | None = None
     joint: Node | None = None
 
 
+@syntax("scene_block", length=R.after("LENGTH"), sameframe=R.after("SAMEFRAME"), start_pos=R.where(3))
 @node
 class Scene(Node):
     scene_id: Node
-    init: list
+    init: list = field(metadata=read(R.rest(until="STARTSCENE"), holds=True))
     length: Node
     sameframe: Node | None
-    body: list
+    body: list = field(metadata=read(R.rest(), holds=True))
     start_pos: Pos = NOWHERE
 
 
+@syntax("animate_stmt", model=R.token("NAME", AS_NAME), repeat=R.flag("REPEAT"))
 @node
 class Animate(Node):
     model: Name
@@ -444,17 +642,31 @@ class Animate(Node):
     repeat: bool
 
 
+@syntax("background_stmt", items=R.rest())
 @node
 class Background(Node):
     items: list
 
 
+def _dollar_name(text: str, pos: Pos) -> Name:
+    """``$NAME`` in a PRINT: the model's name, without the dollar sign (nor the caret under it)."""
+    return Name(Pos(pos.line, pos.column + 1, pos.end_line, pos.end_column, pos.start + 1, pos.end), text[1:].upper())
+
+
+@syntax("print_table", kind=R.const("table"), value=R.token("DOLLAR_NAME", _dollar_name))
+@syntax("print_text", kind=R.const("text"), value=R.token("STRING", R.UNQUOTE))
 @node
 class PrintItem(Node):
     kind: str  # value, table, text
     value: object  # Node for value, Name for table, str for text
 
 
+def _print_value(item: Node) -> PrintItem:
+    """An item of a PRINT that is an expression (a $ table and a text are PrintItems already)."""
+    return item if isinstance(item, PrintItem) else PrintItem(item.pos, "value", item)
+
+
+@syntax("print_stmt", items=R.rest(convert=_print_value))
 @node
 class Print(Node):
     items: list
@@ -462,13 +674,12 @@ class Print(Node):
 
 # ------------------------------------------------------- declared statements
 # A statement made of expressions that the runtime carries out is declared
-# once, here, as pycparser declares its node shapes once: the node's fields
-# are its parts in the grammar's order, each with the types it accepts, and
-# @declared names the grammar rule that makes it, where it may stand and the
-# runtime method that runs it. The transformer (lang/transform.py), the
-# checker (``_s_Declared``, compiler/statements.py) and the lowering
-# (``s_Declared``, compiler/lower.py, which emits ``rt.<runtime>(<parts>, at)``)
-# read the declaration; none of them names the statement.
+# with @declared: each field is one part, an expression of the types it
+# accepts, and @declared names the grammar rule, where it may stand and the
+# runtime method that runs it. The transformer, the checker and the lowering
+# (the rule of Declared, compiler/rules/declared.py, which emits
+# ``rt.<runtime>(<parts>, at)``) read the declaration; none of them names the
+# statement.
 
 #: Where a statement may stand: the program's top level (loops and IFs
 #: included), a scene's initialisation, a scene's body, a PRIMITIVE.
@@ -488,13 +699,13 @@ class Part:
 
 
 def part(*accepts: Type, what: str, many: bool = False) -> Any:
-    """The field of a declared statement's node that holds one :class:`Part`."""
+    """The field of a declared statement's node that holds one :class:`Part` (read in order, as :func:`syntax` does)."""
     return field(metadata={"part": Part(tuple(accepts), what, many)})
 
 
 @dataclass(frozen=True, slots=True)
 class Declaration:
-    """How a declared statement is read, checked and lowered (see :func:`declared`)."""
+    """How a declared statement is checked and lowered (see :func:`declared`)."""
 
     rule: str
     runtime: str
@@ -510,13 +721,13 @@ DECLARED: dict[type, Declaration] = {}
 
 @node
 class Declared(Node):
-    """Base of the declared statements (the passes dispatch on it when a node has no method of its own)."""
+    """Base of the declared statements (compiler/rules/declared.py is the rule of them all)."""
 
 
 def declared(
     rule: str, runtime: str, places: frozenset[str] = PLACES, misplaced: str = "", hint: str | None = None
 ) -> Callable[[type], type]:
-    """Declare a statement: register the node class it decorates.
+    """Declare a statement: register the node class it decorates (and its :func:`syntax`).
 
     Parameters
     ----------
@@ -539,7 +750,7 @@ def declared(
         # Only the last part may take the rest of the children.
         assert all(not p.many for _, p in parts[:-1]), cls.__name__
         DECLARED[cls] = Declaration(rule, runtime, places, misplaced, hint, parts)
-        return cls
+        return syntax(rule)(cls)
 
     return register
 
@@ -570,31 +781,42 @@ class ShootRange(Shoot):
     last: Node = part(Type.INTEGER, what="the last scene to shoot")
 
 
+@syntax("stop_stmt")
 @node
 class Stop(Node):
     pass
 
 
+@syntax("return_stmt")
 @node
 class Return(Node):
     pass
 
 
+@syntax("program_end")
 @node
 class ProgramEnd(Node):
     pass
 
 
+@syntax("draw_with", pos=R.through("modifiers"), modifiers=R.value(convert=lambda mods: mods[1:-1]))
 @node
 class DrawWith(Node):
     modifiers: list
 
 
+@syntax("draw_poly", points=R.rest())
 @node
 class DrawPoly(Node):
     points: list
 
 
+@syntax(
+    "load_stmt",
+    library=R.token("STRING", R.UNQUOTE),
+    library_pos=R.token("STRING", R.POS),
+    names=R.token(("NAME", "PRIM_NAME"), AS_NAME, many=True),
+)
 @node
 class Load(Node):
     library: str  # as written, without its quotes
@@ -602,32 +824,41 @@ class Load(Node):
     names: list  # of Name; empty means the library's models, motions, graphics and primitives
 
 
+@syntax("pat_word", word=R.token("STRING", lambda text, pos: text[1:-1].strip().upper()))
 @node
 class PatWord(Node):
     word: str
 
 
+@syntax("pat_param", name=R.token("NAME", R.UPPER))
 @node
 class PatParam(Node):
     name: str
 
 
+# A default of a PRIMITIVE's optional part: (its parameter's Name, the expression).
+value_rule("pat_default", R.token("NAME", AS_NAME), R.value())
+
+
+@syntax("pat_optional", defaults=R.rest())
 @node
 class PatOptional(Node):
     items: list
     defaults: list  # of (Name, expr)
 
 
+@syntax("pattern_def", name=R.token(("NAME", "PRIM_NAME"), R.UPPER))
 @node
 class PatternDef(Node):
     name: str
     items: list
 
 
+@syntax("primitive_def", name=R.token(("NAME", "PRIM_NAME"), AS_NAME), pattern=R.find(PatternDef))
 @node
 class PrimitiveDef(Node):
     name: Name
-    body: list
+    body: list = field(metadata=read(R.rest(), holds=True))
     pattern: PatternDef | None = None
 
 

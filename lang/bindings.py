@@ -34,10 +34,12 @@ def plain_name(e) -> str | None:
 def assigned(stmt, figure: bool = True) -> list:
     """The names (``A.Name`` nodes) ``stmt`` and the statements inside it assign, in source order.
 
-    An assignment, a keyframe assignment, a STARTMODEL, STARTMOTION or
-    STARTREACH block (and its TRANSLATE INTO vector), a DO variable; and a
-    FIGURE statement, which gives its model a new value, unless ``figure``
-    is false. Declarations are not assignments (see :func:`defined`).
+    The fields lang/ast.py declares ``binds="assigns"`` (an assignment, a
+    keyframe assignment, a STARTMODEL, STARTMOTION or STARTREACH block and
+    its TRANSLATE INTO vector, a DO variable), and ``binds="figure"`` (a
+    FIGURE statement, which gives its model a new value) unless ``figure``
+    is false. Declarations (``binds="declares"``) are not assignments (see
+    :func:`defined`).
     """
     return [n for s in walk_statements(stmt) for n in _binds(s, figure, False)]
 
@@ -59,19 +61,22 @@ def walk_statements(stmt):
                 stack.extend(reversed(getattr(s, name) or ()))
 
 
+#: Each statement that binds names -> its fields that do, and how (lang/ast.py's ``binds=``).
+_BINDS = A.statement_fields("binds")
+
+
 def _binds(s, figure: bool, decl: bool) -> tuple:
     """The names statement ``s`` itself binds (not those of statements inside it)."""
-    kind = type(s)
-    if kind is A.Assign or kind is A.KeyframeAssign:
-        return (s.target,)
-    if kind is A.ModelBlock or kind is A.MotionBlock:
-        return (s.name,)
-    if kind is A.ReachBlock:
-        return (s.name,) if s.translate is None else (s.name, s.translate)
-    if kind is A.Do:
-        return (s.var,)
-    if kind is A.FigureStmt and figure:
-        return (s.model,)
-    if kind is A.Decl and decl:
-        return tuple(s.names)
-    return ()
+    marked = _BINDS.get(type(s))
+    if not marked:
+        return ()
+    names: list = []
+    for field, kind in marked:
+        if (kind == "figure" and not figure) or (kind == "declares" and not decl):
+            continue
+        value = getattr(s, field)
+        if isinstance(value, list):
+            names.extend(value)
+        elif value is not None:
+            names.append(value)
+    return tuple(names)

@@ -128,7 +128,7 @@ def _makers() -> dict:
 _C = TypeVar("_C", bound=type)
 
 
-@dataclass_transform()
+@dataclass_transform(field_specifiers=(dataclasses.field,))  # field(metadata=...) is no default
 def node(cls: _C) -> _C:
     """``@dataclass(slots=True)``, with the methods written out in lang/_node_methods.py."""
     made: Any = _makers().get(cls.__qualname__)

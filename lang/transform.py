@@ -1,5 +1,11 @@
 """The Lark transformer: one method per grammar rule, producing :mod:`.ast` nodes.
 
+The methods of the statements and their parts are made from their
+declarations in lang/ast.py (``@syntax``, read by lang/syntax.py's readers);
+the modifiers' and operators' from lang/vocabulary.py's tables. Written here
+by hand are only the expressions' and the shared helpers (positions and
+spans, parentheses and signs).
+
 It runs inside the LALR parser (Lark's ``transformer=`` option), so the tree
 is built bottom-up in the parser's own loop, without recursion and without
 an intermediate parse tree.
@@ -10,9 +16,10 @@ from __future__ import annotations
 from lark import Token, Transformer
 
 from . import ast as A
+from . import syntax as R
 from .lexer import Tok
-from .numbers import literal
-from .vocabulary import MODIFIERS, OPERATORS, Type
+from .syntax import upper_name
+from .vocabulary import MODIFIERS, OPERATORS
 
 #: What a terminal is in the children: our parser's Tok, or a Token from Lark's own loop.
 TOKENS = (Token, Tok)
@@ -91,29 +98,8 @@ def _nodes(children):
     return [c for c in children if not isinstance(c, TOKENS)]
 
 
-#: One string per distinct upper-cased name: a million ``X = 1`` lines share one "X".
-_NAMES: dict = {}
-
-
-def upper_name(text: str) -> str:
-    """``text`` upper-cased, the same string object for every spelling of one name."""
-    name = _NAMES.get(text)
-    if name is None:
-        name = text.upper()
-        if len(_NAMES) < 1 << 16:  # a bound, for programs of endless distinct names
-            name = _NAMES.setdefault(name, name)
-            _NAMES[text] = name
-    return name
-
-
-def _name(tok: Token) -> A.Name:
+def _name(tok: Token | Tok) -> A.Name:
     return A.Name(_tpos(tok), upper_name(tok.value))
-
-
-def _number(tok: Token) -> A.Num:
-    # lang/numbers.py decides what a literal means; one outside the
-    # language's numbers comes back marked, and the checker reports it.
-    return A.Num(_tpos(tok), literal(tok.value.rstrip("°")), tok.value)
 
 
 class ToAst(Transformer):
@@ -123,320 +109,7 @@ class ToAst(Transformer):
     def start(self, children):
         return [c for c in children if not isinstance(c, TOKENS)]
 
-    def program_end(self, children):
-        return A.ProgramEnd(span(children))
-
-    # --------------------------------------------------------- statements
-    def declaration(self, children):
-        kw = children[0]
-        return A.Decl(span(children), Type(upper_name(kw.value)), _nodes(children))
-
-    def decl_name(self, children):
-        return _name(children[0])
-
-    def assignment(self, children):
-        target, op, value = children
-        return A.Assign(span(children), _name(target), op.value, value)
-
-    def keyframe_assign(self, children):
-        target, joint, index, op, keyframe = children
-        return A.KeyframeAssign(span(children), _name(target), joint, index, op.value, keyframe)
-
-    def keyframe(self, children):
-        rest = _nodes(children)
-        frame, position = rest[0], rest[1]
-        method = rest[2] if len(rest) > 2 else None
-        return A.Keyframe(span(children), frame, position, method)
-
-    def position(self, children):
-        return list(children)
-
-    # ------------------------------------------------------------- REACH
-    def reach_block(self, children):
-        name, model, frames = _name(children[1]), children[3], children[5]
-        method = start = None
-        items = []
-        i = 6
-        while i < len(children):
-            c = children[i]
-            if isinstance(c, A.Name) and method is None and not items and start is None:
-                method = c
-            elif isinstance(c, TOKENS) and c.type == "FROM":
-                start = children[i + 1]
-                i += 1
-            elif isinstance(c, tuple) and not isinstance(c, Tok):  # a reach item (a Tok is a tuple too)
-                items.append(c)
-            i += 1
-        block = A.ReachBlock(span(children), name, model, frames, method, start, [])
-        for word, pos, value in items:
-            block.options.setdefault(word, []).append(pos)
-            if word == "GOAL":
-                block.goals.append(value)
-            elif word == "MOVE JOINTS":
-                block.joints = value
-            elif word == "MOVE CHAIN":
-                block.chain = value
-            elif word == "TRANSLATE":
-                block.translate = value
-            elif word == "SOLVER":
-                block.solver = value
-            elif word == "TOLERANCE":
-                block.tolerance = value
-            elif word == "ITERATIONS":
-                block.iterations = value
-        return block
-
-    def reach_goal(self, children):
-        link, spec = children[1], children[2]
-        kind, point, target, normal = spec
-        weight = children[4] if len(children) > 3 else None
-        last = max(
-            (n for n in (weight, target, normal) if n is not None), key=lambda n: (n.pos.end_line, n.pos.end_column)
-        )
-        goal = A.Goal(
-            _tpos(children[0]).to(last.pos),
-            kind,
-            link if isinstance(link, A.Name) else None,
-            None if isinstance(link, A.Name) else link,
-            point,
-            target,
-            normal,
-            weight,
-        )
-        return ("GOAL", goal.pos, goal)
-
-    def goal_link(self, children):
-        if len(children) == 1:
-            return _name(children[0])
-        return _number(children[1])
-
-    def goal_point(self, children):
-        point = children[1] if len(children) == 4 else None
-        return ("point", point, children[-1], None)
-
-    def goal_plane(self, children):
-        point = children[1] if len(children) == 7 else None
-        return ("plane", point, children[-3], children[-1])
-
-    def goal_axis(self, children):
-        return ("axis", None, children[3], children[1])
-
-    def reach_move_joints(self, children):
-        return ("MOVE JOINTS", span(children), [c for c in children[2:] if not isinstance(c, TOKENS)])
-
-    def reach_move_chain(self, children):
-        return ("MOVE CHAIN", span(children), children[2])
-
-    def reach_translate(self, children):
-        return ("TRANSLATE", span(children), _name(children[2]))
-
-    def reach_solver(self, children):
-        return ("SOLVER", span(children), _name(children[1]))
-
-    def reach_tolerance(self, children):
-        return ("TOLERANCE", span(children), children[1])
-
-    def reach_iterations(self, children):
-        return ("ITERATIONS", span(children), children[1])
-
-    def interpolate(self, children):
-        return _name(children[1])
-
-    def do_stmt(self, children):
-        label = _number(children[1])
-        var = _name(children[2])
-        exprs = children[3:]
-        step = exprs[2] if len(exprs) > 2 else None
-        return A.DoHeader(span(children), label.value, var, exprs[0], exprs[1], step)
-
-    def continue_stmt(self, children):
-        label = _number(children[0])
-        return A.Continue(span(children), label.value)
-
-    def if_stmt(self, children):
-        cond = children[1]
-        branches = [c for c in children[3:] if not isinstance(c, TOKENS)]
-        then = branches[0] if isinstance(branches[0], list) else [branches[0]]
-        orelse = None
-        if len(branches) > 1:
-            orelse = branches[1] if isinstance(branches[1], list) else [branches[1]]
-        return A.If(span(children), cond, then, orelse)
-
-    def block(self, children):
-        return _nodes(children)
-
-    def model_block(self, children):
-        return A.ModelBlock(span(children), _name(children[1]), _nodes(children[2:]))
-
-    def joint_stmt(self, children):
-        args, slide, axis = children[1]
-        return A.JointStmt(span(children), args, slide, axis)
-
-    def motion_block(self, children):
-        items = _nodes(children[2:])
-        joints = [c for c in items if not isinstance(c, A.MotionTable)]
-        tables = [c for c in items if isinstance(c, A.MotionTable)]
-        return A.MotionBlock(span(children), _name(children[1]), joints, tables)
-
-    def motion_table(self, children):
-        rows = children[-1]
-        columns = [c for c in children[1:-1] if not isinstance(c, TOKENS)]
-        return A.MotionTable(span(children), columns, rows.value, _tpos(rows))
-
-    def table_column(self, children):
-        return children[0]
-
-    def root_track(self, children):
-        return A.RootTrack(_tpos(children[0]), len(children) > 1)
-
-    def motion_joint(self, children):
-        joint = children[1]
-        start = None
-        keyframes = []
-        i = 2
-        while i < len(children):
-            c = children[i]
-            if isinstance(c, TOKENS) and c.type == "POSITION":
-                start = children[i + 1]
-                i += 2
-                continue
-            if isinstance(c, A.Keyframe):
-                keyframes.append(c)
-            i += 1
-        return A.MotionJoint(span(children), joint, start, keyframes)
-
-    def motion_root(self, children):
-        joint = A.MotionJoint(span(children), children[0], None, [])
-        rest = self.motion_joint([children[0], None] + list(children[1:]))
-        joint.start, joint.keyframes = rest.start, rest.keyframes
-        return joint
-
-    def motion_morph(self, children):
-        track = A.MorphTrack(span(children[:3]), upper_name(children[0].value), upper_name(children[2].value))
-        joint = A.MotionJoint(span(children), track, None, [])
-        rest = self.motion_joint([children[0], None] + list(children[3:]))
-        joint.start, joint.keyframes = rest.start, rest.keyframes
-        return joint
-
-    def figure_stmt(self, children):
-        model = _name(children[1])
-        if len(children) <= 3:
-            return A.FigureStmt(span(children), model, None)
-        kind = children[3].type
-        if kind == "LINK":
-            return A.FigureStmt(span(children), model, "LINK", link=_name(children[4]))
-        return A.FigureStmt(span(children), model, "JOINT", joint=children[4])
-
-    def scene_block(self, children):
-        at = next(i for i, c in enumerate(children) if isinstance(c, TOKENS) and c.type == "STARTSCENE")
-        init = _nodes(children[3:at])
-        length = children[at + 2]
-        rest = at + 3
-        sameframe = None
-        if rest < len(children) and isinstance(children[rest], TOKENS) and children[rest].type == "SAMEFRAME":
-            sameframe = children[rest + 1]
-            rest += 2
-        body = _nodes(children[rest:])
-        return A.Scene(span(children), children[2], init, length, sameframe, body, span(children[:3]))
-
-    def animate_stmt(self, children):
-        repeat = isinstance(children[-1], TOKENS) and children[-1].type == "REPEAT"
-        return A.Animate(span(children), _name(children[1]), children[3], children[5], children[7], repeat)
-
-    def background_stmt(self, children):
-        return A.Background(span(children), _nodes(children))
-
-    def print_stmt(self, children):
-        items = []
-        for c in children[1:]:
-            if isinstance(c, A.PrintItem):
-                items.append(c)
-            else:
-                items.append(A.PrintItem(c.pos, "value", c))
-        return A.Print(span(children), items)
-
-    def print_table(self, children):
-        tok = children[0]
-        pos = _tpos(tok)
-        return A.PrintItem(
-            pos,
-            "table",
-            A.Name(
-                A.Pos(pos.line, pos.column + 1, pos.end_line, pos.end_column, pos.start + 1, pos.end),
-                tok.value[1:].upper(),
-            ),
-        )
-
-    def print_text(self, children):
-        tok = children[0]
-        return A.PrintItem(_tpos(tok), "text", tok.value[1:-1])
-
-    def load_stmt(self, children):
-        lib = children[-1]
-        names = [_name(t) for t in children[1:-1] if t.type in ("NAME", "PRIM_NAME")]
-        return A.Load(span(children), lib.value[1:-1], _tpos(lib), names)
-
-    def stop_stmt(self, children):
-        return A.Stop(span(children))
-
-    def return_stmt(self, children):
-        return A.Return(span(children))
-
-    def draw_with(self, children):
-        draw, with_, (_lt, *mods, _gt) = children
-        return A.DrawWith(span([draw, with_, mods]), mods)
-
-    def draw_poly(self, children):
-        return A.DrawPoly(span(children), _nodes(children))
-
-    # --------------------------------------------------------- primitives
-    def primitive_def(self, children):
-        name = _name(children[1])
-        body, pattern = [], None
-        for c in children[2:]:
-            if isinstance(c, TOKENS):
-                continue
-            if isinstance(c, A.PatternDef):
-                pattern = c if pattern is None else pattern
-                body.append(c)
-            else:
-                body.append(c)
-        return A.PrimitiveDef(span(children), name, body, pattern)
-
-    def pattern_def(self, children):
-        return A.PatternDef(span(children), upper_name(children[0].value), children[1])
-
-    def pattern(self, children):
-        return list(children)
-
-    def pat_word(self, children):
-        tok = children[0]
-        return A.PatWord(_tpos(tok), tok.value[1:-1].strip().upper())
-
-    def pat_param(self, children):
-        tok = children[0]
-        return A.PatParam(_tpos(tok), upper_name(tok.value))
-
-    def pat_optional(self, children):
-        return A.PatOptional(span(children), children[0], list(children[1:]))
-
-    def pat_default(self, children):
-        return (_name(children[0]), children[1])
-
     # -------------------------------------------------------- expressions
-    def joint_expr(self, children):
-        args, slide, axis = children[1]
-        return A.JointExpr(span(children), args, slide, axis)
-
-    def joint_args(self, children):
-        # (the expressions, whether SLIDE was written, the AXIS expression or None)
-        slide = any(type(c) is Tok and c[0] == "SLIDE" for c in children)
-        axis = children[-1][1] if children and type(children[-1]) is tuple else None  # from joint_axis
-        return [c for c in children if isinstance(c, A.Node)], slide, axis
-
-    def joint_axis(self, children):
-        return ("AXIS", children[1])
-
     def strip_expr(self, children):
         return A.Strip(span(children), children[1], list(children[2:]))
 
@@ -473,7 +146,8 @@ class ToAst(Transformer):
         return A.Modified(pos, target, mods)
 
     def number(self, children):
-        return _number(children[0])
+        tok = children[0]
+        return A.AS_NUM(tok.value, _tpos(tok))
 
     def var(self, children):
         tok = children[0]
@@ -554,21 +228,288 @@ for _op in OPERATORS:
     setattr(ToAst, _op.rule, _operator_rule(_op.rule, _op.symbol))
 
 
-def _declared_rule(cls: type, declaration: A.Declaration):
-    """The transformer method of a declared statement: its children, keywords dropped, are its parts in order."""
-    many = bool(declaration.parts) and declaration.parts[-1][1].many
-    count = len(declaration.parts)
+# ------------------------------------------------------------- declared rules
+# Every statement, and every part of one, is declared in lang/ast.py
+# (``@syntax`` and ``value_rule``): its rule's method is made here from the
+# readers the declaration names (lang/syntax.py). A reader is compiled once
+# into a function of the children and the set of the value children taken
+# so far (``taken``, their indices).
 
-    def rule(self, children):
-        values = _nodes(children)
-        if many:
-            values = [*values[: count - 1], values[count - 1 :]]
-        return cls(span(children), *values)
 
-    rule.__name__ = declaration.rule
+#: The classes of a token: our parser's Tok, Lark's Token (from its own loop, in the stock reference parser).
+_TOKEN_TYPES = frozenset((Tok, Token))
+
+
+def _is_token(c) -> bool:
+    return type(c) in _TOKEN_TYPES
+
+
+def _type(c) -> str:
+    return c[0] if type(c) is Tok else c.type
+
+
+def _converted(tok, convert, table: dict):
+    """A token through its reader's conversion (by its type, when the reader has a table)."""
+    f = table.get(_type(tok), convert) if table else convert
+    return f(tok.value, _tpos(tok))
+
+
+def _next_value(children, taken: set, of=None):
+    """The index of the first value child not taken (None if none, or if ``of`` is given and it is not one)."""
+    tokens = _TOKEN_TYPES
+    for i, c in enumerate(children):
+        if type(c) not in tokens and i not in taken:
+            return i if of is None or isinstance(c, of) else None
+    return None
+
+
+def _value(r: R.Reader):
+    of, convert, tokens = r.of, r.convert, _TOKEN_TYPES
+
+    def read(children, taken):
+        # The usual case inline (every assignment's value): the next value, no type asked, no conversion.
+        for i, c in enumerate(children):
+            if type(c) not in tokens and i not in taken:
+                if of is not None and not isinstance(c, of):
+                    return None
+                taken.add(i)
+                return c if convert is None else convert(c)
+        return None
+
+    return read
+
+
+def _rest(r: R.Reader):
+    of, until, convert = r.of, r.until, r.convert
+
+    def read(children, taken):
+        out = []
+        for i, c in enumerate(children):
+            if _is_token(c):
+                if until is not None and _type(c) == until:
+                    break
+            elif i not in taken and (of is None or isinstance(c, of)):
+                taken.add(i)
+                out.append(c if convert is None else convert(c))
+        return out
+
+    return read
+
+
+def _block(r: R.Reader):
+    def read(children, taken):
+        i = _next_value(children, taken)
+        if i is None:
+            return None
+        taken.add(i)
+        c = children[i]
+        return c if isinstance(c, list) else [c]
+
+    return read
+
+
+def _after(r: R.Reader):
+    types, convert = r.types, r.convert
+
+    def read(children, taken):
+        for i, c in enumerate(children):
+            if _is_token(c) and _type(c) in types:
+                if i + 1 >= len(children):
+                    return None
+                taken.add(i + 1)
+                value = children[i + 1]
+                return _converted(value, convert, {}) if convert is not None and _is_token(value) else value
+        return None
+
+    return read
+
+
+def _token(r: R.Reader):
+    types, convert, table, many = r.types, r.convert, dict(r.table), r.many
+    if many:
+        return lambda children, taken: [
+            _converted(c, convert, table) for c in children if _is_token(c) and _type(c) in types
+        ]
+    if len(types) == 1 and not table:
+        (kind,) = types
+
+        def read_one(children, taken):
+            for c in children:
+                if type(c) is Tok:
+                    if c[0] == kind:
+                        return convert(c[1], A.token_pos(c[3], c[4], c[5], c[2], c[6]))
+                elif type(c) is Token and c.type == kind:
+                    return convert(c.value, _tpos(c))
+            return None
+
+        return read_one
+
+    def read(children, taken):
+        for c in children:
+            if _is_token(c) and _type(c) in types:
+                return _converted(c, convert, table)
+        return None
+
+    return read
+
+
+def _flag(r: R.Reader):
+    types = r.types
+    return lambda children, taken: any(_is_token(c) and _type(c) in types for c in children)
+
+
+def _which(r: R.Reader):
+    table, default = dict(r.table), r.default
+
+    def read(children, taken):
+        return next((table[_type(c)] for c in children if _is_token(c) and _type(c) in table), default)
+
+    return read
+
+
+def _find(r: R.Reader):
+    of = r.of
+    return lambda children, taken: next((c for c in children if isinstance(c, of)), None)  # type: ignore[arg-type]
+
+
+def _inner(r: R.Reader):
+    of, name = r.of, r.types[0]
+
+    def read(children, taken):
+        c = next((c for c in children if isinstance(c, of)), None)
+        return None if c is None else getattr(c, name)
+
+    return read
+
+
+def _item(r: R.Reader):
+    k = r.default
+
+    def read(children, taken):
+        c = next((c for c in children if type(c) is tuple), None)
+        return None if c is None else c[k]
+
+    return read
+
+
+def _option(r: R.Reader):
+    word = r.types[0]
+
+    def read(children, taken):
+        found = [c.value for c in children if isinstance(c, A.Option) and c.word == word]
+        return found[-1] if found else None
+
+    return read
+
+
+def _options(r: R.Reader):
+    def read(children, taken):
+        places: dict = {}
+        for c in children:
+            if isinstance(c, A.Option):
+                places.setdefault(c.word, []).append(c.pos)
+        return places
+
+    return read
+
+
+def _made(r: R.Reader):
+    cls, make = r.of, _node_maker(r.of, r.table, r.default)  # type: ignore[arg-type]
+    assert cls is not None
+    return make
+
+
+_READERS = {
+    "value": _value,
+    "rest": _rest,
+    "block": _block,
+    "after": _after,
+    "token": _token,
+    "flag": _flag,
+    "which": _which,
+    "find": _find,
+    "inner": _inner,
+    "item": _item,
+    "option": _option,
+    "options": _options,
+    "made": _made,
+    "where": lambda r: lambda children, taken, n=r.default: span(children[:n]),
+    "const": lambda r: lambda children, taken, v=r.default: v,
+    "factory": lambda r: lambda children, taken, make=r.default: make(),
+}
+
+
+def _reader(r: R.Reader):
+    """The function ``(children, taken) -> value`` of reader ``r``."""
+    return _READERS[r.kind](r)
+
+
+def _position(r: R.Reader | None, names: tuple):
+    """The function ``(children, values) -> Pos`` of a position's reader (None: the span of all children)."""
+    if r is None:
+        return lambda children, values: span(children)
+    if r.kind == "where":
+        n = r.default
+        return lambda children, values: span(children[:n])
+    if r.kind == "through":
+        index = names.index(r.types[0])
+        return lambda children, values: span([children[0], values[index]])
+    read = _reader(r)
+    return lambda children, values: read(children, set())
+
+
+def _node_maker(cls: type, readers: tuple, pos: R.Reader | None):
+    """The function ``(children, taken) -> node`` of a node class and its fields' readers."""
+    reads = [_reader(r) for _, r in readers]
+    if pos is None and len(reads) <= 3:
+        # The common shapes spelt out (a million assignments are parsed through here):
+        # no list of values, and the span of all children.
+        if not reads:
+            return lambda children, taken: cls(span(children))
+        if len(reads) == 1:
+            (r0,) = reads
+            return lambda children, taken: cls(span(children), r0(children, taken))
+        if len(reads) == 2:
+            r0, r1 = reads
+            return lambda children, taken: cls(span(children), r0(children, taken), r1(children, taken))
+        r0, r1, r2 = reads
+        return lambda children, taken: cls(
+            span(children), r0(children, taken), r1(children, taken), r2(children, taken)
+        )
+    where = _position(pos, tuple(name for name, _ in readers))
+
+    def make(children, taken):
+        values = [read(children, taken) for read in reads]
+        return cls(where(children, values), *values)
+
+    return make
+
+
+def _syntax_rule(sx: R.Syntax):
+    """The transformer method of a declared rule (lang/ast.py)."""
+    if sx.cls is None:
+        reads = [_reader(r) for _, r in sx.readers]
+        if len(reads) == 1:
+            (one,) = reads
+
+            def rule(self, children):
+                return one(children, set())
+        else:
+
+            def rule(self, children):
+                taken: set = set()
+                return tuple(read(children, taken) for read in reads)
+    else:
+        make = _node_maker(sx.cls, sx.readers, sx.pos)
+
+        def rule(self, children):
+            return make(children, set())
+
+    rule.__name__ = sx.rule
     return rule
 
 
-# One method per declared statement of lang/ast.py: a new one needs no code here.
-for _cls, _declaration in A.DECLARED.items():
-    setattr(ToAst, _declaration.rule, _declared_rule(_cls, _declaration))
+# One method per declared rule of lang/ast.py: a new statement needs no code here.
+for _sx in R.SYNTAX.values():
+    assert not hasattr(ToAst, _sx.rule), f"{_sx.rule} is declared in lang/ast.py and written in ToAst"
+    setattr(ToAst, _sx.rule, _syntax_rule(_sx))

@@ -1,8 +1,9 @@
 """One way to walk the syntax tree: dispatch by node type, with generic children.
 
 Like Jinja2's ``NodeVisitor``: a pass names its methods after the node types
-they handle (``s_Assign`` for statements, ``e_BinOp`` for expressions: each
-pass chooses its prefixes), and :meth:`NodeVisitor.dispatch` finds the one
+they handle (``e_BinOp`` for the lowering's expressions, ``_e_BinOp`` for the
+checker's: each pass chooses its prefixes; statements have one rule each in
+compiler/rules/ instead), and :meth:`NodeVisitor.dispatch` finds the one
 for a node, once per type. A node type a pass does not handle is walked
 through: :meth:`NodeVisitor.generic_visit` visits its children
 (:func:`children`), so a new node type needs methods only in the passes
@@ -27,13 +28,9 @@ LEAVES: set = set()
 # Field annotations (strings: lang/ast.py postpones them) that never hold a node.
 _SCALAR = {"str", "int", "float", "bool", "Pos", "int | float", "str | None", "int | None", "float | None"}
 
-#: Statements that hold statements, and the fields that hold their statement lists, in source order.
-BLOCKS: dict = {
-    A.Do: ("body",),
-    A.If: ("then", "orelse"),
-    A.Scene: ("init", "body"),
-    A.PrimitiveDef: ("body",),
-}
+#: Statements that hold statements, and the fields that hold their statement lists, in source order
+#: (the fields lang/ast.py declares with ``holds=True``).
+BLOCKS: dict = {cls: tuple(name for name, _ in marked) for cls, marked in A.statement_fields("holds").items()}
 
 
 def _node_fields(cls) -> tuple:
@@ -117,8 +114,7 @@ class NodeVisitor:
             cache = self.__dict__["_methods"] = {}
         method = cache.get(key)
         if method is None:
-            # The node's own method, else one for a base class (``_s_Declared``
-            # handles every declared statement of lang/ast.py).
+            # The node's own method, else one for a base class.
             method = next(
                 (m for c in type(node).__mro__[:-1] if (m := getattr(self, prefix + c.__name__, None)) is not None),
                 None,

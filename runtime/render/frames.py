@@ -436,6 +436,7 @@ class Renderer:
             self.pool = self.executor
         if self.pool is None and self.workers > 1 and len(chunk) >= CHUNK:
             self.pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_init, initargs=(os.getpid(),))
+            _widen_result_pipe(self.pool)
             task = task.shipping(self._shipping.pick(shapes, self._in_flight()))
             # The first submit forks the workers.  With SIGINT and SIGTERM blocked
             # meanwhile, a signal cannot reach a worker before it has set itself to
@@ -636,6 +637,34 @@ def _signals_blocked():
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+# Bytes of the pipe the workers' results come back through (Linux; at most the system's pipe-max-size).
+_RESULT_PIPE = 1 << 20
+_F_SETPIPE_SZ = 1031
+
+
+def _widen_result_pipe(pool) -> None:
+    """Let a task's result (eight raw frames: 2.5 MB at 640x480 grey) cross the pipe in a few writes, not forty.
+
+    A pipe holds 64 kB by default, so the worker's writer and this
+    process's reader take turns, waking each other, about forty times a
+    task; with 1 MB, three.  Measured on the five humanoids to MP4 with two
+    workers (interleaved runs, load 5-7): 4.43 ms of CPU a frame against
+    4.62.  Best effort: elsewhere than Linux, or where the system allows
+    less, the pipe stays as it is.
+    """
+    if not sys.platform.startswith("linux"):
+        return
+    reader = getattr(getattr(pool, "_result_queue", None), "_reader", None)
+    if reader is None:
+        return
+    try:
+        import fcntl
+
+        fcntl.fcntl(reader.fileno(), _F_SETPIPE_SZ, _RESULT_PIPE)
+    except (AttributeError, OSError, ValueError, ImportError):
+        return
 
 
 def _worker_init(parent: int) -> None:

@@ -113,22 +113,15 @@ class _Walker:
             for t in s.body:
                 self.node(t, inner)
             return
-        if kind is A.Decl:
-            for n in s.names:
-                self.name(n, scope, "declaration")
-        elif kind in (A.Assign, A.KeyframeAssign):
-            self.name(s.target, scope, "assignment")
-        elif kind in (A.ModelBlock, A.MotionBlock, A.ReachBlock):
-            self.name(s.name, scope, "assignment")
-            if kind is A.ReachBlock and s.translate is not None:
-                self.name(s.translate, scope, "assignment")
-        elif kind is A.Do:
-            self.name(s.var, scope, "assignment")
-        elif kind is A.Load:
+        # The names a statement binds, as lang/ast.py declares them (binds=...).
+        for attr, how in _BINDS.get(kind, ()):
+            value = getattr(s, attr)
+            for n in value if isinstance(value, list) else (value,):
+                self.name(n, scope, _ROLES[how])
+        if kind is A.Load:
             for n in s.names:
                 self.name(n, scope, "load")
         elif kind is A.FigureStmt:
-            self.name(s.model, scope, "use")
             self.name(s.link, scope, "link")
         elif kind is A.Animate:
             self.name(s.model, scope, "use")
@@ -187,15 +180,12 @@ def _named_fields(s) -> set:
     return out
 
 
-_STATEMENTS = frozenset(
+#: Each statement that binds names -> its fields that do, and how; the role each gets in the index.
+_BINDS = A.statement_fields("binds")
+_ROLES = {"declares": "declaration", "assigns": "assignment", "figure": "use"}  # FIGURE changes a model it uses
+
+_STATEMENTS = frozenset(_BINDS) | frozenset(
     {
-        A.Decl,
-        A.Assign,
-        A.KeyframeAssign,
-        A.ModelBlock,
-        A.MotionBlock,
-        A.ReachBlock,
-        A.Do,
         A.If,
         A.Load,
         A.FigureStmt,

@@ -11,6 +11,8 @@ or after a :class:`Missing` answer.
 from __future__ import annotations
 
 import pathlib
+import sys
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import pytest
@@ -175,3 +177,18 @@ def test_shapes_kept_and_shipped_stay_bounded():
         M._keep({f"k{i}": shapes["b0"]})
     assert 0 < len(M._kept) <= M.KEPT
     M._kept.clear()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="pipe sizes are a Linux setting")
+def test_the_results_come_back_through_a_pipe_of_a_megabyte():
+    import fcntl
+
+    pool = ProcessPoolExecutor(max_workers=1)
+    try:
+        fd = pool._result_queue._reader.fileno()
+        assert fcntl.fcntl(fd, 1032) == 65536  # F_GETPIPE_SZ: the default
+        R._widen_result_pipe(pool)
+        allowed = int(pathlib.Path("/proc/sys/fs/pipe-max-size").read_text())
+        assert fcntl.fcntl(fd, 1032) == (R._RESULT_PIPE if allowed >= R._RESULT_PIPE else 65536)
+    finally:
+        pool.shutdown()
