@@ -252,12 +252,13 @@ def resolve(task: Task, keep: bool = True) -> list | Missing:
         Per image, a list of ``(camera, [(triangles, shade, cull), ...])``
         with each figure's triangles in world coordinates.
     """
-    lacking = tuple(sorted(k for k in task.keys() if k not in task.shapes and k not in _kept))
+    # Looked up before the task's own shapes are kept: keeping them may clear the store.
+    shapes = {k: task.shapes[k] if k in task.shapes else _kept.get(k) for k in task.keys()}
+    lacking = tuple(sorted(k for k, shape in shapes.items() if shape is None))
     if lacking:
         return Missing(lacking)
     if keep:
         _keep(task.shapes)
-    shapes = {k: task.shapes[k] if k in task.shapes else _kept[k] for k in task.keys()}
     drawn = _figures(task, shapes)
     out = []
     for i, image in enumerate(task.images):
