@@ -423,13 +423,15 @@ def _point_rows(
             dx, dy, dz = y[0] - cx, y[1] - cy, y[2] - cz
             u = (oy * dz - oz * dy, oz * dx - ox * dz, ox * dy - oy * dx)
             cols.append(u if A is None else _apply(A, u))
-        lw = goals.length * w
-        for i in range(3):
-            row = [c[i] * w for c in cols]
-            if t is not None:
+        rows = list(map(list, zip(*cols))) if cols else [[], [], []]  # the goal's three rows
+        if w != 1.0:
+            rows = [[v * w for v in row] for row in rows]
+        if t is not None:
+            lw = goals.length * w
+            for i, row in enumerate(rows):
                 row += [lw if j == i else 0.0 for j in range(3)]
-            J.append(row)
-            r.append(res[i] * w)
+        J += rows
+        r += [res[0] * w, res[1] * w, res[2] * w]
     return r, J, dist
 
 
