@@ -413,7 +413,9 @@ class IKModel:
         -------
         IKModel
         """
-        mask = np.broadcast_to(np.asarray(movable, dtype=bool), (figure.n_joints, 3))
+        mask = np.asarray(movable, dtype=bool)
+        if mask.shape != (figure.n_joints, 3):
+            mask = np.broadcast_to(mask, (figure.n_joints, 3))
         key = (id(figure), mask.tobytes(), bool(translate))
         hit = _model_cache.get(key)
         if hit is not None and hit[0] is figure:

@@ -77,6 +77,8 @@ class SolveStatus(StrEnum):
 
 #: The solvers' status codes (runtime/ik/solvers.py) as the solution reports them.
 _STATUS = {CONVERGED: SolveStatus.CONVERGED, STALLED: SolveStatus.STALLED, LIMIT: SolveStatus.LIMIT}
+# The same as an array indexed by the codes: a batch's statuses in one gather.
+_STATUS_BY_CODE = np.array([_STATUS.get(code) for code in range(max(_STATUS) + 1)], dtype=object)
 
 
 _DEFAULT_OPTIONS = ReachOptions()
@@ -562,7 +564,7 @@ def _pose_solution(figure, model, stack, result, start_deg, tol: float, translat
     # Wrapping free axes changes no link, so the solver's last distances are the pose's.
     residuals = stack.report(result.dist)
     converged = result.status == CONVERGED
-    status = np.array([_STATUS[s] for s in result.status], dtype=object)
+    status = _STATUS_BY_CODE[result.status]
     met = (result.dist <= tol) | ~stack.active
     if batched:
         return PoseSolution(
