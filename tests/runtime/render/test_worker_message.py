@@ -96,10 +96,12 @@ def test_the_worker_forms_the_triangles_the_main_process_formed_from_a_batch():
     X = rng.normal(size=(13, 6, 4, 4))  # thirteen frames of a six-link figure
     local = np.broadcast_to(table.triangles, (13, 40, 3, 3)).copy()
     local[:, 5:9] += rng.normal(size=(13, 4, 3, 3))  # a SHAPE morph moves rows 5-8
+    table.triangles[2, 0, 0] = local[:, 2, 0, 0] = 0.0
+    local[4, 2, 0, 0] = -0.0  # and row 2 by a sign only, in one frame
     batch = world_triangles(table, X, None)
     morphed = world_triangles(table, X, local)
     rows, moved = R._moved_rows(table, local)
-    assert rows.tolist() == [5, 6, 7, 8]
+    assert rows.tolist() == [2, 5, 6, 7, 8]
     images = []
     for n in range(13):
         plain = M.Posed(table, X[n], n == 3)
