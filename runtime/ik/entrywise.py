@@ -423,13 +423,15 @@ def _point_rows(
             dx, dy, dz = y[0] - cx, y[1] - cy, y[2] - cz
             u = (oy * dz - oz * dy, oz * dx - ox * dz, ox * dy - oy * dx)
             cols.append(u if A is None else _apply(A, u))
-        lw = goals.length * w
-        for i in range(3):
-            row = [c[i] * w for c in cols]
-            if t is not None:
+        rows = list(map(list, zip(*cols))) if cols else [[], [], []]  # the goal's three rows
+        if w != 1.0:
+            rows = [[v * w for v in row] for row in rows]
+        if t is not None:
+            lw = goals.length * w
+            for i, row in enumerate(rows):
                 row += [lw if j == i else 0.0 for j in range(3)]
-            J.append(row)
-            r.append(res[i] * w)
+        J += rows
+        r += [res[0] * w, res[1] * w, res[2] * w]
     return r, J, dist
 
 
@@ -686,23 +688,23 @@ def _batch_point_rows(goals: _Goals, stack, R: list, p: list, omega, pivot, t) -
         world = world + t * goals.length
     res = world - stack.p_target.transpose(1, 2, 0)
     dist = np.sqrt(np.einsum("gib,gib->bg", res, res))
-    w = stack.row_weight.T.reshape(G, 3, B)[:, :1]  # (G, 1, B): a goal's rows share its weight
+    # (G, 1, B): a goal's rows share its weight; None when every weight is the largest (1).
+    w = None if bool((stack.row_weight == 1.0).all()) else stack.row_weight.T.reshape(G, 3, B)[:, :1]
     J = np.zeros((G, 3, P, B))
+    o0, o1, o2 = omega[:, 0], omega[:, 1], omega[:, 2]  # (V, B) each
     for g, moves in enumerate(goals.moves):
         D = Y[g] - pivot  # (V, 3, B)
-        u = np.stack(
-            (
-                omega[:, 1] * D[:, 2] - omega[:, 2] * D[:, 1],
-                omega[:, 2] * D[:, 0] - omega[:, 0] * D[:, 2],
-                omega[:, 0] * D[:, 1] - omega[:, 1] * D[:, 0],
-            )
-        )  # (3, V, B)
+        Jg = J[g, :, :V]  # (3, V, B): omega x D, written in place
+        np.subtract(o1 * D[:, 2], o2 * D[:, 1], out=Jg[0])
+        np.subtract(o2 * D[:, 0], o0 * D[:, 2], out=Jg[1])
+        np.subtract(o0 * D[:, 1], o1 * D[:, 0], out=Jg[2])
         if not all(moves):
-            u *= np.array(moves, dtype=float)[:, None]
+            Jg *= np.array(moves, dtype=float)[:, None]
         if goals.A is not None:
-            u = np.einsum("ij,jvb->ivb", np.reshape(goals.A, (3, 3)), u)
-        J[g, :, :V] = u * w[g]
+            Jg[...] = np.einsum("ij,jvb->ivb", np.reshape(goals.A, (3, 3)), Jg)
+        if w is not None:
+            Jg *= w[g]
         if t is not None:
-            J[g, :, V:] = np.eye(3)[:, :, None] * (goals.length * w[g])
-    r = (res * w).reshape(3 * G, B).T
+            J[g, :, V:] = np.eye(3)[:, :, None] * (goals.length if w is None else goals.length * w[g])
+    r = (res if w is None else res * w).reshape(3 * G, B).T
     return r, J.reshape(3 * G, P, B).transpose(2, 0, 1), dist

@@ -11,6 +11,8 @@ or after a :class:`Missing` answer.
 from __future__ import annotations
 
 import pathlib
+import sys
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import pytest
@@ -94,10 +96,12 @@ def test_the_worker_forms_the_triangles_the_main_process_formed_from_a_batch():
     X = rng.normal(size=(13, 6, 4, 4))  # thirteen frames of a six-link figure
     local = np.broadcast_to(table.triangles, (13, 40, 3, 3)).copy()
     local[:, 5:9] += rng.normal(size=(13, 4, 3, 3))  # a SHAPE morph moves rows 5-8
+    table.triangles[2, 0, 0] = local[:, 2, 0, 0] = 0.0
+    local[4, 2, 0, 0] = -0.0  # and row 2 by a sign only, in one frame
     batch = world_triangles(table, X, None)
     morphed = world_triangles(table, X, local)
     rows, moved = R._moved_rows(table, local)
-    assert rows.tolist() == [5, 6, 7, 8]
+    assert rows.tolist() == [2, 5, 6, 7, 8]
     images = []
     for n in range(13):
         plain = M.Posed(table, X[n], n == 3)
@@ -166,6 +170,24 @@ def test_a_task_naming_a_shape_the_worker_lacks_is_answered_missing_then_drawn_w
     assert keys.key((ground[0] * 2, ground[1], ground[2])) != keys.key(ground)
 
 
+def test_a_kept_shape_still_draws_when_the_task_s_own_shapes_fill_the_store():
+    M._kept.clear()
+    old = (np.ones((1, 3, 3)), np.array([10], dtype=np.uint8), np.array([False]))
+    new = (np.full((1, 3, 3), 2.0), np.array([20], dtype=np.uint8), np.array([False]))
+    camera = ((0.0, 0.0, 10.0), 10.0)
+    keys = M.Keys()
+    task, shapes = M.pack([[(camera, [old])]], keys, (SIZE, 1, False, False, "thesis"))
+    M.resolve(task.shipping(shapes))  # ``old`` is kept
+    for i in range(M.KEPT - 1):
+        M._keep({f"filler{i}": old})
+    assert len(M._kept) == M.KEPT
+    task, shapes = M.pack([[(camera, [old, new])]], keys, (SIZE, 1, False, False, "thesis"))
+    fresh = {k: v for k, v in shapes.items() if v is new}
+    drawn = M.resolve(task.shipping(fresh))  # keeping ``new`` clears the store ``old`` was found in
+    assert drawn[0][0][1] == [old, new]
+    M._kept.clear()
+
+
 def test_shapes_kept_and_shipped_stay_bounded():
     M._kept.clear()
     ship = M.Shipping()
@@ -175,3 +197,18 @@ def test_shapes_kept_and_shipped_stay_bounded():
         M._keep({f"k{i}": shapes["b0"]})
     assert 0 < len(M._kept) <= M.KEPT
     M._kept.clear()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="pipe sizes are a Linux setting")
+def test_the_results_come_back_through_a_pipe_of_a_megabyte():
+    import fcntl
+
+    pool = ProcessPoolExecutor(max_workers=1)
+    try:
+        fd = pool._result_queue._reader.fileno()
+        assert fcntl.fcntl(fd, 1032) == 65536  # F_GETPIPE_SZ: the default
+        R._widen_result_pipe(pool)
+        allowed = int(pathlib.Path("/proc/sys/fs/pipe-max-size").read_text())
+        assert fcntl.fcntl(fd, 1032) == (R._RESULT_PIPE if allowed >= R._RESULT_PIPE else 65536)
+    finally:
+        pool.shutdown()
