@@ -25,6 +25,7 @@ Example (``arm`` a model with a link named HAND)::
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -35,7 +36,7 @@ from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import pose as PO
 from liganimate.runtime.figure.tree import Figure, Joint
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
-from liganimate.runtime.ik.model import IKModel
+from liganimate.runtime.ik.model import IKModel, figure_length
 from liganimate.runtime.ik.options import ReachOptions
 from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
@@ -440,13 +441,11 @@ def _movable_mask(figure: Figure, goals: Sequence, movable) -> np.ndarray:
 def _options(figure: Figure, solver: str, tolerance, max_iterations) -> tuple[float, int]:
     if solver not in SOLVERS:
         raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVER_NAMES)}")
-    from liganimate.runtime.ik.model import figure_length
-
     if tolerance is None:
         tol = DEFAULT_TOLERANCE * figure_length(figure)
     else:
         tol = float(tolerance)
-        if not np.isfinite(tol) or tol <= 0:
+        if not math.isfinite(tol) or tol <= 0:
             raise GoalError(f"the tolerance must be a positive number, not {tolerance!r}.")
     if max_iterations is None:
         it = DEFAULT_MAX_ITERATIONS[solver]
