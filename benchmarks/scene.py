@@ -80,7 +80,7 @@ def capture_draws(program, size, every: int):
     original = R.draw_images
     seen = [0]  # images handed over so far: workers=1 hands them over in order
 
-    def grab(size_, draws_list, aa=1, png=True, raw=False):
+    def grab(size_, draws_list, *options):  # aa, png, raw, look: whatever draw_images takes
         for draws in draws_list:
             index = seen[0]
             seen[0] += 1

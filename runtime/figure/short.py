@@ -22,7 +22,9 @@ its ``k`` rows, in order, written back into ``Z``:
    products; for a slide, its shift ``k F d``;
 5. each joint's translation, ``sum_m R[i, m] (-far[m]) + 1 * near[i]``
    (``near - R far``: ``L1 - R L2``, or ``L2 - R^T L1`` for a joint walked
-   backwards, whose rotation is read transposed);
+   backwards, whose rotation is read transposed); where ``far`` is 0 every
+   term but ``near`` is a zero, and the translation is the constant
+   ``near``, computed by no call;
 6. one product per depth level of the tree, each child's entry
    ``sum_m P[i, m] A[m, j]`` over ``m = 0..3`` in order (``P`` its parent's
    3x4, ``A`` its joint's 4x4); a level whose parent is the identity (the
@@ -32,8 +34,9 @@ its ``k`` rows, in order, written back into ``Z``:
 
 Sums are elementwise adds, row after row, and products elementwise (never
 BLAS), so every number is the one the previous short-batch walk computed
-(bit for bit: an exact zero may come out as -0.0), on every machine and
-for any batch size.  ``tests/runtime/figure/test_short.py`` checks that
+(bit for bit: an exact zero may come out as -0.0; for angles that are not
+finite the rotations are NaN as before, though a translation may keep its
+number), on every machine and for any batch size.  ``tests/runtime/figure/test_short.py`` checks that
 against the previous walk and the previous kinematics.
 """
 
@@ -67,7 +70,7 @@ class Stage:
 class Plan:
     """Where every number of one pose lives in the work array, and the steps between them."""
 
-    template: np.ndarray  # Z before a pose: the constants 1, 0, -1 in place
+    template: np.ndarray  # Z before a pose: the constants (1, 0, -1, every joint's near) in place
     raw: slice  # 3J places: the pose's angles, for the slides (if any)
     radians: slice
     cosines: slice  # 3J places: cos of angle a of joint k at 3k + a
@@ -158,12 +161,14 @@ def _block(plan: Plan, angles: np.ndarray, root, out) -> np.ndarray:
 
 
 BLOCK = 32
-"""Poses worked on together; their work arrays are kept for reuse (eight sizes and figures at most, a few MB).
+"""Poses worked on together; their work arrays are kept for reuse (eight sizes and figures at most).
 
 Every number of a block is a row of at most this many: large enough for
 numpy's per-call cost to be shared out, small enough for a block's work
-arrays (about 7 KB a pose for a humanoid) to stay in cache and for the
-memory kept to stay bounded whatever batch sizes a program asks for.
+arrays (about 25 KB a pose for a humanoid, 0.8 MB a block) to stay near
+the cache, and for the memory kept to stay bounded (under 10 MB for
+humanoids) whatever batch sizes a program asks for.  Measured on
+HUMANOID, blocks of 32 beat 64 and 128 for every batch from 32 to 255.
 """
 
 _BATCH_WORK: dict = {}  # (id(plan), b) -> (plan, work arrays not in use); the stored plan keeps the id valid
@@ -285,6 +290,7 @@ class _Builder:
         self.slide_set = frozenset(walk.slides.tolist())
         self.framed_at: dict = {}
         self.moved: dict = {}
+        self.constants: list = []  # (slice, values): places of Z that hold constants besides 1, 0, -1
         self.level_one_end = walk.levels[0][1] if walk.levels else 1
 
     def _places(self, n: int) -> slice:
@@ -305,7 +311,7 @@ class _Builder:
         framed = walk.framed.tolist()
         if framed:
             stages += self._framed(framed)
-        stages.append(self._translations())
+        stages += self._translations()
         if len(walk.slides):
             stages += self._slides()
         self.x = self._places(12 * fig.n_links)
@@ -325,6 +331,8 @@ class _Builder:
             levels[0] = (slice(width, width + P.size),) + levels[0][1:]
         template = np.zeros(self.size)
         template[self.one], template[self.minus_one] = 1.0, -1.0
+        for places, values in self.constants:
+            template[places] = values
         return Plan(
             template=template,
             raw=self.raw,
@@ -392,16 +400,27 @@ class _Builder:
             return self.turned.start + 9 * self.framed_at[q] + 3 * i + j
         return self._plain(int(walk.order[q]), i, j)
 
-    def _translations(self) -> Stage:
-        """``t[i] = sum_m R[i, m] (-far[m]) + 1 * near[i]`` for every walked joint."""
+    def _translations(self) -> list:
+        """``t[i] = sum_m R[i, m] (-far[m]) + 1 * near[i]`` for every walked joint whose ``far`` is not 0.
+
+        With ``far`` 0 (a joint at its far link's origin, as most are) every
+        term of the sum but ``near`` is a zero, and the sum is ``near``: its
+        places are constants of the work array, and cost no call.
+        """
         walk, J = self.walk, self.figure.n_joints
-        self.t = self._places(3 * J)
-        index = [
-            [self._walked(q, i, m) if m < 3 else int(self.one) for q in range(J) for i in range(3)] for m in range(4)
-        ]
         near, minus_far = walk.near, walk.minus_far  # (3, J) each
-        weights = [[minus_far[m, q] if m < 3 else near[i, q] for q in range(J) for i in range(3)] for m in range(4)]
-        return Stage(_table(index), "weighted", np.array(weights, dtype=np.float64), self.t)
+        self.near = self._places(3 * J)
+        self.constants.append((self.near, near.T.reshape(-1)))
+        moving = [q for q in range(J) if minus_far[:, q].any()]
+        self.t = self._places(3 * len(moving))
+        self.t_at = {q: self.t.start + 3 * n for n, q in enumerate(moving)}
+        if not moving:
+            return []
+        index = [
+            [self._walked(q, i, m) if m < 3 else int(self.one) for q in moving for i in range(3)] for m in range(4)
+        ]
+        weights = [[minus_far[m, q] if m < 3 else near[i, q] for q in moving for i in range(3)] for m in range(4)]
+        return [Stage(_table(index), "weighted", np.array(weights, dtype=np.float64), self.t)]
 
     def _slides(self) -> tuple[Stage, Stage]:
         """A slide's shift ``sum_a F[i, a] d[a]``, and its translation ``t * 1 + shift * gain``."""
@@ -414,7 +433,7 @@ class _Builder:
         first = Stage(_table(index), "weighted", np.array(weights, dtype=np.float64), shift)
         moved = self._places(3 * len(slides))
         index = [
-            [self.t.start + 3 * q + i for q in slides for i in range(3)],
+            [self._unmoved(q, i) for q in slides for i in range(3)],
             [shift.start + 3 * n + i for n in range(len(slides)) for i in range(3)],
         ]
         gain = walk.slide_gain
@@ -422,8 +441,12 @@ class _Builder:
         self.moved = {q: moved.start + 3 * n for n, q in enumerate(slides)}
         return first, Stage(_table(index), "weighted", np.array(weights, dtype=np.float64), moved)
 
+    def _unmoved(self, q: int, i: int) -> int:
+        """Place of entry i of walked joint q's translation ``near - R far`` (a constant where far is 0)."""
+        return self.t_at[q] + i if q in self.t_at else self.near.start + 3 * q + i
+
     def _translation(self, q: int, i: int) -> int:
-        return self.moved[q] + i if q in self.moved else self.t.start + 3 * q + i
+        return self.moved[q] + i if q in self.moved else self._unmoved(q, i)
 
     # -- the walk down the tree ----------------------------------------------
 

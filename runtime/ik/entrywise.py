@@ -288,59 +288,66 @@ def _joint_kinds(walk: _Walk, base: np.ndarray) -> tuple[list, list]:
     return kinds, trig
 
 
-def _frames(walk: _Walk, kinds: list, trig: list, cv: list, sv: list, origin: tuple) -> tuple[list, list, dict]:
-    """Every link's rotation (9-tuple) and origin (3-tuple), and the trig of the full joints.
+def _walked(walk: _Walk, kinds: list, trig: list, cv: list, sv: list, origin: tuple) -> tuple[list, list, list, list]:
+    """Every link's rotation (9-tuple) and origin (3-tuple), and every variable's signed axis and pivot.
 
     ``cv``, ``sv`` are the variables' cosines and sines; ``origin`` the main
-    link's rotation and origin (floats, or arrays for a batch).
+    link's rotation and origin (floats, or arrays for a batch).  A
+    variable's pivot is its joint's location, ``p_near + R_near near`` on
+    the walk's way (the same point seen from either link), and a hinge's
+    axis is a column of the near link's rotation, which its turn keeps.
     """
     R: list = [None] * walk.n_links
     p: list = [None] * walk.n_links
+    omega: list = [None] * len(walk.variables)
+    pivot: list = [None] * len(walk.variables)
     R[walk.main], p[walk.main] = origin
-    full = {}
     for (k, parent, child, rev, frame, near, far, variables), kind in zip(walk.steps, kinds):
         RP = R[parent]
+        pc = _moved(RP, p[parent], near)  # the joint's location
         if kind is None:
             RC = RP
         elif kind[0] == _TURN:
-            v = kind[2]
-            RC = _turned(RP, kind[1], cv[v], -sv[v] if rev else sv[v])
+            a, v = kind[1], kind[2]
+            RC = _turned(RP, a, cv[v], -sv[v] if rev else sv[v])
+            omega[v] = (-RP[a], -RP[3 + a], -RP[6 + a]) if rev else (RP[a], RP[3 + a], RP[6 + a])
+            pivot[v] = pc
         elif kind[0] == _FIXED:
             RC = _mul(RP, kind[1])
         else:
-            cs = list(trig[k])
-            for a in range(3):
-                if variables[a] >= 0:
-                    cs[a], cs[a + 3] = cv[variables[a]], sv[variables[a]]
-            full[k] = cs
-            RC = _mul(RP, _joint_rotation(cs, frame, rev))
+            RC = _full_joint(RP, list(trig[k]), variables, cv, sv, frame, rev, pc, omega, pivot)
         R[child] = RC
-        pc = _moved(RP, p[parent], near)
         for i, f in far:
             pc = (pc[0] - RC[i] * f, pc[1] - RC[3 + i] * f, pc[2] - RC[6 + i] * f)
         p[child] = pc
-    return R, p, full
+    return R, p, omega, pivot
 
 
-def _axes(walk: _Walk, R: list, p: list, full: dict) -> tuple[list, list]:
-    """Each variable's signed axis and pivot in the model frame (as :meth:`IKModel.axes`)."""
-    omega, pivot = [], []
-    for k, a, prim, loc, sign, frame in walk.variables:
-        Rp = R[prim]
-        cs = full.get(k)
-        if cs is None:
-            # A turn joint: its local axis is e_a, a column of its primary's rotation.
-            w = (Rp[a], Rp[3 + a], Rp[6 + a])
-        else:
-            v = _local_axis(cs, a, frame)
+def _full_joint(RP: tuple, cs: list, variables: tuple, cv, sv, frame, rev: bool, at: tuple, omega: list, pivot: list):
+    """A joint's far-side rotation from ``RP`` through its full ``Rz Ry Rx``; its variables' axes and pivots set.
+
+    ``cs`` is the joint's start trig (its variables' replaced here) and ``at``
+    the joint's location.  The axes are those of :meth:`IKModel.axes`, in
+    the primary's frame (the far link's when walked backwards), signed.
+    """
+    for a in range(3):
+        v = variables[a]
+        if v >= 0:
+            cs[a], cs[a + 3] = cv[v], sv[v]
+    RC = _mul(RP, _joint_rotation(cs, frame, rev))
+    Rp = RC if rev else RP
+    for a in range(3):
+        v = variables[a]
+        if v >= 0:
+            u = _local_axis(cs, a, frame)
             w = (
-                Rp[0] * v[0] + Rp[1] * v[1] + Rp[2] * v[2],
-                Rp[3] * v[0] + Rp[4] * v[1] + Rp[5] * v[2],
-                Rp[6] * v[0] + Rp[7] * v[1] + Rp[8] * v[2],
+                Rp[0] * u[0] + Rp[1] * u[1] + Rp[2] * u[2],
+                Rp[3] * u[0] + Rp[4] * u[1] + Rp[5] * u[2],
+                Rp[6] * u[0] + Rp[7] * u[1] + Rp[8] * u[2],
             )
-        omega.append(w if sign > 0 else (-w[0], -w[1], -w[2]))
-        pivot.append(_moved(Rp, p[prim], loc))
-    return omega, pivot
+            omega[v] = (-w[0], -w[1], -w[2]) if rev else w
+            pivot[v] = at
+    return RC
 
 
 # ---------------------------------------------------------------- point goals
@@ -423,13 +430,15 @@ def _point_rows(
             dx, dy, dz = y[0] - cx, y[1] - cy, y[2] - cz
             u = (oy * dz - oz * dy, oz * dx - ox * dz, ox * dy - oy * dx)
             cols.append(u if A is None else _apply(A, u))
-        lw = goals.length * w
-        for i in range(3):
-            row = [c[i] * w for c in cols]
-            if t is not None:
+        rows = list(map(list, zip(*cols))) if cols else [[], [], []]  # the goal's three rows
+        if w != 1.0:
+            rows = [[v * w for v in row] for row in rows]
+        if t is not None:
+            lw = goals.length * w
+            for i, row in enumerate(rows):
                 row += [lw if j == i else 0.0 for j in range(3)]
-            J.append(row)
-            r.append(res[i] * w)
+        J += rows
+        r += [res[0] * w, res[1] * w, res[2] * w]
     return r, J, dist
 
 
@@ -591,8 +600,7 @@ def kernel(prob, tol: float, maxstep: float) -> Kernel | None:
     lower, upper, V, inactive = walk.lower, walk.upper, model.n_vars, goals.inactive
 
     def evaluate(x: list) -> tuple:
-        R, p, full = _frames(walk, kinds, trig, list(map(math.cos, x)), list(map(math.sin, x)), _ORIGIN)
-        omega, pivot = _axes(walk, R, p, full)
+        R, p, omega, pivot = _walked(walk, kinds, trig, list(map(math.cos, x)), list(map(math.sin, x)), _ORIGIN)
         r, J, dist = _point_rows(goals, targets, R, p, omega, pivot, x)
         return r, J, dist, 0.5 * _dot(r, r)
 
@@ -653,8 +661,7 @@ def batch_evaluator(prob) -> Callable | None:
         xt = np.ascontiguousarray(x.T)
         one, zero = np.ones(B), np.zeros(B)
         origin = ((one, zero, zero, zero, one, zero, zero, zero, one), (zero, zero, zero))
-        R, p, full = _frames(walk, kinds, trig, list(np.cos(xt[:V])), list(np.sin(xt[:V])), origin)
-        omega, pivot = _axes(walk, R, p, full)
+        R, p, omega, pivot = _walked(walk, kinds, trig, list(np.cos(xt[:V])), list(np.sin(xt[:V])), origin)
         return _batch_point_rows(
             goals, stack, R, p, np.array(omega), np.array(pivot), xt[V:] if model.translate else None
         )
@@ -686,23 +693,23 @@ def _batch_point_rows(goals: _Goals, stack, R: list, p: list, omega, pivot, t) -
         world = world + t * goals.length
     res = world - stack.p_target.transpose(1, 2, 0)
     dist = np.sqrt(np.einsum("gib,gib->bg", res, res))
-    w = stack.row_weight.T.reshape(G, 3, B)[:, :1]  # (G, 1, B): a goal's rows share its weight
+    # (G, 1, B): a goal's rows share its weight; None when every weight is the largest (1).
+    w = None if bool((stack.row_weight == 1.0).all()) else stack.row_weight.T.reshape(G, 3, B)[:, :1]
     J = np.zeros((G, 3, P, B))
+    o0, o1, o2 = omega[:, 0], omega[:, 1], omega[:, 2]  # (V, B) each
     for g, moves in enumerate(goals.moves):
         D = Y[g] - pivot  # (V, 3, B)
-        u = np.stack(
-            (
-                omega[:, 1] * D[:, 2] - omega[:, 2] * D[:, 1],
-                omega[:, 2] * D[:, 0] - omega[:, 0] * D[:, 2],
-                omega[:, 0] * D[:, 1] - omega[:, 1] * D[:, 0],
-            )
-        )  # (3, V, B)
+        Jg = J[g, :, :V]  # (3, V, B): omega x D, written in place
+        np.subtract(o1 * D[:, 2], o2 * D[:, 1], out=Jg[0])
+        np.subtract(o2 * D[:, 0], o0 * D[:, 2], out=Jg[1])
+        np.subtract(o0 * D[:, 1], o1 * D[:, 0], out=Jg[2])
         if not all(moves):
-            u *= np.array(moves, dtype=float)[:, None]
+            Jg *= np.array(moves, dtype=float)[:, None]
         if goals.A is not None:
-            u = np.einsum("ij,jvb->ivb", np.reshape(goals.A, (3, 3)), u)
-        J[g, :, :V] = u * w[g]
+            Jg[...] = np.einsum("ij,jvb->ivb", np.reshape(goals.A, (3, 3)), Jg)
+        if w is not None:
+            Jg *= w[g]
         if t is not None:
-            J[g, :, V:] = np.eye(3)[:, :, None] * (goals.length * w[g])
-    r = (res * w).reshape(3 * G, B).T
+            J[g, :, V:] = np.eye(3)[:, :, None] * (goals.length if w is None else goals.length * w[g])
+    r = (res if w is None else res * w).reshape(3 * G, B).T
     return r, J.reshape(3 * G, P, B).transpose(2, 0, 1), dist

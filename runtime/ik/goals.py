@@ -181,7 +181,7 @@ def _vectors(value, what: str, batch: int | None) -> np.ndarray:
         raise GoalError(
             f"{what} must be a vector of three numbers (or a batch of them), not an array of shape {v.shape}."
         )
-    if not np.all(np.isfinite(v)):
+    if not np.isfinite(v).all():
         raise GoalError(f"{what} must be finite.")
     return v
 
@@ -485,7 +485,8 @@ class GoalStack:
         out.__dict__.update(self.__dict__)
         out.goals = goals
         out.warnings = list(self.warnings)
-        out.p_target = np.stack(pts, axis=1) if pts else self.p_target
+        # One point goal (a reach): its (B, 3) targets given their goal axis, without np.stack's checks.
+        out.p_target = (pts[0][:, None] if len(pts) == 1 else np.stack(pts, axis=1)) if pts else self.p_target
         if origins:
             out.q_origin, out.q_normal = np.stack(origins, axis=1), np.stack(normals, axis=1)
         if dirs:

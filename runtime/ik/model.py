@@ -313,6 +313,8 @@ class IKModel:
     lower, upper : numpy.ndarray, shape (V,)
         Bounds of the angle variables in radians; ``-inf``/``inf`` on free
         axes (extremes spanning 360 degrees or more).
+    param_lower, param_upper : numpy.ndarray, shape (n_params,)
+        The same, then ``-inf``/``inf`` for the translation; read-only.
     downstream : numpy.ndarray of bool, shape (V, n_links)
         Whether each link moves with each variable (it lies on the far side
         of the variable's joint from the main link).
@@ -348,6 +350,14 @@ class IKModel:
         free = free_range[self.var_joint, self.var_axis] if V else np.zeros(0, dtype=bool)
         self.lower = np.where(free, -np.inf, np.deg2rad(lo[self.var_joint, self.var_axis]) if V else 0.0)
         self.upper = np.where(free, np.inf, np.deg2rad(hi[self.var_joint, self.var_axis]) if V else 0.0)
+        # The bounds of all the parameters, the translation's infinite (read-only: solves share them).
+        self.param_lower = np.concatenate((self.lower, np.full(self.n_params - V, -np.inf)))
+        self.param_upper = np.concatenate((self.upper, np.full(self.n_params - V, np.inf)))
+        self.param_lower.setflags(write=False)
+        self.param_upper.setflags(write=False)
+        # For clamping a solved pose: whether some axis wraps (kinematics.clamp), else the extremes to clip to.
+        self.wraps = bool((free_range & ~figure.slides[:, None]).any()) if J else False
+        self.extremes_lo, self.extremes_hi = lo, hi
         self.downstream = moves[self.var_joint] if V else np.zeros((0, figure.n_links), dtype=bool)
         # Per link, 1.0 for each variable that moves it: the goals' Jacobian masks.
         self.moved_by = self.downstream.T.astype(float)
@@ -413,7 +423,9 @@ class IKModel:
         -------
         IKModel
         """
-        mask = np.broadcast_to(np.asarray(movable, dtype=bool), (figure.n_joints, 3))
+        mask = np.asarray(movable, dtype=bool)
+        if mask.shape != (figure.n_joints, 3):
+            mask = np.broadcast_to(mask, (figure.n_joints, 3))
         key = (id(figure), mask.tobytes(), bool(translate))
         hit = _model_cache.get(key)
         if hit is not None and hit[0] is figure:

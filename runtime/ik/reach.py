@@ -25,6 +25,7 @@ Example (``arm`` a model with a link named HAND)::
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -35,7 +36,7 @@ from liganimate.runtime.figure import kinematics as K
 from liganimate.runtime.figure import pose as PO
 from liganimate.runtime.figure.tree import Figure, Joint
 from liganimate.runtime.ik.goals import AxisGoal, GoalError, GoalStack, PlaneGoal, PointGoal, batch_size, resolve_link
-from liganimate.runtime.ik.model import IKModel
+from liganimate.runtime.ik.model import IKModel, figure_length
 from liganimate.runtime.ik.options import ReachOptions
 from liganimate.runtime.ik.solvers import CONVERGED, LIMIT, SOLVER_NAMES, SOLVERS, STALLED, solve
 from liganimate.runtime.motion.algebra import Motion
@@ -77,6 +78,8 @@ class SolveStatus(StrEnum):
 
 #: The solvers' status codes (runtime/ik/solvers.py) as the solution reports them.
 _STATUS = {CONVERGED: SolveStatus.CONVERGED, STALLED: SolveStatus.STALLED, LIMIT: SolveStatus.LIMIT}
+# The same as an array indexed by the codes: a batch's statuses in one gather.
+_STATUS_BY_CODE = np.array([_STATUS.get(code) for code in range(max(_STATUS) + 1)], dtype=object)
 
 
 _DEFAULT_OPTIONS = ReachOptions()
@@ -95,7 +98,23 @@ def reach_options(options: ReachOptions | None = None, **fields) -> ReachOptions
     unknown = sorted(set(fields) - _OPTION_NAMES)
     if unknown:
         raise GoalError(f"there is no REACH option {', '.join(unknown)}.")
-    return dataclasses.replace(base, **fields) if fields else base
+    if not fields:
+        return base
+    # A script solving one figure again and again passes the same options
+    # each time: dataclasses.replace costs more than the rest of the options.
+    try:
+        key = (base, tuple(fields.items()))
+        hit = _OPTIONS_MADE.get(key)
+    except TypeError:  # an unhashable value (a list of joints): made afresh
+        return dataclasses.replace(base, **fields)
+    if hit is None:
+        if len(_OPTIONS_MADE) >= 256:
+            _OPTIONS_MADE.clear()
+        hit = _OPTIONS_MADE[key] = dataclasses.replace(base, **fields)
+    return hit
+
+
+_OPTIONS_MADE: dict = {}  # (options, fields) -> options with those fields; frozen values, so shared
 
 
 @dataclass(frozen=True)
@@ -422,13 +441,11 @@ def _movable_mask(figure: Figure, goals: Sequence, movable) -> np.ndarray:
 def _options(figure: Figure, solver: str, tolerance, max_iterations) -> tuple[float, int]:
     if solver not in SOLVERS:
         raise GoalError(f"unknown solver {solver!r}.", hint=f"the solvers are {', '.join(SOLVER_NAMES)}")
-    from liganimate.runtime.ik.model import figure_length
-
     if tolerance is None:
         tol = DEFAULT_TOLERANCE * figure_length(figure)
     else:
         tol = float(tolerance)
-        if not np.isfinite(tol) or tol <= 0:
+        if not math.isfinite(tol) or tol <= 0:
             raise GoalError(f"the tolerance must be a positive number, not {tolerance!r}.")
     if max_iterations is None:
         it = DEFAULT_MAX_ITERATIONS[solver]
@@ -557,12 +574,16 @@ def _pose_solution(figure, model, stack, result, start_deg, tol: float, translat
     angles = start_deg.copy()
     flat = angles.reshape(B, -1)
     flat[:, model.var_flat] = np.rad2deg(q)
-    angles = K.clamp(figure, flat.reshape(B, figure.n_joints, 3))
+    angles = flat.reshape(B, figure.n_joints, 3)
+    # kinematics.clamp; where no axis wraps that is a clip, without its checks of the angles it is given.
+    angles = (
+        K.clamp(figure, angles) if model.wraps else np.minimum(np.maximum(angles, model.extremes_lo), model.extremes_hi)
+    )
     t = result.x[:, model.n_vars :] * model.length if translate else np.zeros((B, 3))
     # Wrapping free axes changes no link, so the solver's last distances are the pose's.
     residuals = stack.report(result.dist)
     converged = result.status == CONVERGED
-    status = np.array([_STATUS[s] for s in result.status], dtype=object)
+    status = _STATUS_BY_CODE[result.status]
     met = (result.dist <= tol) | ~stack.active
     if batched:
         return PoseSolution(

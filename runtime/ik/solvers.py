@@ -149,12 +149,8 @@ class _Problem:
         self.model = model
         self.stack = stack
         self.base = base
-        P = model.n_params
-        V = model.n_vars
-        self.lower = np.full(P, -np.inf)
-        self.upper = np.full(P, np.inf)
-        self.lower[:V] = model.lower
-        self.upper[:V] = model.upper
+        # Every variable's bounds (the translation's infinite): read-only, the model's.
+        self.lower, self.upper = model.param_lower, model.param_upper
 
     # The start angles' trigonometry, made when first asked for: a single
     # solve in floats needs neither (runtime/ik/entrywise.py).
@@ -421,7 +417,7 @@ def solve(
     if spec is None:
         raise ValueError(f"unknown solver {method!r}; expected one of {', '.join(SOLVER_NAMES)}")
     prob = _Problem(model, stack, base)
-    x = np.clip(np.array(x0, dtype=float), prob.lower, prob.upper)
+    x = np.minimum(np.maximum(np.array(x0, dtype=float), prob.lower), prob.upper)  # np.clip's wrapper costs more
     if method == "dls" and x.shape[0] == 1:
         # One problem (the language's STARTREACH): the batch bookkeeping
         # would cost more than the arithmetic; same iterates, scalar control.

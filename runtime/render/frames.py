@@ -725,8 +725,9 @@ def _moved_rows(table, local) -> tuple:
     """The mesh table's rows a SHAPE morph changed in any frame (bit for bit), and their triangles per frame."""
     if local is None:
         return None, None
-    own = np.ascontiguousarray(table.triangles).view(np.uint64)
-    changed = np.ascontiguousarray(local).view(np.uint64) != own[None]
+    bits = np.dtype(f"u{local.dtype.itemsize}")  # compared as bits: -0.0 is not 0.0, a NaN equals itself
+    own = np.ascontiguousarray(table.triangles, dtype=local.dtype).view(bits)
+    changed = np.ascontiguousarray(local).view(bits) != own[None]
     rows = np.flatnonzero(changed.reshape(len(local), len(table.triangles), -1).any(axis=(0, 2)))
     return rows, local[:, rows]
 

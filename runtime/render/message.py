@@ -26,6 +26,7 @@ another's key.
 from __future__ import annotations
 
 import hashlib
+import threading
 from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
@@ -215,8 +216,10 @@ def pack(images: list, keys: Keys, options: tuple) -> tuple[Task, dict]:
 
 
 # The shapes this process keeps (a worker: what tasks shipped it); key -> shape, and their bytes.
+# A Dask worker may run tasks in several threads: the store changes under a lock.
 _kept: dict = {}
 _kept_bytes = [0]
+_keeping = threading.Lock()
 
 
 def _nbytes(shape) -> int:
@@ -225,15 +228,16 @@ def _nbytes(shape) -> int:
 
 
 def _keep(shapes: dict) -> None:
-    for key, shape in shapes.items():
-        if key in _kept:
-            continue
-        size = _nbytes(shape)
-        if len(_kept) >= KEPT or _kept_bytes[0] + size > KEPT_BYTES:
-            _kept.clear()
-            _kept_bytes[0] = 0
-        _kept[key] = shape
-        _kept_bytes[0] += size
+    with _keeping:
+        for key, shape in shapes.items():
+            if key in _kept:
+                continue
+            size = _nbytes(shape)
+            if len(_kept) >= KEPT or _kept_bytes[0] + size > KEPT_BYTES:
+                _kept.clear()
+                _kept_bytes[0] = 0
+            _kept[key] = shape
+            _kept_bytes[0] += size
 
 
 def resolve(task: Task, keep: bool = True) -> list | Missing:
@@ -252,12 +256,13 @@ def resolve(task: Task, keep: bool = True) -> list | Missing:
         Per image, a list of ``(camera, [(triangles, shade, cull), ...])``
         with each figure's triangles in world coordinates.
     """
-    lacking = tuple(sorted(k for k in task.keys() if k not in task.shapes and k not in _kept))
+    # Looked up before the task's own shapes are kept: keeping them may clear the store.
+    shapes = {k: task.shapes[k] if k in task.shapes else _kept.get(k) for k in task.keys()}
+    lacking = tuple(sorted(k for k, shape in shapes.items() if shape is None))
     if lacking:
         return Missing(lacking)
     if keep:
         _keep(task.shapes)
-    shapes = {k: task.shapes[k] if k in task.shapes else _kept[k] for k in task.keys()}
     drawn = _figures(task, shapes)
     out = []
     for i, image in enumerate(task.images):

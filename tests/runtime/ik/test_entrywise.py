@@ -336,3 +336,33 @@ def test_batched_damped_step_with_the_written_out_3x3_equals_numpy_solve(P):
         )
         is None
     )
+
+
+def test_batched_solves_of_a_figure_with_a_slide_walk_too(monkeypatch):
+    """A batch on a figure with a SLIDE holds the slide and solves the angles: walk and numpy agree."""
+    links = (Link("BASE", None), Link("RAIL", None), Link("ARM", None), Link("HAND", None))
+    joints = (
+        Joint(1, 0, 1, (0, 0, 0), (0, 0, 0), [(-0.5, 0.5), (0, 0), (0, 0)], slide=True),
+        Joint(2, 1, 2, (0, 0, 0), (0, -1, 0), [(-170, 170)], axes=frame_from_axis((0, 0, 1))),
+        Joint(3, 2, 3, (0, 1, 0), (0, 0, 0), [(0, 0), (0, 0), (-120, 120)]),
+    )
+    fig = Figure(links, joints)
+    rng = np.random.default_rng(9)
+    start = np.zeros((3, 3))
+    start[0, 0] = 0.25  # the slide's displacement, held
+    poses = np.repeat(start[None], 30, axis=0)
+    poses[:, 1, 0] = rng.uniform(-170, 170, 30)
+    poses[:, 2, 2] = rng.uniform(-120, 120, 30)
+    X = K.pose_transforms(fig, poses)[:, 3]
+    targets = X[:, :3, :3] @ np.array([0, 0.5, 0]) + X[:, :3, 3]  # reachable with the slide where it is
+    goals = [PointGoal("HAND", targets, point=(0, 0.5, 0))]
+    a = solve_pose(fig, goals, start=start, tolerance=1e-6)
+    with monkeypatch.context() as m:
+        no_walk(m)
+        b = solve_pose(fig, goals, start=start, tolerance=1e-6)
+    assert a.converged.sum() >= 10
+    np.testing.assert_array_equal(a.status, b.status)
+    met = a.converged
+    np.testing.assert_array_equal(a.iterations[met], b.iterations[met])
+    np.testing.assert_allclose(np.deg2rad(a.angles[met]), np.deg2rad(b.angles[met]), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.angles[:, 0], b.angles[:, 0])  # the slide stays where it started

@@ -96,10 +96,12 @@ def test_the_worker_forms_the_triangles_the_main_process_formed_from_a_batch():
     X = rng.normal(size=(13, 6, 4, 4))  # thirteen frames of a six-link figure
     local = np.broadcast_to(table.triangles, (13, 40, 3, 3)).copy()
     local[:, 5:9] += rng.normal(size=(13, 4, 3, 3))  # a SHAPE morph moves rows 5-8
+    table.triangles[2, 0, 0] = local[:, 2, 0, 0] = 0.0
+    local[4, 2, 0, 0] = -0.0  # and row 2 by a sign only, in one frame
     batch = world_triangles(table, X, None)
     morphed = world_triangles(table, X, local)
     rows, moved = R._moved_rows(table, local)
-    assert rows.tolist() == [5, 6, 7, 8]
+    assert rows.tolist() == [2, 5, 6, 7, 8]
     images = []
     for n in range(13):
         plain = M.Posed(table, X[n], n == 3)
@@ -166,6 +168,24 @@ def test_a_task_naming_a_shape_the_worker_lacks_is_answered_missing_then_drawn_w
     copy = (ground[0].copy(), ground[1].copy(), ground[2].copy())
     assert keys.key(copy) == keys.key(ground)
     assert keys.key((ground[0] * 2, ground[1], ground[2])) != keys.key(ground)
+
+
+def test_a_kept_shape_still_draws_when_the_task_s_own_shapes_fill_the_store():
+    M._kept.clear()
+    old = (np.ones((1, 3, 3)), np.array([10], dtype=np.uint8), np.array([False]))
+    new = (np.full((1, 3, 3), 2.0), np.array([20], dtype=np.uint8), np.array([False]))
+    camera = ((0.0, 0.0, 10.0), 10.0)
+    keys = M.Keys()
+    task, shapes = M.pack([[(camera, [old])]], keys, (SIZE, 1, False, False, "thesis"))
+    M.resolve(task.shipping(shapes))  # ``old`` is kept
+    for i in range(M.KEPT - 1):
+        M._keep({f"filler{i}": old})
+    assert len(M._kept) == M.KEPT
+    task, shapes = M.pack([[(camera, [old, new])]], keys, (SIZE, 1, False, False, "thesis"))
+    fresh = {k: v for k, v in shapes.items() if v is new}
+    drawn = M.resolve(task.shipping(fresh))  # keeping ``new`` clears the store ``old`` was found in
+    assert drawn[0][0][1] == [old, new]
+    M._kept.clear()
 
 
 def test_shapes_kept_and_shipped_stay_bounded():
