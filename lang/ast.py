@@ -387,7 +387,7 @@ value_rule("pattern", R.rest())
 value_rule("goal_link", R.token(("NAME", "NUMBER"), {"NAME": AS_NAME, "NUMBER": AS_NUM}))
 
 
-@syntax("declaration", type=R.token("TYPE_KW", lambda text, pos: Type(upper_name(text))))
+@syntax("declaration", type=R.token("TYPE_KW", lambda text: Type(upper_name(text))))
 @node
 class Decl(Node):
     type: str  # a vocabulary.Type
@@ -824,7 +824,7 @@ class Load(Node):
     names: list  # of Name; empty means the library's models, motions, graphics and primitives
 
 
-@syntax("pat_word", word=R.token("STRING", lambda text, pos: text[1:-1].strip().upper()))
+@syntax("pat_word", word=R.token("STRING", lambda text: text[1:-1].strip().upper()))
 @node
 class PatWord(Node):
     word: str

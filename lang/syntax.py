@@ -35,11 +35,12 @@ the field that needs it.
 A node's position is the span of all its children unless its declaration
 says otherwise (``pos=where(1)``, ``pos=token("NAME", POS)``).
 
-Conversions of a token take its text and position: :data:`NAME` (a
-``Name`` node), :data:`UPPER` (the name as a string), :data:`TEXT`,
-:data:`UNQUOTE` (a string's text without its quotes), :data:`POS`,
-:data:`NUMBER` (a ``Num`` node), :data:`LABEL` (a number's value); a node
-whose token needs another one declares it beside its fields.
+A token's conversion takes its text, or its text and its position: here
+:func:`UPPER` (a name as a string), :func:`TEXT`, :func:`UNQUOTE` (a
+string's text without its quotes) and :func:`POS`; in lang/ast.py
+``AS_NAME`` (a ``Name`` node), ``AS_NUM`` (a ``Num`` node) and ``AS_LABEL``
+(a number's value); a node whose token needs another one declares it beside
+its fields.
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ class Reader(NamedTuple):
 
     kind: str
     types: tuple[str, ...] = ()
-    convert: Callable[..., Any] | None = None  # of a token (its text and position) or of a value
+    convert: Callable[..., Any] | None = None  # of a token (its text, and its position) or of a value
     of: type | tuple[type, ...] | None = None
     until: str | None = None
     many: bool = False
@@ -99,14 +100,14 @@ def block() -> Reader:
     return Reader("block")
 
 
-def after(types: str | tuple[str, ...], convert: Callable[[str, Any], Any] | None = None) -> Reader:
+def after(types: str | tuple[str, ...], convert: Callable[..., Any] | None = None) -> Reader:
     """The child just after the first token of ``types`` (a token converted by ``convert``), or None."""
     return Reader("after", _types(types), convert)
 
 
 def token(
     types: str | tuple[str, ...],
-    convert: Callable[[str, Any], Any] | dict[str, Callable[[str, Any], Any]],
+    convert: Callable[..., Any] | dict[str, Callable[..., Any]],
     many: bool = False,
 ) -> Reader:
     """The first token of ``types``, converted (None if absent); ``many``: all of them, a list.
@@ -184,17 +185,21 @@ def factory(make: Callable[[], Any]) -> Reader:
 # nodes, so lang/ast.py fills them in once those classes exist.
 
 
-def TEXT(text: str, pos: Any) -> str:
+# A conversion of one parameter is given the text alone: the parser then makes
+# no position for a token whose position nobody keeps (every assignment's "=").
+
+
+def TEXT(text: str) -> str:
     """The token's text as written."""
     return text
 
 
-def UPPER(text: str, pos: Any) -> str:
+def UPPER(text: str) -> str:
     """The token's text upper-cased (a name: the language is case-insensitive)."""
     return upper_name(text)
 
 
-def UNQUOTE(text: str, pos: Any) -> str:
+def UNQUOTE(text: str) -> str:
     """A string token's text without its quotes."""
     return text[1:-1]
 

@@ -248,10 +248,15 @@ def _type(c) -> str:
     return c[0] if type(c) is Tok else c.type
 
 
+def _takes_position(convert) -> bool:
+    """Does a token's conversion take the token's position too (or its text alone)?"""
+    return convert.__code__.co_argcount > 1
+
+
 def _converted(tok, convert, table: dict):
     """A token through its reader's conversion (by its type, when the reader has a table)."""
     f = table.get(_type(tok), convert) if table else convert
-    return f(tok.value, _tpos(tok))
+    return f(tok.value, _tpos(tok)) if _takes_position(f) else f(tok.value)
 
 
 def _next_value(children, taken: set, of=None):
@@ -332,6 +337,18 @@ def _token(r: R.Reader):
         ]
     if len(types) == 1 and not table:
         (kind,) = types
+        if not _takes_position(convert):
+
+            def read_text(children, taken):
+                for c in children:
+                    if type(c) is Tok:
+                        if c[0] == kind:
+                            return convert(c[1])
+                    elif type(c) is Token and c.type == kind:
+                        return convert(c.value)
+                return None
+
+            return read_text
 
         def read_one(children, taken):
             for c in children:
@@ -485,9 +502,41 @@ def _node_maker(cls: type, readers: tuple, pos: R.Reader | None):
     return make
 
 
+def _node_rule(cls: type, readers: tuple, pos: R.Reader | None):
+    """The transformer method of a node's rule: one call per node, for the shapes most statements have."""
+    reads = [_reader(r) for _, r in readers]
+    if pos is not None or len(reads) > 3:
+        make = _node_maker(cls, readers, pos)
+        return lambda self, children: make(children, set())
+    # Spelt out by arity (a million assignments are parsed through here): no list of
+    # values, no second call, and the span of all children.
+    if not reads:
+        return lambda self, children: cls(span(children))
+    if len(reads) == 1:
+        (r0,) = reads
+        return lambda self, children: cls(span(children), r0(children, set()))
+    if len(reads) == 2:
+        r0, r1 = reads
+
+        def rule2(self, children):
+            taken: set = set()
+            return cls(span(children), r0(children, taken), r1(children, taken))
+
+        return rule2
+    r0, r1, r2 = reads
+
+    def rule3(self, children):
+        taken: set = set()
+        return cls(span(children), r0(children, taken), r1(children, taken), r2(children, taken))
+
+    return rule3
+
+
 def _syntax_rule(sx: R.Syntax):
     """The transformer method of a declared rule (lang/ast.py)."""
-    if sx.cls is None:
+    if sx.cls is not None:
+        rule = _node_rule(sx.cls, sx.readers, sx.pos)
+    else:
         reads = [_reader(r) for _, r in sx.readers]
         if len(reads) == 1:
             (one,) = reads
@@ -499,11 +548,6 @@ def _syntax_rule(sx: R.Syntax):
             def rule(self, children):
                 taken: set = set()
                 return tuple(read(children, taken) for read in reads)
-    else:
-        make = _node_maker(sx.cls, sx.readers, sx.pos)
-
-        def rule(self, children):
-            return make(children, set())
 
     rule.__name__ = sx.rule
     return rule
