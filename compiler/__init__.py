@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from liganimate.lang import collector
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
+from liganimate.lang.node_methods import record
 from liganimate.lang.parser import parse_source
 from liganimate.lang.source import Source, load, prepare
 
@@ -13,7 +12,7 @@ from .check import Checked, check
 from .lower import lower
 
 
-@dataclass
+@record
 class Compiled:
     """The result of compiling one program: the module text and the warnings found."""
 

@@ -24,10 +24,11 @@ So a scope is walked until its types settle; only the last walk reports.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from liganimate.lang import ast as A
 from liganimate.lang.diagnostics import LigDiagnostics
+from liganimate.lang.node_methods import record
 
 from . import scopes as S
 from . import types as T
@@ -46,7 +47,7 @@ PRIMITIVE_PASSES = 3
 MAIN_PASSES = 4
 
 
-@dataclass
+@record
 class Checked:
     """A program that passed the static checks, with what lowering needs."""
 

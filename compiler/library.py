@@ -26,13 +26,14 @@ import hashlib
 import os
 import re
 import stat
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 from liganimate import __version__
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics, did_you_mean
 from liganimate.lang.name_table import read_tables
+from liganimate.lang.node_methods import record
 from liganimate.lang.source import SourceFileError, lig_text, read_source_bytes
 
 from . import library_cache
@@ -63,7 +64,7 @@ class LibraryCycle(Exception):
         self.chain = chain
 
 
-@dataclass
+@record
 class Library:
     """A compiled library and what it offers to the programs that load it."""
 

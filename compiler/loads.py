@@ -8,17 +8,18 @@ source was scanned; here each LOAD is matched with what its library offers.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from liganimate.lang import ast as A
 from liganimate.lang import bindings
 from liganimate.lang.diagnostics import did_you_mean
+from liganimate.lang.node_methods import record
 
 from .reports import Report
 from .scopes import Scope
 
 
-@dataclass
+@record
 class Loaded:
     """What the LOADs brought: the tables :class:`~.check.Checked` carries to the lowering."""
 

@@ -13,22 +13,23 @@ slots; a call writes its slots in the same order, separated by commas.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from liganimate.lang import ast as A
 from liganimate.lang.diagnostics import did_you_mean
+from liganimate.lang.node_methods import record
 
 from . import types as T
 
 
-@dataclass
+@record
 class Slot:
     keyword: str
     param: str
     group: int | None  # None when required, else the optional group's number
 
 
-@dataclass
+@record
 class Signature:
     """What a primitive call must look like, and the defaults of its optional parts."""
 

@@ -11,17 +11,18 @@ type of its value, and an implicit number assigned a REAL anywhere is REAL.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from liganimate.lang import ast as A
 from liganimate.lang import bindings
 from liganimate.lang.diagnostics import did_you_mean
+from liganimate.lang.node_methods import record
 
 from . import types as T
 from .reports import SILENT, Sink
 
 
-@dataclass
+@record
 class Scope:
     """The variables of the main program or of one PRIMITIVE."""
 
@@ -32,7 +33,7 @@ class Scope:
     params: list = field(default_factory=list)
 
 
-@dataclass
+@record
 class SceneInfo:
     """What a scene uses: models to snapshot, models it animates, names it assigns."""
 
@@ -41,7 +42,7 @@ class SceneInfo:
     assigned: set = field(default_factory=set)
 
 
-@dataclass
+@record
 class State:
     """Where the checker is and what it has found.
 

@@ -7,14 +7,15 @@ Python traceback ever reaches the user.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from .ast import Pos
 from .display import at_end, escape_text, last_line, render_line, source_line
 from .messages import closest, did_you_mean  # noqa: F401  (the one did-you-mean, re-exported)
+from .node_methods import record
 
 
-@dataclass(slots=True)
+@record(slots=True)
 class Diagnostic:
     """One message about one place in one file."""
 

@@ -19,10 +19,11 @@ import errno
 import os
 import re
 import stat
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from .ast import Pos
 from .diagnostics import Diagnostic, LigDiagnostics
+from .node_methods import record
 
 # A C-comment line that looks like a statement deserves a warning: in 1986
 # it was a comment, but today the writer probably meant a variable called C.
@@ -158,7 +159,7 @@ def lig_text(data: bytes, path: str) -> str:
     return text.removeprefix("\ufeff")
 
 
-@dataclass
+@record
 class Source:
     """A decoded program: the text as written and the text the lexer sees."""
 

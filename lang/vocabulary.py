@@ -14,13 +14,16 @@ so adding a word means adding one entry here plus its implementation:
 * a block: one :class:`Block` in :data:`BLOCKS` (the parser's messages about
   unclosed or stray blocks read it).
 
-This module imports nothing of the package, so every stage may read it.
+This module imports nothing of the package but lang/node_methods.py (how its records are
+made), so every stage may read it.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from enum import StrEnum
+
+from .node_methods import record
 
 
 # ------------------------------------------------------------------ types
@@ -50,7 +53,7 @@ _PLURAL = {GRAPHICAL: "graphical objects", MODEL: "models", MOTION: "motions"}
 
 
 # -------------------------------------------------------------- modifiers
-@dataclass(frozen=True)
+@record(frozen=True)
 class Modifier:
     """One modifier of the ``<...>`` lists.
 
@@ -134,7 +137,7 @@ DRAW_WITH = (MODIFIERS["lightness"], MODIFIERS["colour"])
 
 
 # -------------------------------------------------------------- operators
-@dataclass(frozen=True)
+@record(frozen=True)
 class Operator:
     """One row of the operator table: an operator on two operand types.
 
@@ -202,7 +205,7 @@ def operators_for(symbol: str, left: str | None, right: str | None) -> list:
 
 
 # ----------------------------------------------------- built-in functions
-@dataclass(frozen=True)
+@record(frozen=True)
 class Function:
     """A built-in function: the types each argument may have, and the result type.
 
@@ -252,7 +255,7 @@ FUNCTIONS = {
 
 
 # ------------------------------------------------------------------ blocks
-@dataclass(frozen=True)
+@record(frozen=True)
 class Block:
     """A block of statements: the word that opens it, the word that closes it.
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 import dataclasses
 import io
 import sys
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
@@ -22,6 +21,7 @@ from liganimate.lang import keyframe_table, messages
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
+from liganimate.lang.node_methods import record
 from liganimate.runtime import budgets, limits, printing
 from liganimate.runtime.arithmetic import Arithmetic
 from liganimate.runtime.errors import LigError
@@ -64,7 +64,7 @@ class Posed:
         return Posed(figure, self.motion, self.frame, self.statement)
 
 
-@dataclass(frozen=True, slots=True)
+@record(frozen=True, slots=True)
 class TableArgs:
     """A keyframe table of a STARTMOTION block, as the compiled module passes it to :meth:`Runtime.motion_block`.
 
@@ -78,7 +78,7 @@ class TableArgs:
     at: int
 
 
-@dataclass(frozen=True, slots=True)
+@record(frozen=True, slots=True)
 class JointArgs:
     """One JOINT line of a STARTMODEL block, as the compiled module passes it to :meth:`Runtime.model_block`.
 
@@ -99,7 +99,7 @@ class JointArgs:
     kind: tuple = (False, None)  # (SLIDE written, the AXIS vector or None)
 
 
-@dataclass(frozen=True, slots=True)
+@record(frozen=True, slots=True)
 class GoalArgs:
     """One GOAL line of a STARTREACH block, as the compiled module passes it to :meth:`Runtime.reach`.
 

@@ -1,17 +1,19 @@
-"""The syntax tree's node classes: dataclasses whose methods come from lang/_node_methods.py.
+"""Records (the syntax tree's node classes and others): dataclasses whose methods come from lang/_node_methods.py.
 
 * The generated module is the one the classes give today (as lang/_tables.py is for the grammar).
-* Every node class took its methods from it: none paid for compiling them at import.
-* The methods behave as ``@dataclass(slots=True)``'s own, class by class: the same
-  signature and docstring, repr, equality, hashing, defaults and factories.
+* Every record took its methods from it: none paid for compiling them at import.
+* The methods behave as ``@dataclass``'s own (frozen and slots as asked), class by class: the
+  same signature and docstring, repr, equality, hashing, immutability, defaults and factories.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import inspect
 import os
 
+import pytest
 from paths import ROOT_DIR
 
 from liganimate.lang import ast as A
@@ -19,7 +21,11 @@ from liganimate.lang import node_methods as N
 
 
 def node_classes() -> list:
-    return [c for c in N.MADE if c.__module__ == "liganimate.lang.ast"]
+    """Every record of the modules that declare records."""
+    modules = N.users()
+    for name in modules:
+        importlib.import_module(name)
+    return [c for c in N.MADE if c.__module__ in modules]
 
 
 def test_generated_methods_are_the_ones_the_classes_give():
@@ -31,14 +37,15 @@ def test_generated_methods_are_the_ones_the_classes_give():
 def test_every_node_class_took_its_methods_from_the_generated_module():
     makers = N._makers()
     classes = node_classes()
-    assert len(classes) > 50 and A.Program in classes and A.Num in classes
+    assert len(classes) > 70 and A.Program in classes and A.Num in classes
+    assert {"liganimate.lang.ast", "liganimate.lang.vocabulary", "liganimate.compiler.scopes"} <= set(N.users())
     for cls in classes:
-        assert makers[cls.__qualname__][0] == N.shape(cls), cls.__qualname__
+        assert makers[N._key(cls)][0] == N.shape(cls), cls.__qualname__
         assert cls.__init__.__code__.co_filename.endswith("_node_methods.py"), cls.__qualname__
 
 
 def twin(cls: type) -> type:
-    """``cls`` as @dataclass(slots=True) makes it from the same fields (the reference)."""
+    """``cls`` as @dataclass makes it from the same fields and options (the reference)."""
     spec = []
     for f in dataclasses.fields(cls):
         extra = {}
@@ -47,22 +54,30 @@ def twin(cls: type) -> type:
         if f.default_factory is not dataclasses.MISSING:
             extra["default_factory"] = f.default_factory
         spec.append((f.name, f.type, dataclasses.field(**extra)))
-    return dataclasses.make_dataclass(cls.__name__, spec, slots=True)
+    frozen = cls.__dataclass_params__.frozen
+    return dataclasses.make_dataclass(cls.__name__, spec, slots="__slots__" in cls.__dict__, frozen=frozen)
 
 
 def test_methods_behave_as_dataclass_ones():
     for cls in node_classes():
         ref = twin(cls)
         name = cls.__qualname__
-        assert dataclasses.is_dataclass(cls) and "__slots__" in cls.__dict__, name
+        assert dataclasses.is_dataclass(cls), name
         assert str(inspect.signature(cls)) == str(inspect.signature(ref)), name
         if not cls.__doc__ or cls.__doc__.startswith(cls.__name__ + "("):  # no docstring of its own
             assert cls.__doc__ == ref.__doc__, name
         assert cls.__match_args__ == ref.__match_args__, name
-        assert cls.__hash__ is None and ref.__hash__ is None, name
+        assert ("__slots__" in cls.__dict__) == ("__slots__" in ref.__dict__), name
         names = [f.name for f in dataclasses.fields(cls)]
         values = [f"v{i}" for i in range(len(names))]
         mine, theirs = cls(*values), ref(*values)
+        if ref.__hash__ is None:
+            assert cls.__hash__ is None, name
+        else:
+            assert hash(mine) == hash(theirs) == hash(cls(*values)), name
+        if cls.__dataclass_params__.frozen and names:
+            with pytest.raises(dataclasses.FrozenInstanceError):
+                setattr(mine, names[0], "changed")
         assert repr(mine) == repr(theirs).replace(ref.__qualname__, cls.__qualname__, 1), name
         assert mine == cls(*values) and not (mine != cls(*values)), name
         assert mine != theirs, name  # another class: never equal, as dataclasses compare
@@ -99,3 +114,37 @@ def test_a_changed_class_gets_compiled_methods(monkeypatch):
         repr(e) == f"test_a_changed_class_gets_compiled_methods.<locals>.Edited(pos={A.NOWHERE!r}, name='X', items=[])"
     )
     N.MADE.remove(Edited)
+
+
+def test_a_frozen_record_and_methods_of_its_own(monkeypatch):
+    monkeypatch.setattr(N, "_makers", lambda: {})
+
+    @N.record(frozen=True)
+    class Pair:
+        a: int
+        b: int = 2
+
+        def __repr__(self) -> str:  # its own: kept, as @dataclass keeps it
+            return "pair"
+
+    p = Pair(1)
+    assert (p.b, repr(p), p == Pair(1, 2), hash(p) == hash(Pair(1, 2))) == (2, "pair", True, True)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.a = 3  # type: ignore[misc]
+    assert dataclasses.replace(p, b=5) == Pair(1, 5)
+    N.MADE.remove(Pair)
+
+    @N.record
+    class Unhashable:
+        a: int
+
+    assert Unhashable.__hash__ is None and Unhashable(1) == Unhashable(1) != Unhashable(2)
+    N.MADE.remove(Unhashable)
+
+
+def test_a_record_refuses_what_it_does_not_write():
+    with pytest.raises(TypeError, match="plain"):
+
+        @N.record
+        class Hidden:
+            a: int = dataclasses.field(default=0, repr=False)
