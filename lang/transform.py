@@ -18,6 +18,7 @@ from lark import Token, Transformer
 from . import ast as A
 from . import syntax as R
 from .lexer import Tok
+from .numbers import literal
 from .syntax import upper_name
 from .vocabulary import MODIFIERS, OPERATORS
 
@@ -146,8 +147,9 @@ class ToAst(Transformer):
         return A.Modified(pos, target, mods)
 
     def number(self, children):
+        # lang/numbers.py decides what a literal means (as lang/ast.py's AS_NUM, inline: numbers are most tokens).
         tok = children[0]
-        return A.AS_NUM(tok.value, _tpos(tok))
+        return A.Num(_tpos(tok), literal(tok.value.rstrip("°")), tok.value)
 
     def var(self, children):
         tok = children[0]
