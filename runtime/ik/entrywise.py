@@ -1,27 +1,34 @@
-"""One pose in Python floats: a single solve's kinematics, point goals and damped step.
+"""Point goals' kinematics written entry by entry: in floats for one solve, in arrays for a batch.
 
-A single solve (the language's STARTREACH, ``reach``) of a figure of a few
-joints is about ten iterations on arrays of a handful of numbers, where one
-numpy call costs as much as twenty float operations.  For point goals on a
-small problem (:func:`kernel` says which), :func:`solvers._dls_one` takes its
-evaluation and its step from here, written in Python floats:
+Every entry of a rotation, an origin, an axis, a pivot or a Jacobian row is a
+value of its own, combined with ``+``, ``-`` and ``*`` only, so the same walk
+serves two uses:
 
-* the link frames, walked joint by joint from the main link.  A joint that
-  turns about one of its own axes, its other two at zero and no AXIS frame
-  (every hinge of a chain), is a plane rotation of two of its parent's
-  columns; any other joint is its full ``Rz Ry Rx`` (turned by its AXIS
-  frame, transposed when walked backwards) times its parent's rotation;
-* each variable's axis and pivot, the goals' residuals and Jacobian, as in
-  :meth:`IKModel.forward_one` and :meth:`GoalStack.evaluate_one`;
-* the damped step of ``solvers._held_step`` (hold, damped solve, cap,
-  projection), its small linear system solved by Gaussian elimination with
-  partial pivoting, and the acceptance of ``solvers._judged_step``.
+* **One solve** (the language's STARTREACH, ``reach``): about ten iterations
+  on a handful of numbers, where one numpy call costs as much as twenty
+  float operations.  For point goals on a small problem (:func:`kernel`
+  says which), :func:`solvers._dls_one` takes its evaluation and its step
+  from here in Python floats, with the damped step of
+  ``solvers._held_step`` (hold, damped solve, cap, projection; its 3x3
+  system by a written-out Cholesky factorisation, :func:`solve3`, any other
+  small one by Gaussian elimination with partial pivoting).
+* **A batch** (:func:`batch_evaluator`): each entry an array over the batch,
+  where the 4x4 products and gathers of :meth:`IKModel.forward_trig` and
+  :meth:`IKModel.axes_trig` cost several times more.
 
-The values are those of the numpy formulas up to rounding; the tests check
-both against each other on random trees, placements, limits and
-translation (``tests/runtime/ik/test_entrywise.py``).  Bigger problems, plane
-and axis goals stay with the numpy formulas, where the arithmetic, not the
-number of calls, is the cost.
+The walk goes joint by joint from the main link.  A joint that turns about
+one of its own axes, its other two at zero and no AXIS frame (every hinge
+of a chain), is a plane rotation of two of its parent's columns, and its
+variable's axis a column of the parent's rotation; any other joint is its
+full ``Rz Ry Rx`` (turned by its AXIS frame, transposed when walked
+backwards) times its parent's rotation.  A variable's pivot is its joint's
+location, passed on the way.
+
+The values are those of the numpy formulas (:meth:`IKModel.forward_one`,
+:meth:`GoalStack.evaluate_one` and ``evaluate``) up to rounding; the tests
+check both against each other on random trees, placements, limits,
+translation and slides (``tests/runtime/ik/test_entrywise.py``).  Plane and
+axis goals, and problems too big for it, stay with the numpy formulas.
 """
 
 from __future__ import annotations
@@ -35,7 +42,7 @@ import numpy as np
 
 __all__ = ["Kernel", "kernel", "batch_evaluator", "solve3", "MAX_SIZE", "MAX_FULL_JOINTS"]
 
-#: The scalar path takes problems with at most this many residual rows times
+#: The float path takes problems with at most this many residual rows times
 #: variables (a point goal on a 30-joint chain is 90): beyond, the step's
 #: products are long enough for numpy to win.
 MAX_SIZE = 240
