@@ -220,7 +220,7 @@ class _Walk:
     """What the walk of one model needs, fixed per figure (kept on the model)."""
 
     steps: tuple  # per joint in walk order: (joint, parent link, child link, reversed, frame, near, far, variables)
-    variables: tuple  # per variable: (joint, axis, primary link, location on the primary, sign, frame)
+    n_vars: int
     n_links: int
     main: int
     lower: list  # the variables' bounds (radians; the translation's infinite)
@@ -230,7 +230,7 @@ class _Walk:
 
 def _walk_of(model) -> _Walk:
     """The model's :class:`_Walk`, built at its first single solve."""
-    walk = model.__dict__.get("_scalar_walk")
+    walk = model.__dict__.get("_entrywise_walk")
     if walk is not None:
         return walk
     fig = model.figure
@@ -254,16 +254,10 @@ def _walk_of(model) -> _Walk:
                     var_axes,
                 )
             )
-    variables = tuple(
-        (k, a, int(prim), _nonzero(loc), float(sign), frames[k])
-        for k, a, prim, loc, sign in zip(
-            model.var_joint.tolist(), model.var_axis.tolist(), model.var_primary, model.var_loc1, model.sign
-        )
-    )
     pad = [math.inf] * (model.n_params - model.n_vars)
     lower, upper = model.lower.tolist() + [-v for v in pad], model.upper.tolist() + pad
-    walk = _Walk(tuple(steps), variables, fig.n_links, fig.main, lower, upper, {})
-    model.__dict__["_scalar_walk"] = walk
+    walk = _Walk(tuple(steps), model.n_vars, fig.n_links, fig.main, lower, upper, {})
+    model.__dict__["_entrywise_walk"] = walk
     return walk
 
 
@@ -306,8 +300,8 @@ def _walked(walk: _Walk, kinds: list, trig: list, cv: list, sv: list, origin: tu
     """
     R: list = [None] * walk.n_links
     p: list = [None] * walk.n_links
-    omega: list = [None] * len(walk.variables)
-    pivot: list = [None] * len(walk.variables)
+    omega: list = [None] * walk.n_vars
+    pivot: list = [None] * walk.n_vars
     R[walk.main], p[walk.main] = origin
     for (k, parent, child, rev, frame, near, far, variables), kind in zip(walk.steps, kinds):
         RP = R[parent]
