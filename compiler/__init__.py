@@ -163,12 +163,15 @@ def _scan_loads(source: Source, path: str, stack: tuple, opened: dict | None = N
     (``library.FAILURES``). The checker reports those from ``opened``; if
     parsing fails first, :func:`compile_source` reports them itself.
     """
-    from . import library
+    requests = source.load_requests()
+    if not requests:
+        return set(), []
+    from . import library  # only a program that LOADs needs it (and its cache's cryptography)
 
     opened = {} if opened is None else opened
     names: set[str] = set()
     failed: list = []
-    for lib_name, wanted, pos in source.load_requests():
+    for lib_name, wanted, pos in requests:
         lib = library.open_library(lib_name, path, stack, opened)
         if isinstance(lib, Exception):
             failed.append((lib_name, pos, lib))

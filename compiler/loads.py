@@ -40,13 +40,13 @@ class _Loader:
         self.origin: dict = {}  # NAME -> (library path, Pos of the LOAD)
 
     def run(self, path: str, stack: tuple, opened: dict) -> Loaded:
-        from . import library as L
-
         for stmt in self.program.body:
             if not isinstance(stmt, A.Load):
                 for name in bindings.defined(stmt):
                     self.defined.setdefault(name.name, name.pos)
                 continue
+            from . import library as L  # only a program that LOADs needs it (and its cache's cryptography)
+
             lib = L.open_library(stmt.library, path, stack, opened)
             if isinstance(lib, Exception):
                 message, hint, inner = L.failure(lib, stmt.library)

@@ -7,7 +7,6 @@ program's author reads one sentence for one rule, whichever stage found it.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterable
 
 from .numbers import MIN_FRAME_GAP
@@ -15,6 +14,8 @@ from .numbers import MIN_FRAME_GAP
 
 def closest(name: str, candidates: Iterable[str], n: int = 3, cutoff: float = 0.6) -> list:
     """The known names closest to ``name`` (compared upper-cased), best first, for 'did you mean' hints."""
+    import difflib  # only a wrong name needs it: a correct program's start does not pay for it
+
     return difflib.get_close_matches(name.upper(), sorted({c.upper() for c in candidates}), n=n, cutoff=cutoff)
 
 

@@ -42,8 +42,11 @@ FORBIDDEN = (
     "liganimate.fmt_cli",
     "liganimate.runtime.render.movies",
     "liganimate.runtime.exchange",
-    # The language server's incremental parser.
+    # The language server's incremental parser; the libraries (Appendix A LOADs none) and their cache;
+    # the did-you-mean hints of a wrong name.
     "liganimate.lang.incremental",
+    "liganimate.compiler.library",
+    "difflib",
 )
 #: Light modules under those packages that check does use: the host's framing of a scene and its camera,
 #: REACH's options and solver names.

@@ -2,7 +2,9 @@
 
 Owns :mod:`.model` (a figure as the solvers see it), :mod:`.goals` (goal
 kinds, residuals, Jacobians), :mod:`.solvers` (damped least squares, Jacobian
-transpose, cyclic coordinate descent) and :mod:`.reach` (poses and motions
+transpose, cyclic coordinate descent), :mod:`.entrywise` (point goals'
+kinematics entry by entry: in floats for one solve, in arrays for a batch)
+and :mod:`.reach` (poses and motions
 that meet goals) and :mod:`.language` (the STARTREACH block: GOAL lines
 into goals, the solve checked, warnings by goal).
 

@@ -1,27 +1,34 @@
-"""One pose in Python floats: a single solve's kinematics, point goals and damped step.
+"""Point goals' kinematics written entry by entry: in floats for one solve, in arrays for a batch.
 
-A single solve (the language's STARTREACH, ``reach``) of a figure of a few
-joints is about ten iterations on arrays of a handful of numbers, where one
-numpy call costs as much as twenty float operations.  For point goals on a
-small problem (:func:`kernel` says which), :func:`solvers._dls_one` takes its
-evaluation and its step from here, written in Python floats:
+Every entry of a rotation, an origin, an axis, a pivot or a Jacobian row is a
+value of its own, combined with ``+``, ``-`` and ``*`` only, so the same walk
+serves two uses:
 
-* the link frames, walked joint by joint from the main link.  A joint that
-  turns about one of its own axes, its other two at zero and no AXIS frame
-  (every hinge of a chain), is a plane rotation of two of its parent's
-  columns; any other joint is its full ``Rz Ry Rx`` (turned by its AXIS
-  frame, transposed when walked backwards) times its parent's rotation;
-* each variable's axis and pivot, the goals' residuals and Jacobian, as in
-  :meth:`IKModel.forward_one` and :meth:`GoalStack.evaluate_one`;
-* the damped step of ``solvers._held_step`` (hold, damped solve, cap,
-  projection), its small linear system solved by Gaussian elimination with
-  partial pivoting, and the acceptance of ``solvers._judged_step``.
+* **One solve** (the language's STARTREACH, ``reach``): about ten iterations
+  on a handful of numbers, where one numpy call costs as much as twenty
+  float operations.  For point goals on a small problem (:func:`kernel`
+  says which), :func:`solvers._dls_one` takes its evaluation and its step
+  from here in Python floats, with the damped step of
+  ``solvers._held_step`` (hold, damped solve, cap, projection; its 3x3
+  system by a written-out Cholesky factorisation, :func:`solve3`, any other
+  small one by Gaussian elimination with partial pivoting).
+* **A batch** (:func:`batch_evaluator`): each entry an array over the batch,
+  where the 4x4 products and gathers of :meth:`IKModel.forward_trig` and
+  :meth:`IKModel.axes_trig` cost several times more.
 
-The values are those of the numpy formulas up to rounding; the tests check
-both against each other on random trees, placements, limits and
-translation (``tests/runtime/ik/test_entrywise.py``).  Bigger problems, plane
-and axis goals stay with the numpy formulas, where the arithmetic, not the
-number of calls, is the cost.
+The walk goes joint by joint from the main link.  A joint that turns about
+one of its own axes, its other two at zero and no AXIS frame (every hinge
+of a chain), is a plane rotation of two of its parent's columns, and its
+variable's axis a column of the parent's rotation; any other joint is its
+full ``Rz Ry Rx`` (turned by its AXIS frame, transposed when walked
+backwards) times its parent's rotation.  A variable's pivot is its joint's
+location, passed on the way.
+
+The values are those of the numpy formulas (:meth:`IKModel.forward_one`,
+:meth:`GoalStack.evaluate_one` and ``evaluate``) up to rounding; the tests
+check both against each other on random trees, placements, limits,
+translation and slides (``tests/runtime/ik/test_entrywise.py``).  Plane and
+axis goals, and problems too big for it, stay with the numpy formulas.
 """
 
 from __future__ import annotations
@@ -35,7 +42,7 @@ import numpy as np
 
 __all__ = ["Kernel", "kernel", "batch_evaluator", "solve3", "MAX_SIZE", "MAX_FULL_JOINTS"]
 
-#: The scalar path takes problems with at most this many residual rows times
+#: The float path takes problems with at most this many residual rows times
 #: variables (a point goal on a 30-joint chain is 90): beyond, the step's
 #: products are long enough for numpy to win.
 MAX_SIZE = 240
@@ -213,7 +220,7 @@ class _Walk:
     """What the walk of one model needs, fixed per figure (kept on the model)."""
 
     steps: tuple  # per joint in walk order: (joint, parent link, child link, reversed, frame, near, far, variables)
-    variables: tuple  # per variable: (joint, axis, primary link, location on the primary, sign, frame)
+    n_vars: int
     n_links: int
     main: int
     lower: list  # the variables' bounds (radians; the translation's infinite)
@@ -223,7 +230,7 @@ class _Walk:
 
 def _walk_of(model) -> _Walk:
     """The model's :class:`_Walk`, built at its first single solve."""
-    walk = model.__dict__.get("_scalar_walk")
+    walk = model.__dict__.get("_entrywise_walk")
     if walk is not None:
         return walk
     fig = model.figure
@@ -247,16 +254,10 @@ def _walk_of(model) -> _Walk:
                     var_axes,
                 )
             )
-    variables = tuple(
-        (k, a, int(prim), _nonzero(loc), float(sign), frames[k])
-        for k, a, prim, loc, sign in zip(
-            model.var_joint.tolist(), model.var_axis.tolist(), model.var_primary, model.var_loc1, model.sign
-        )
-    )
     pad = [math.inf] * (model.n_params - model.n_vars)
     lower, upper = model.lower.tolist() + [-v for v in pad], model.upper.tolist() + pad
-    walk = _Walk(tuple(steps), variables, fig.n_links, fig.main, lower, upper, {})
-    model.__dict__["_scalar_walk"] = walk
+    walk = _Walk(tuple(steps), model.n_vars, fig.n_links, fig.main, lower, upper, {})
+    model.__dict__["_entrywise_walk"] = walk
     return walk
 
 
@@ -299,8 +300,8 @@ def _walked(walk: _Walk, kinds: list, trig: list, cv: list, sv: list, origin: tu
     """
     R: list = [None] * walk.n_links
     p: list = [None] * walk.n_links
-    omega: list = [None] * len(walk.variables)
-    pivot: list = [None] * len(walk.variables)
+    omega: list = [None] * walk.n_vars
+    pivot: list = [None] * walk.n_vars
     R[walk.main], p[walk.main] = origin
     for (k, parent, child, rev, frame, near, far, variables), kind in zip(walk.steps, kinds):
         RP = R[parent]

@@ -102,11 +102,12 @@ def reach_options(options: ReachOptions | None = None, **fields) -> ReachOptions
         return base
     # A script solving one figure again and again passes the same options
     # each time: dataclasses.replace costs more than the rest of the options.
-    try:
-        key = (base, tuple(fields.items()))
-        hit = _OPTIONS_MADE.get(key)
-    except TypeError:  # an unhashable value (a list of joints): made afresh
+    # Only plain values are remembered, with their types (1, 1.0 and True are
+    # equal keys, but not the same option: True restarts is an error).
+    if any(type(v) not in _PLAIN for v in fields.values()):
         return dataclasses.replace(base, **fields)
+    key = (base, tuple((k, type(v), v) for k, v in fields.items()))
+    hit = _OPTIONS_MADE.get(key)
     if hit is None:
         if len(_OPTIONS_MADE) >= 256:
             _OPTIONS_MADE.clear()
@@ -115,6 +116,7 @@ def reach_options(options: ReachOptions | None = None, **fields) -> ReachOptions
 
 
 _OPTIONS_MADE: dict = {}  # (options, fields) -> options with those fields; frozen values, so shared
+_PLAIN = (type(None), bool, int, float, str)
 
 
 @dataclass(frozen=True)

@@ -352,14 +352,28 @@ def _stoppable(fn, whole_process: bool) -> int:
     return status
 
 
+def _load_program(path: str) -> tuple:
+    """``compiler.load_program(path)``, the compiler itself imported with the cyclic collector paused.
+
+    Importing the compiler makes a few hundred classes, functions and
+    tables and no garbage, yet the collector walks them a dozen times on the
+    way (a few ms of a cold ``check``); compiling and running the module
+    pause it already (lang/collector.py).
+    """
+    from liganimate.lang import collector
+
+    with collector.paused():
+        from liganimate.compiler import load_program
+
+        return load_program(path)
+
+
 def cmd_run(args) -> int:
     def go():
         stem = os.path.splitext(os.path.basename(args.file))[0]
         _usage_checked(args, args.parser)
         options = _render_options(args, stem)
-        from liganimate.compiler import load_program
-
-        program, warnings = load_program(args.file)
+        program, warnings = _load_program(args.file)
         return _render(program, warnings, options)
 
     return guarded(go)
@@ -367,9 +381,7 @@ def cmd_run(args) -> int:
 
 def cmd_check(args) -> int:
     def go():
-        from liganimate.compiler import load_program
-
-        program, warnings = load_program(args.file)
+        program, warnings = _load_program(args.file)
         _print_diagnostics(warnings)
         _print_diagnostics(_checked(program, False, stdout=sys.stdout, asked=args.progress).warnings)
         return 0

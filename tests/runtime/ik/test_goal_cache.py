@@ -93,3 +93,15 @@ def test_single_solves_give_what_a_batch_gives():
         one = solve_pose(fig, [PointGoal("HAND", t)], tolerance=1e-6)
         assert one.status == batch.status[k]
         np.testing.assert_allclose(one.residuals, batch.residuals[k], atol=1e-6)
+
+
+def test_options_made_from_equal_values_of_other_types_are_not_confused():
+    """reach_options remembers options made from plain values, by value and type: True is no restart count."""
+    from liganimate.runtime.ik.reach import reach_options
+
+    assert reach_options(restarts=1).restarts == 1 and type(reach_options(restarts=1).restarts) is int
+    assert reach_options(restarts=True).restarts is True  # (solve_pose refuses it)
+    assert type(reach_options(restarts=1).restarts) is int
+    assert reach_options(tolerance=1).tolerance == 1 and type(reach_options(tolerance=1.0).tolerance) is float
+    assert reach_options(movable=[1, 2]).movable == [1, 2]  # not plain: made afresh
+    assert reach_options(restarts=2) is reach_options(restarts=2)
