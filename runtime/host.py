@@ -26,9 +26,11 @@ from liganimate.runtime import budgets, limits, printing
 from liganimate.runtime.arithmetic import Arithmetic
 from liganimate.runtime.errors import LigError
 from liganimate.runtime.figure import kinematics as K
-from liganimate.runtime.figure import morphing as MO
-from liganimate.runtime.figure import pose as P
 from liganimate.runtime.figure import tree as F
+
+# Posing (`figure.pose`) and morphing segments (`figure.morphing`) are imported
+# where they are first needed, not here: a check, and a program that draws
+# nothing, would pay for their set-up at start-up (issue 22's cold start).
 from liganimate.runtime.ik.options import ReachOptions  # generated modules build it as _host.ReachOptions
 from liganimate.runtime.library import Library  # noqa: F401  (generated modules name it _host.Library)
 from liganimate.runtime.motion import algebra as M
@@ -367,9 +369,11 @@ class Runtime(Arithmetic):
         """
         if value is None:
             self.fail(at, "a graphical object is used before it has a value")
-        if isinstance(value, Posed):
-            return self._guard(at, P.posed_graphical, value.figure, value.motion, value.frame)
-        if isinstance(value, F.Figure):
+        if isinstance(value, Posed | F.Figure):
+            from liganimate.runtime.figure import pose as P
+
+            if isinstance(value, Posed):
+                return self._guard(at, P.posed_graphical, value.figure, value.motion, value.frame)
             return self._guard(at, P.posed_graphical, value, None, 0.0)
         return value
 
@@ -609,6 +613,8 @@ class Runtime(Arithmetic):
         motion = self._guard(at, lambda: M.Motion.from_tracks(spec, root=root, arrays=arrays, turn=turn))
         if not morphs:
             return motion
+        from liganimate.runtime.figure import morphing as MO
+
         return self._guard(at, lambda: motion.with_morphs(MO.channels(morphs, motion.length, self.fail)))
 
     def _frames_in_order(self, kfs) -> None:
@@ -781,8 +787,12 @@ class Runtime(Arithmetic):
                 f"{', '.join(map(str, missing))}, which the model does not have",
             )
         if motion.morphs is not None:
+            from liganimate.runtime.figure import morphing as MO
+
             self._guard(at, MO.bind, fig, motion.morphs)
         if fig.slides.any():
+            from liganimate.runtime.figure import pose as P
+
             problem = P.slide_out_of_range(fig, motion)
             if problem is not None:
                 self.fail(at, *problem)
@@ -860,6 +870,8 @@ class SceneState:
 
     def measure(self) -> None:
         """Add this tick's drawing (and the background) to :attr:`extent`, for the default framing."""
+        from liganimate.runtime.figure import pose as P
+
         for item in self.background:
             tris = item.triangles if isinstance(item, Graphical) else P.static_triangles(item)[0]
             self.extent = framing.union(self.extent, framing.extent(tris))
@@ -872,6 +884,8 @@ def _rooted(posed: Posed) -> Posed:
     """A drawn pose with its motion's root track folded into the placement (world = placement @ Trans(root) @ Rot @ pose)."""
     if posed.motion.root is None and posed.motion.turn is None:
         return posed
+    from liganimate.runtime.figure import pose as P
+
     fig = posed.figure
     placed = P.rooted_placements(np.asarray(fig.placement)[None], posed.motion, np.array([posed.frame]))[0]
     return posed.with_figure(fig.with_placement(placed))

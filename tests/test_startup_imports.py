@@ -47,6 +47,13 @@ FORBIDDEN = (
     "liganimate.lang.incremental",
     "liganimate.compiler.library",
     "difflib",
+    # Posing and morphing segments: Appendix A poses nothing during a check (a graphical sum of
+    # graphicals, no figure drawn as one), so the kinematics' walks are never needed.
+    "liganimate.runtime.figure.pose",
+    "liganimate.runtime.figure.morphing",
+    "liganimate.runtime.figure.short",
+    "liganimate.runtime.figure.folded",
+    "liganimate.runtime.figure.walk",
 )
 #: Light modules under those packages that check does use: the host's framing of a scene and its camera,
 #: REACH's options and solver names.

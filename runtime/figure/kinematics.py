@@ -19,11 +19,10 @@ walk kept to cross-check it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
-from liganimate.runtime.figure import folded as _folded
-from liganimate.runtime.figure import short as _short
 from liganimate.runtime.figure.tree import Figure
 
 __all__ = [
@@ -216,8 +215,31 @@ def placed_transforms(figure: Figure, angles: np.ndarray, root) -> np.ndarray:
     """
     B = angles.shape[0]
     if 0 < B < SHORT:
-        return _short.placed_short(figure, angles, None if root is None else np.asarray(root, dtype=np.float64))
-    return _folded.placed_long(figure, angles, root)
+        return _placed_short(figure, angles, None if root is None else np.asarray(root, dtype=np.float64))
+    return _placed_long(figure, angles, root)
+
+
+# The two walks are imported on first use, not with this module: `check` and
+# every program that poses nothing (the matrices above are all it needs) would
+# pay for their set-up at start-up.
+_walks: tuple[Callable[..., np.ndarray], Callable[..., np.ndarray]] | None = None
+
+
+def _placed_short(figure, angles, root) -> np.ndarray:
+    return (_walks or _import_walks())[0](figure, angles, root)
+
+
+def _placed_long(figure, angles, root) -> np.ndarray:
+    return (_walks or _import_walks())[1](figure, angles, root)
+
+
+def _import_walks() -> tuple[Callable[..., np.ndarray], Callable[..., np.ndarray]]:
+    global _walks
+    from liganimate.runtime.figure.folded import placed_long
+    from liganimate.runtime.figure.short import placed_short
+
+    _walks = (placed_short, placed_long)
+    return _walks
 
 
 SHORT = 256
