@@ -28,7 +28,6 @@ a class that needs more keeps ``@dataclass``.
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import importlib
 import importlib.util
@@ -36,7 +35,6 @@ import inspect
 import os
 import re
 import reprlib
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, dataclass_transform, overload
@@ -266,24 +264,11 @@ def module_text() -> str:
 
 def main(argv=None) -> int:
     """Regenerate ``lang/_node_methods.py`` (or with ``--check``, report whether it is current)."""
-    ap = argparse.ArgumentParser(prog="python -m liganimate.lang.node_methods", description=main.__doc__)
-    ap.add_argument("--check", action="store_true", help="only check; exit 1 if the module is stale")
-    args = ap.parse_args(argv)
-    path = Path(__file__).with_name(_MODULE)
-    text = module_text()
-    current = path.read_text(encoding="utf-8") if path.exists() else None
-    if args.check:
-        if current != text:
-            print(f"{path} is stale: run python -m liganimate.lang.node_methods", file=sys.stderr)
-            return 1
-        print(f"{path} is current")
-        return 0
-    if current != text:
-        path.write_text(text, encoding="utf-8")
-        print(f"wrote {path}")
-    else:
-        print(f"{path} already current")
-    return 0
+    from .generated import regenerate
+
+    return regenerate(
+        argv, "liganimate.lang.node_methods", Path(__file__).with_name(_MODULE), module_text, main.__doc__ or ""
+    )
 
 
 if __name__ == "__main__":

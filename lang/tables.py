@@ -31,11 +31,9 @@ from freshly generated ones.
 
 from __future__ import annotations
 
-import argparse
 import functools
 import hashlib
 import json
-import sys
 from importlib import resources
 from pathlib import Path
 from typing import NamedTuple
@@ -285,24 +283,11 @@ def fresh_module_text() -> str:
 
 def main(argv=None) -> int:
     """Regenerate ``lang/_tables.py`` (or with ``--check``, report whether it is current)."""
-    ap = argparse.ArgumentParser(prog="python -m liganimate.lang.tables", description=main.__doc__)
-    ap.add_argument("--check", action="store_true", help="only check; exit 1 if the shipped tables are stale")
-    args = ap.parse_args(argv)
-    path = Path(__file__).with_name(_MODULE)
-    text = fresh_module_text()
-    current = path.read_text(encoding="utf-8") if path.exists() else None
-    if args.check:
-        if current != text:
-            print(f"{path} is stale: run python -m liganimate.lang.tables", file=sys.stderr)
-            return 1
-        print(f"{path} is current")
-        return 0
-    if current != text:
-        path.write_text(text, encoding="utf-8")
-        print(f"wrote {path}")
-    else:
-        print(f"{path} already current")
-    return 0
+    from .generated import regenerate
+
+    return regenerate(
+        argv, "liganimate.lang.tables", Path(__file__).with_name(_MODULE), fresh_module_text, main.__doc__ or ""
+    )
 
 
 if __name__ == "__main__":

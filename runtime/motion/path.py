@@ -23,7 +23,7 @@ from . import turning as tu
 __all__ = ["Drift", "Reversal", "Shift", "concat", "join", "repeat", "reverse", "shift"]
 
 
-class Shift(tr.Track):
+class Shift(tr.Wrapper):
     """A track moved by a constant displacement.
 
     Parameters
@@ -32,7 +32,7 @@ class Shift(tr.Track):
     d : array_like, shape (3,)
     """
 
-    __slots__ = ("d", "inner")
+    __slots__ = ("d",)
 
     def __init__(self, inner: tr.Track, d):
         self.inner = inner
@@ -42,8 +42,8 @@ class Shift(tr.Track):
         self.end_value = inner.end_value + self.d
         self.min_keys = inner.min_keys
 
-    def children(self):
-        return (self.inner,)
+    def _rewrapped(self, inner):
+        return Shift(inner, self.d)
 
     def sample(self, t):
         x, v, a = self.inner.sample(t)
@@ -52,26 +52,11 @@ class Shift(tr.Track):
     def sample_x(self, t):
         return self.inner.sample_x(t) + self.d
 
-    def _reversed(self, length, memo):
-        return Shift(tr.reverse(self.inner, length, memo), self.d)
-
-    def _scaled_frames(self, r, memo):
-        return Shift(tr.scale_frames(self.inner, r, memo), self.d)
-
-    def _mapped(self, m, memo):  # pragma: no cover - angle maps never reach a root path
-        raise TypeError("a root path has no angles to map")
-
     def _emit(self, out, offset):
         saved = out.shift
         out.shift = saved + (self.d if out.rot is None else out.rot @ self.d)
         self.inner._emit(out, offset)
         out.shift = saved
-
-    def _edge_leaf(self, side):
-        return tr.edge_leaf(self.inner, side)
-
-    def _with_edge(self, side, edge):
-        return Shift(tr.with_edge(self.inner, side, edge), self.d)
 
 
 def shift(track: tr.Track, d) -> tr.Track:

@@ -202,6 +202,42 @@ def _knot_velocity(s1, s2, kind_l, kind_r, w_l, w_r, cap_l, cap_r) -> np.ndarray
     return np.where(same, np.clip(v, -limit, limit), 0.0)
 
 
+class Wrapper(Track):
+    """A root-path node that changes one inner track's values pointwise (moved, turned).
+
+    The algebra's rebuilding (reversal, SCALE FRAMES, a junction's edge) goes
+    through to the inner track and wraps the result the same way; a subclass
+    gives :meth:`_rewrapped` and its own sampling and emitting.
+    """
+
+    __slots__ = ("inner",)
+    inner: Track
+
+    def _rewrapped(self, inner: Track) -> Track:
+        """This node's change applied to another inner track."""
+        raise NotImplementedError
+
+    def children(self) -> tuple[Track, ...]:
+        return (self.inner,)
+
+    def _reversed(self, length: float, memo: dict) -> Track:
+        return self._rewrapped(reverse(self.inner, length, memo))
+
+    def _scaled_frames(self, r: float, memo: dict) -> Track:
+        return self._rewrapped(scale_frames(self.inner, r, memo))
+
+    def _mapped(self, m: LeafMap, memo: dict) -> Track:  # pragma: no cover - angle maps never reach a root path
+        raise TypeError("a root path has no angles to map")
+
+    # A junction shares velocities only between leaves seen the same way: the edge leaf is the
+    # inner one (turning.edge_turn says how far a Rotated turns it).
+    def _edge_leaf(self, side: str) -> Leaf | None:
+        return edge_leaf(self.inner, side)
+
+    def _with_edge(self, side: str, edge: Edge) -> Track:
+        return self._rewrapped(with_edge(self.inner, side, edge))
+
+
 class Edge(NamedTuple):
     """A leaf's first or last segment as its neighbour across a junction sees it.
 

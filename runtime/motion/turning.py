@@ -90,7 +90,7 @@ def spiral_offsets(k: np.ndarray, theta: float, phi: float, step) -> np.ndarray:
     return np.column_stack([w.imag, k * step[1], w.real])
 
 
-class Rotated(tr.Track):
+class Rotated(tr.Wrapper):
     """A path turned by ``degrees`` about Y (values, velocities and accelerations alike).
 
     Parameters
@@ -99,7 +99,7 @@ class Rotated(tr.Track):
     degrees : float
     """
 
-    __slots__ = ("degrees", "inner", "matrix")
+    __slots__ = ("degrees", "matrix")
 
     def __init__(self, inner: tr.Track, degrees: float):
         self.inner, self.degrees = inner, float(degrees)
@@ -109,8 +109,11 @@ class Rotated(tr.Track):
         self.end_value = self.matrix @ inner.end_value
         self.min_keys = inner.min_keys
 
-    def children(self):
-        return (self.inner,)
+    # A junction shares velocities only between leaves seen in the same heading (the knot
+    # velocity is worked out axis by axis, so both sides must be in one frame): the edge
+    # leaf is the inner one (tr.Wrapper), and :func:`edge_turn` says how far it is turned.
+    def _rewrapped(self, inner):
+        return Rotated(inner, self.degrees)
 
     def sample(self, t):
         x, v, a = self.inner.sample(t)
@@ -120,29 +123,11 @@ class Rotated(tr.Track):
     def sample_x(self, t):
         return self.inner.sample_x(t) @ self.matrix.T
 
-    def _reversed(self, length, memo):
-        return Rotated(tr.reverse(self.inner, length, memo), self.degrees)
-
-    def _scaled_frames(self, r, memo):
-        return Rotated(tr.scale_frames(self.inner, r, memo), self.degrees)
-
-    def _mapped(self, m, memo):  # pragma: no cover - angle maps never reach a root path
-        raise TypeError("a root path has no angles to map")
-
     def _emit(self, out, offset):
         saved = out.rot
         out.rot = self.matrix if saved is None else saved @ self.matrix
         self.inner._emit(out, offset)
         out.rot = saved
-
-    # A junction shares velocities only between leaves seen in the same heading (the knot
-    # velocity is worked out axis by axis, so both sides must be in one frame): the edge
-    # leaf is the inner one, and :func:`edge_turn` says how far it is turned.
-    def _edge_leaf(self, side):
-        return tr.edge_leaf(self.inner, side)
-
-    def _with_edge(self, side, edge):
-        return Rotated(tr.with_edge(self.inner, side, edge), self.degrees)
 
 
 #: Turns (degrees) smaller than this count as none: a junction between paths turned by
