@@ -5,8 +5,9 @@ ground BOX, one still camera), at 640x480, in the thesis look and the
 modern look.  The renderer keeps each BACKGROUND object's triangles once a
 render (the static-background table) but projects them, spans them and
 fills their pixels with every image, merged with the figures' triangles.
-This measures, CPU time an image (the draw step alone, one process, best of
-several rounds, interleaved):
+This measures, CPU time an image (the draw step alone, one process, the
+round of least CPU of several, interleaved; the frame's wall time and the
+load are printed beside it):
 
 * **frame**: drawing the image as the renderer does;
 * **ground**: what the background adds (the frame less the same frame
@@ -37,7 +38,7 @@ import os
 import sys
 import tempfile
 
-from _clock import load_text, measure
+from _clock import Cost, best_of, load_text, measure
 
 from liganimate.compiler import load_program
 from liganimate.runtime.render import frames as R
@@ -80,12 +81,12 @@ def captured(program, look: str) -> list:
 
 
 def best(fns: dict, count: int, rounds: int) -> dict:
-    """CPU ms of one of ``count`` calls made by each function, best of ``rounds`` interleaved rounds."""
-    out = {name: float("inf") for name in fns}
+    """The cost (CPU and wall) of one of ``count`` calls made by each function, the round of least CPU of ``rounds`` interleaved."""
+    costs: dict[str, list[Cost]] = {name: [] for name in fns}
     for _ in range(rounds):
         for name, fn in fns.items():
-            out[name] = min(out[name], 1e3 * measure(fn).cpu / count)
-    return out
+            costs[name].append(measure(fn).per(count))
+    return {name: best_of(c) for name, c in costs.items()}
 
 
 def projection(draws: list, look: str, ground: bool):
@@ -142,10 +143,13 @@ def measure_look(program, look: str, count: int, rounds: int) -> dict:
         len(draws),
         rounds,
     )
-    full, without, copied = ms["full"], ms["without"], ms["copy"]
-    cached = ms["spans"] - ms["spans_without"]
+    cpu = {name: 1e3 * c.cpu for name, c in ms.items()}
+    full, without, copied = cpu["full"], cpu["without"], cpu["copy"]
+    cached = cpu["spans"] - cpu["spans_without"]
     return {
         "frame_ms": round(full, 4),
+        "frame_wall_ms": round(1e3 * ms["full"].wall, 4),
+        "load": ms["full"].load,
         "ground_ms": round(full - without, 4),
         "cacheable_ms": round(cached, 4),
         "buffers_ms": round(copied, 4),
@@ -169,7 +173,7 @@ def main(argv=None) -> int:
             m = measure_look(program, look, count, rounds)
             out[look] = m
             print(
-                f"{look:>6}: frame {m['frame_ms']:.3f} ms; the ground adds {m['ground_ms']:.3f} ms, of which a "
+                f"{look:>6}: frame {m['frame_ms']:.3f} ms CPU ({m['frame_wall_ms']:.3f} ms wall); the ground adds {m['ground_ms']:.3f} ms, of which a "
                 f"per-camera cache of its projection and spans could skip {m['cacheable_ms']:.3f} ms "
                 f"({100 * m['cacheable_ms'] / m['frame_ms']:.1f}% of the frame); copying a drawn background's "
                 f"buffers ({m['buffer_bytes'] / 1e6:.2f} MB) costs {m['buffers_ms']:.3f} ms"
