@@ -145,7 +145,7 @@ def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: i
     W, H = cam.size
     img = np.full((H, W) + np.shape(bg), bg, dtype=np.uint8)
     # Nothing drawn yet: the depth buffer need only span the pixels touched.
-    _draw(None, img, tris, shade, cam, cull, 0)
+    _draw(None, img, tris, shade, cam, cull, 0, bg)
     return downsample(img, aa)
 
 
@@ -280,16 +280,22 @@ class Framebuffer:
         return out
 
 
-def _draw(zbuf, img, tris, shade, camera, cull, first_index):
+def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
+    """Draw triangles into ``img`` (its depth keys ``zbuf``, or None for a fresh image of ``background``).
+
+    Returns the next draw's first triangle number.
+    """
     n = len(tris)
     if first_index + n >= _MAX_TRIANGLES:
         raise RenderError(f"Too many triangles in one image (more than {_MAX_TRIANGLES - 1}).")
     W, H = camera.size
     band_rows = None if W * H <= _ONE_BAND_PIXELS else max(1, _BAND_PIXELS // W)
     # A fresh image's depth keys are this draw's alone, so their tags may
-    # carry each triangle's grey level in their low byte: the winners'
-    # keys then give the pixels' grey levels directly (see _band).
-    packed = zbuf is None and shade.ndim == 1 and n <= _PACKED_TRIANGLES
+    # carry each triangle's grey level in their low byte, and "nothing drawn"
+    # may be the background's grey level (a key below any surface's): the
+    # depth keys then cast to bytes are the image (see _band).
+    packed = zbuf is None and shade.ndim == 1 and np.ndim(background) == 0 and n <= _PACKED_TRIANGLES
+    empty = background if packed else EMPTY
     spans = _spans(tris, cull, camera, first_index, band_rows, shade if packed else None) if n else None
     if spans is None:
         return first_index + n
@@ -298,7 +304,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
     bounds, tbounds = spans.bounds, spans.tbounds
     if len(bounds) == 2:
         lo, hi = spans.origin, spans.origin + spans.size
-        zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
+        zb = np.full(hi - lo, empty, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
         _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, packed)
         return first_index + n
     starts = bounds[:-1]
@@ -308,7 +314,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
     if flat_z is None:
         # One buffer for every band: clearing it while it is still in the
         # cache is cheaper than fresh zeroed pages from the kernel.
-        scratch = np.zeros(max(h - l for l, h in zip(los, his)), dtype=np.int64)
+        scratch = np.full(max(h - l for l, h in zip(los, his)), empty, dtype=np.int64)
     for i, (lo, hi) in enumerate(zip(los, his)):
         sl, tl = slice(bounds[i], bounds[i + 1]), slice(tbounds[i], tbounds[i + 1])
         if flat_z is not None:
@@ -316,7 +322,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index):
         else:
             zb = scratch[: hi - lo]
             if i:
-                zb.fill(EMPTY)
+                zb.fill(empty)
         band = _Spans(
             offset[sl] - lo, spans.wstart[sl], spans.step[sl], count[sl], spans.tag[tl], spans.nrows[tl], [], [], 0, 0
         )
@@ -347,8 +353,9 @@ class _Spans(NamedTuple):
 def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
     """Depth-test one band's spans into its depth keys and image (views of the band's pixel range).
 
-    ``fresh``: the depth keys were all EMPTY before this draw.  ``packed``:
-    the tags are ``number << 8 | grey level`` (only in a fresh draw).
+    ``fresh``: the depth keys were all EMPTY before this draw.  ``packed``
+    (only in a fresh draw): the tags are ``number << 8 | grey level``, and
+    the keys were all the background's grey level.
     """
     offset, wstart, step, count = spans.offset, spans.wstart, spans.step, spans.count
     # ends[k]: fragments up to the end of span k; ends0 has a 0 before them.
@@ -366,13 +373,14 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         frags[1:] -= frags[:-1].copy()
         pix, key = _expand(offset, wstart, step, count, ends, spans.tag, frags)
         np.maximum.at(zb, pix, key)
+        if packed:
+            # Each key's low byte is the grey level of the winner, or the background.
+            np.copyto(im, zb, casting="unsafe")
+            return
         if fresh:
             # Every key in the buffer is this draw's: each fragment may
             # paint its pixel's winner (some pixels several times, alike).
             key = zb.take(pix)
-            if packed:
-                im[pix] = key.astype(np.uint8)  # the low byte: the winner's grey level
-                return
             key &= _INDEX_MASK
             if first_index:
                 key -= first_index
@@ -399,8 +407,7 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
             np.maximum.at(zb, pix, key)
             lo = hi
     if packed:
-        sel = (zb != EMPTY).nonzero()[0]
-        im[sel] = zb.take(sel).astype(np.uint8)
+        np.copyto(im, zb, casting="unsafe")
         return
     num = zb & _INDEX_MASK
     sel = ((zb != EMPTY) & (num >= first_index)).nonzero()[0]
