@@ -432,7 +432,7 @@ def main(argv=None) -> int:
     from .generated import regenerate
 
     return regenerate(
-        argv, "liganimate.lang.node_methods", Path(__file__).with_name(_MODULE), module_text, main.__doc__ or ""
+        argv, "liganimate.lang.node_methods", [(Path(__file__).with_name(_MODULE), module_text)], main.__doc__ or ""
     )
 
 
