@@ -37,6 +37,7 @@ a class that needs more keeps ``@dataclass``.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import importlib
 import importlib.util
@@ -228,19 +229,23 @@ def written_shape(cls: type, frozen: bool) -> tuple | None:
     return (*out, *inherited.values())
 
 
-def _probe(frozen: bool, slots: bool) -> Any:
-    """A one-field class made by ``@dataclass`` with these options (its parameters and its field kind are shared)."""
-    key = (frozen, slots)
-    if key not in _PROBES:
-        _PROBES[key] = dataclasses.dataclass(frozen=frozen, slots=slots)(
-            type("Probe", (), {"__annotations__": {"x": "int"}})
-        )
-    return _PROBES[key]
-
-
-_PROBES: dict = {}
+#: A class @dataclass made with no methods: its field kind and parameters are what :func:`_assembled` sets.
+_PLAIN: Any = dataclasses.dataclass(init=False, repr=False, eq=False)(type("Plain", (), {"__annotations__": {"x": "int"}}))
 #: The kind of an ordinary field (dataclasses marks each field: ordinary, ClassVar or InitVar).
-_FIELD = dataclasses.fields(_probe(False, False))[0]._field_type  # type: ignore[attr-defined]
+_FIELD = dataclasses.fields(_PLAIN)[0]._field_type  # type: ignore[attr-defined]
+_PARAMS: dict = {}
+
+
+def _params(frozen: bool, slots: bool) -> Any:
+    """``__dataclass_params__`` as ``@dataclass(frozen=frozen, slots=slots, init=False, repr=False, eq=False)`` sets it."""
+    key = (frozen, slots)
+    if key not in _PARAMS:
+        params = copy.copy(_PLAIN.__dataclass_params__)
+        params.frozen = frozen
+        if hasattr(params, "slots"):  # recorded since Python 3.12
+            params.slots = slots
+        _PARAMS[key] = params
+    return _PARAMS[key]
 
 
 def _slots_of(cls: type) -> tuple:
@@ -294,7 +299,7 @@ def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
             delattr(cls, name)
         else:
             setattr(cls, name, f.default)
-    cls.__dataclass_params__ = _probe(frozen, slots).__dataclass_params__
+    cls.__dataclass_params__ = _params(frozen, slots)
     cls.__dataclass_fields__ = fields
     if "__match_args__" not in cls.__dict__:
         cls.__match_args__ = tuple(fields)  # type: ignore[misc]
