@@ -230,7 +230,9 @@ def written_shape(cls: type, frozen: bool) -> tuple | None:
 
 
 #: A class @dataclass made with no methods: its field kind and parameters are what :func:`_assembled` sets.
-_PLAIN: Any = dataclasses.dataclass(init=False, repr=False, eq=False)(type("Plain", (), {"__annotations__": {"x": "int"}}))
+_PLAIN: Any = dataclasses.dataclass(init=False, repr=False, eq=False)(
+    type("Plain", (), {"__annotations__": {"x": "int"}})
+)
 #: The kind of an ordinary field (dataclasses marks each field: ordinary, ClassVar or InitVar).
 _FIELD = dataclasses.fields(_PLAIN)[0]._field_type  # type: ignore[attr-defined]
 _PARAMS: dict = {}
