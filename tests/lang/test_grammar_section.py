@@ -90,3 +90,41 @@ def test_a_statement_declared_with_its_node_reaches_the_grammar_and_parses(regis
 def test_a_grammar_without_its_markers_is_refused_with_a_sentence():
     with pytest.raises(ValueError, match="no generated section"):
         grammar.fresh_text("start: statement\n")
+
+
+def test_fields_read_by_position_are_the_ones_the_generic_readers_find(monkeypatch):
+    # A production of fixed shape (NAME ASSIGN_OP rhs) is read by position
+    # (lang/transform.py); the generic readers, which search the children,
+    # are the definition. Both transformers must build the same trees.
+    from liganimate.lang import parser as P
+    from liganimate.lang import transform
+
+    fixed = [
+        rule
+        for rule, sx in R.SYNTAX.items()
+        if sx.cls is not None
+        and sx.pos is None
+        and (shape := transform._fixed_shape(R.PRODUCTIONS.get(rule))) is not None
+        and transform._positional(sx.readers, shape) is not None
+    ]
+    assert {"assignment", "continue_stmt", "view_point", "shoot_range", "stop_stmt"} <= set(fixed)
+
+    class Generic(ToAst):
+        pass
+
+    for rule in fixed:
+        sx = R.SYNTAX[rule]
+        setattr(Generic, rule, transform._node_rule(sx.cls, sx.readers, sx.pos))
+    generic = Driver(P.grammar(), Generic())
+    texts = [
+        "X = 1\nY := X + 2 * 3\nV :- (1, 2, 3)\nVIEW POINT = (1, 2, 3)\nVIEW WIDTH = 7.5\n"
+        "SHOOTSCENES FROM 1 TO 2 + 1\nSHOOTSCENES\nDO 10 I = 1, 3\nJ = I\n10 CONTINUE\nSTOP\nEND\n"
+    ]
+    for name in sorted(os.listdir(os.path.join(ROOT_DIR, "examples"))):
+        if name.endswith(".lig"):
+            with open(os.path.join(ROOT_DIR, "examples", name), encoding="utf-8") as fh:
+                texts.append(fh.read())
+    shipped = [P.parse(text) for text in texts]
+    monkeypatch.setattr(P, "driver", lambda: generic)
+    assert [P.parse(text) for text in texts] == shipped
+    assert len(texts) > 10 and sum(len(program.body) for program in shipped) > 200
