@@ -1431,7 +1431,7 @@ def lang_vocabulary__Modifier(_d, _f, FACTORY, _set=object.__setattr__):
         return NotImplemented
 
     def __hash__(self):
-        return hash((self.kind,self.label,self.methods,self.accepts,self.accepts_noun,self.nonzero,self.axis,))
+        return hash((self.kind,self.label,self.accepts,self.accepts_noun,self.nonzero,self.axis,))
 
     return __init__, __repr__, __eq__, __hash__
 
@@ -1648,7 +1648,7 @@ MAKERS = {
     'liganimate.lang.ast:Program': ((('frozen', False), ('pos', 'required', 'Pos'), ('filename', 'required', 'str'), ('source', 'required', 'str'), ('body', 'required', 'list'), ('primitives', 'factory', 'list')), lang_ast__Program, "Program(pos: 'Pos', filename: 'str', source: 'str', body: 'list', primitives: 'list' = <factory>)"),
     'liganimate.lang.diagnostics:Diagnostic': ((('frozen', False), ('filename', 'required', 'str'), ('pos', 'required', 'Pos'), ('message', 'required', 'str'), ('hint', 'default', 'str | None'), ('severity', 'default', 'str'), ('source', 'default', 'str | None'), ('notes', 'factory', 'list')), lang_diagnostics__Diagnostic, None),
     'liganimate.lang.source:Source': ((('frozen', False), ('filename', 'required', 'str'), ('text', 'required', 'str'), ('lexed', 'required', 'str'), ('warnings', 'factory', 'list')), lang_source__Source, None),
-    'liganimate.lang.vocabulary:Modifier': ((('frozen', True), ('kind', 'required', 'str'), ('label', 'required', 'str'), ('methods', 'required', 'dict'), ('accepts', 'default', 'tuple'), ('accepts_noun', 'default', 'str'), ('nonzero', 'default', 'bool'), ('axis', 'default', 'bool')), lang_vocabulary__Modifier, None),
+    'liganimate.lang.vocabulary:Modifier': ((('frozen', True), ('kind', 'required', 'str'), ('label', 'required', 'str'), ('methods', 'required', 'dict', 'unhashed'), ('accepts', 'default', 'tuple'), ('accepts_noun', 'default', 'str'), ('nonzero', 'default', 'bool'), ('axis', 'default', 'bool')), lang_vocabulary__Modifier, None),
     'liganimate.lang.vocabulary:Operator': ((('frozen', True), ('symbol', 'required', 'str'), ('rule', 'required', 'str'), ('left', 'required', 'tuple'), ('right', 'required', 'tuple'), ('result', 'required', 'str | None'), ('runtime', 'default', 'str | None'), ('at_operator', 'default', 'bool'), ('animated', 'default', 'bool'), ('group_right', 'default', 'bool')), lang_vocabulary__Operator, None),
     'liganimate.lang.vocabulary:Function': ((('frozen', True), ('name', 'required', 'str'), ('params', 'required', 'tuple'), ('result', 'required', 'Type | None'), ('runtime', 'required', 'str')), lang_vocabulary__Function, None),
     'liganimate.lang.vocabulary:Block': ((('frozen', True), ('opener', 'required', 'str'), ('closer', 'required', 'str'), ('shown', 'required', 'str')), lang_vocabulary__Block, None),

@@ -168,13 +168,26 @@ class Node:
 # ------------------------------------------------------------ declarations
 
 
-def syntax(rule: str, pos: R.Reader | None = None, **readers: R.Reader) -> Callable[[type], type]:
+def syntax(
+    rule: str,
+    pos: R.Reader | None = None,
+    *,
+    statement: str | None = None,
+    production: str | None = None,
+    **readers: R.Reader,
+) -> Callable[[type], type]:
     """Declare that grammar rule ``rule`` makes the decorated node class (put it above ``@node``).
 
     Parameters
     ----------
     rule : str
         The rule or alias of lang/lig.lark; a class may be made by several.
+    statement, production : str, optional
+        The rule's production (Lark's notation), written into lig.lark by
+        ``python -m liganimate.lang.tables`` (lang/grammar.py): a statement's
+        (an alternative of ``?statement``), or a part's. A rule given
+        neither is written in lig.lark by hand (an alias, or a part shared
+        by several statements).
     pos : Reader, optional
         How the node's position is read (lang/syntax.py); by default the
         span of all the rule's children.
@@ -203,29 +216,38 @@ def syntax(rule: str, pos: R.Reader | None = None, **readers: R.Reader) -> Calla
         unknown = set(readers) - {name for name, _ in chosen}
         assert not unknown and rule not in SYNTAX, (rule, unknown)
         SYNTAX[rule] = Syntax(rule, cls, tuple(chosen), pos)
+        if statement is not None or production is not None:
+            R.produce(rule, statement or production or "", statement=statement is not None)
         return cls
 
     return register
 
 
-def read(reader: R.Reader | None = None, *, binds: str | None = None, holds: bool = False) -> dict[str, Any]:
-    """A field's metadata: read by ``reader``, binding names (``binds``) or holding statements (``holds``).
+def read(
+    reader: R.Reader | None = None, *, binds: str | None = None, uses: bool = False, holds: bool = False
+) -> dict[str, Any]:
+    """A field's metadata: read by ``reader``, binding names (``binds``), using one (``uses``) or holding statements.
 
     Write ``field(metadata=read(...))``. ``binds`` is "assigns" (the
     statement gives the names a value), "figure" (FIGURE's new value of its
     model, which some questions leave out) or "declares" (a declaration: a
-    type, no value).
+    type, no value). ``uses`` marks a ``Name`` field that names a variable
+    the statement reads without an expression (ANIMATE's model): the
+    editor's index counts it among the variable's references. ``holds``
+    marks a list of statements the statement holds.
     """
     metadata: dict[str, Any] = {"read": reader} if reader is not None else {}
     if binds is not None:
         metadata["binds"] = binds
+    if uses:
+        metadata["uses"] = True
     if holds:
         metadata["holds"] = True
     return metadata
 
 
 def statement_fields(key: str) -> dict[type, tuple[tuple[str, Any], ...]]:
-    """Each node class with fields that declare ``key`` ("binds", "holds") -> those fields and what they say, in order."""
+    """Each node class with fields that declare ``key`` ("binds", "uses", "holds") -> those fields and what they say, in order."""
     found: dict[type, tuple[tuple[str, Any], ...]] = {}
     # The module's classes, not Node.__subclasses__(): a slots dataclass leaves the class it replaced behind.
     for cls in list(globals().values()):
@@ -378,23 +400,26 @@ def AS_LABEL(text: str, pos: Pos) -> int | float:
 
 
 # The parts made of one token or a list of values.
-value_rule("decl_name", R.token("NAME", AS_NAME))
+value_rule("decl_name", R.token("NAME", AS_NAME), production="NAME")
 value_rule("interpolate", R.token("NAME", AS_NAME))
 value_rule("position", R.rest())
-value_rule("block", R.rest())
+value_rule("block", R.rest(), production="BEGIN _sep* (statement _sep*)* END")
 value_rule("table_column", R.value())
 value_rule("pattern", R.rest())
 value_rule("goal_link", R.token(("NAME", "NUMBER"), {"NAME": AS_NAME, "NUMBER": AS_NUM}))
 
 
-@syntax("declaration", type=R.token("TYPE_KW", lambda text: Type(upper_name(text))))
+R.produce("_name_list", 'decl_name ("," decl_name)*')
+
+
+@syntax("declaration", statement="TYPE_KW _name_list", type=R.token("TYPE_KW", lambda text: Type(upper_name(text))))
 @node
 class Decl(Node):
     type: str  # a vocabulary.Type
     names: list = field(metadata=read(R.rest(), binds="declares"))  # of Name
 
 
-@syntax("assignment", op=R.token("ASSIGN_OP", R.TEXT))
+@syntax("assignment", statement="NAME ASSIGN_OP rhs", op=R.token("ASSIGN_OP", R.TEXT))
 @node
 class Assign(Node):
     target: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
@@ -410,7 +435,11 @@ class Keyframe(Node):
     method: Name | None
 
 
-@syntax("keyframe_assign", op=R.token("ASSIGN_OP", R.TEXT))
+@syntax(
+    "keyframe_assign",
+    statement='NAME "[" (expr | root_track) "," expr "]" ASSIGN_OP keyframe',
+    op=R.token("ASSIGN_OP", R.TEXT),
+)
 @node
 class KeyframeAssign(Node):
     target: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
@@ -420,7 +449,13 @@ class KeyframeAssign(Node):
     keyframe: Keyframe
 
 
-@syntax("do_stmt", label=R.token("NUMBER", AS_LABEL), var=R.token("NAME", AS_NAME), step=R.value())
+@syntax(
+    "do_stmt",
+    statement='DO NUMBER NAME "=" expr "," expr ("," expr)?',
+    label=R.token("NUMBER", AS_LABEL),
+    var=R.token("NAME", AS_NAME),
+    step=R.value(),
+)
 @node
 class DoHeader(Node):
     """``DO label var = a, b[, step]`` before loops are grouped."""
@@ -432,7 +467,7 @@ class DoHeader(Node):
     step: Node | None
 
 
-@syntax("continue_stmt", label=R.token("NUMBER", AS_LABEL))
+@syntax("continue_stmt", statement="NUMBER CONTINUE", label=R.token("NUMBER", AS_LABEL))
 @node
 class Continue(Node):
     label: int
@@ -451,7 +486,10 @@ class Do(Node):
     end_pos: Pos = NOWHERE
 
 
-@syntax("if_stmt")
+R.produce("_branch", "statement | block")
+
+
+@syntax("if_stmt", statement="IF cond THEN _branch (ELSE _branch)?")
 @node
 class If(Node):
     cond: Node
@@ -459,7 +497,7 @@ class If(Node):
     orelse: list | None = field(metadata=read(R.block(), holds=True))
 
 
-@syntax("joint_stmt", args=R.item(0), slide=R.item(1), axis=R.item(2))
+@syntax("joint_stmt", production="JOINT joint_args", args=R.item(0), slide=R.item(1), axis=R.item(2))
 @node
 class JointStmt(Node):
     args: list
@@ -467,7 +505,7 @@ class JointStmt(Node):
     axis: Node | None = None
 
 
-@syntax("model_block", joints=R.rest())
+@syntax("model_block", statement="STARTMODEL NAME _sep* (joint_stmt _sep*)* ENDMODEL", joints=R.rest())
 @node
 class ModelBlock(Node):
     name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
@@ -523,7 +561,12 @@ class MotionTable(Node):
     data: object = None
 
 
-@syntax("motion_block", joints=R.rest(of=MotionJoint), tables=R.rest(of=MotionTable))
+@syntax(
+    "motion_block",
+    statement="STARTMOTION NAME _sep* ((motion_joint | motion_root | motion_table | motion_morph) _sep*)* ENDMOTION",
+    joints=R.rest(of=MotionJoint),
+    tables=R.rest(of=MotionTable),
+)
 @node
 class MotionBlock(Node):
     name: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="assigns"))
@@ -581,8 +624,11 @@ class Option(Node):
     value: Node
 
 
+# Goal-directed positioning (not in the thesis; see docs/language.md 4.17):
+# a MOTION from a start pose to the pose that best meets weighted goals.
 @syntax(
     "reach_block",
+    statement="STARTREACH NAME MODEL_KW expr FRAME expr interpolate? (FROM expr)? _sep* (reach_item _sep*)* ENDREACH",
     method=R.value(of=Name),
     start=R.after("FROM"),
     goals=R.rest(of=Goal),
@@ -612,7 +658,13 @@ class ReachBlock(Node):
     options: dict = field(default_factory=dict)  # option word -> Pos of each line that gives it (for duplicates)
 
 
-@syntax("figure_stmt", kind=R.which(("LINK", "JOINT")), link=R.after("LINK", AS_NAME), joint=R.after("JOINT"))
+@syntax(
+    "figure_stmt",
+    statement="FIGURE NAME MAIN (LINK NAME | JOINT expr)?",
+    kind=R.which(("LINK", "JOINT")),
+    link=R.after("LINK", AS_NAME),
+    joint=R.after("JOINT"),
+)
 @node
 class FigureStmt(Node):
     model: Name = field(metadata=read(R.token("NAME", AS_NAME), binds="figure"))
@@ -621,7 +673,14 @@ class FigureStmt(Node):
     joint: Node | None = None
 
 
-@syntax("scene_block", length=R.after("LENGTH"), sameframe=R.after("SAMEFRAME"), start_pos=R.where(3))
+@syntax(
+    "scene_block",
+    statement="INITIALIZE SCENE expr _sep* (statement _sep*)* STARTSCENE LENGTH expr (SAMEFRAME expr)? _sep*"
+    " (statement _sep*)* ENDSCENE",
+    length=R.after("LENGTH"),
+    sameframe=R.after("SAMEFRAME"),
+    start_pos=R.where(3),
+)
 @node
 class Scene(Node):
     scene_id: Node
@@ -632,17 +691,17 @@ class Scene(Node):
     start_pos: Pos = NOWHERE
 
 
-@syntax("animate_stmt", model=R.token("NAME", AS_NAME), repeat=R.flag("REPEAT"))
+@syntax("animate_stmt", statement="ANIMATE NAME FROM expr TO expr USING expr REPEAT?", repeat=R.flag("REPEAT"))
 @node
 class Animate(Node):
-    model: Name
+    model: Name = field(metadata=read(R.token("NAME", AS_NAME), uses=True))
     start: Node
     end: Node
     motion: Node
     repeat: bool
 
 
-@syntax("background_stmt", items=R.rest())
+@syntax("background_stmt", statement='BACKGROUND expr ("," expr)*', items=R.rest())
 @node
 class Background(Node):
     items: list
@@ -666,7 +725,7 @@ def _print_value(item: Node) -> PrintItem:
     return item if isinstance(item, PrintItem) else PrintItem(item.pos, "value", item)
 
 
-@syntax("print_stmt", items=R.rest(convert=_print_value))
+@syntax("print_stmt", statement='PRINT print_item ("," print_item)*', items=R.rest(convert=_print_value))
 @node
 class Print(Node):
     items: list
@@ -725,15 +784,21 @@ class Declared(Node):
 
 
 def declared(
-    rule: str, runtime: str, places: frozenset[str] = PLACES, misplaced: str = "", hint: str | None = None
+    rule: str,
+    runtime: str,
+    places: frozenset[str] = PLACES,
+    misplaced: str = "",
+    hint: str | None = None,
+    *,
+    statement: str,
 ) -> Callable[[type], type]:
     """Declare a statement: register the node class it decorates (and its :func:`syntax`).
 
     Parameters
     ----------
     rule : str
-        The grammar rule or alias (lang/lig.lark) whose children, keywords
-        dropped, are the node's parts in order.
+        The grammar rule whose children, keywords dropped, are the node's
+        parts in order.
     runtime : str
         The ``Runtime`` method (runtime/host.py) the statement lowers to,
         called with the parts' values (a ``many`` part as a tuple) and the
@@ -742,6 +807,8 @@ def declared(
         Where it may stand, a subset of :data:`PLACES`.
     misplaced, hint : str
         The error (and its hint) where it stands elsewhere.
+    statement : str
+        The rule's production (see :func:`syntax`).
     """
     assert places <= PLACES and (places == PLACES or misplaced), rule
 
@@ -750,44 +817,57 @@ def declared(
         # Only the last part may take the rest of the children.
         assert all(not p.many for _, p in parts[:-1]), cls.__name__
         DECLARED[cls] = Declaration(rule, runtime, places, misplaced, hint, parts)
-        return syntax(rule)(cls)
+        return syntax(rule, statement=statement)(cls)
 
     return register
 
 
-@declared("view_point", "set_view_point")
+@declared("view_point", "set_view_point", statement='VIEW POINT "=" expr')
 @node
 class ViewPoint(Declared):
     point: Node = part(Type.VECTOR, what="a view point (x, y, z)")
 
 
-@declared("view_width", "set_view_width")
+@declared("view_width", "set_view_width", statement='VIEW WIDTH_KW "=" expr')
 @node
 class ViewWidth(Declared):
     width: Node = part(*NUMBER, what="a view width")
 
 
-@declared("shoot_stmt", "shoot", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
+@declared(
+    "shoot_stmt",
+    "shoot",
+    frozenset({"top"}),
+    "SHOOTSCENES belongs outside scenes and primitives",
+    statement="SHOOTSCENES",
+)
 @node
 class Shoot(Declared):
     pass
 
 
+# SHOOTSCENES FROM a TO b (not in the thesis; see docs/language.md 4.9): only scenes a to b.
 # A Shoot, so that a library refuses it and an archive leaves it out as it does SHOOTSCENES.
-@declared("shoot_range", "shoot_range", frozenset({"top"}), "SHOOTSCENES belongs outside scenes and primitives")
+@declared(
+    "shoot_range",
+    "shoot_range",
+    frozenset({"top"}),
+    "SHOOTSCENES belongs outside scenes and primitives",
+    statement="SHOOTSCENES FROM expr TO expr",
+)
 @node
 class ShootRange(Shoot):
     first: Node = part(Type.INTEGER, what="the first scene to shoot")
     last: Node = part(Type.INTEGER, what="the last scene to shoot")
 
 
-@syntax("stop_stmt")
+@syntax("stop_stmt", statement="STOP")
 @node
 class Stop(Node):
     pass
 
 
-@syntax("return_stmt")
+@syntax("return_stmt", statement="RETURN")
 @node
 class Return(Node):
     pass
@@ -799,20 +879,31 @@ class ProgramEnd(Node):
     pass
 
 
-@syntax("draw_with", pos=R.through("modifiers"), modifiers=R.value(convert=lambda mods: mods[1:-1]))
+# Inside a PRIMITIVE: DRAW WITH <LIGHTNESS l> (or <COLOUR (r, g, b)>) and DRAW POLY FROM (p) TO (q) ...
+@syntax(
+    "draw_with",
+    statement="DRAW WITH modlist",
+    pos=R.through("modifiers"),
+    modifiers=R.value(convert=lambda mods: mods[1:-1]),
+)
 @node
 class DrawWith(Node):
     modifiers: list
 
 
-@syntax("draw_poly", points=R.rest())
+@syntax("draw_poly", statement="DRAW POLY FROM expr (TO expr)+", points=R.rest())
 @node
 class DrawPoly(Node):
     points: list
 
 
+# LOAD 'library'  or  LOAD NAME, NAME FROM 'library' (see docs/language.md)
+R.produce("_load_name", "NAME | PRIM_NAME")
+
+
 @syntax(
     "load_stmt",
+    statement='LOAD STRING | LOAD _load_name ("," _load_name)* FROM STRING',
     library=R.token("STRING", R.UNQUOTE),
     library_pos=R.token("STRING", R.POS),
     names=R.token(("NAME", "PRIM_NAME"), AS_NAME, many=True),

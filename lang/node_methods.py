@@ -11,16 +11,25 @@ a dataclass (``dataclasses.fields``, ``replace`` and the field metadata
 work as before, with slots or frozen as asked), but those methods come from
 ``lang/_node_methods.py``, where the source dataclasses would write is kept
 already compiled (as pycparser keeps its node classes in a generated
-module). :func:`node`, the syntax tree's, is ``record(slots=True)``. The
-module is generated from the classes themselves::
+module). :func:`node`, the syntax tree's, is ``record(slots=True)``.
+
+Nor does a class whose fields are as the module records them go through
+``@dataclass`` at all: its inspection of every annotation and default was
+most of what remained (about 40 microseconds a class). The fields are read
+from the class as written (:func:`written_shape`) and, when they match, the
+class is assembled directly (:func:`_assembled`: the same ``Field`` objects,
+parameters, ``__match_args__``, slots, and a frozen class's ``__setattr__``
+and ``__delattr__``). tests/lang/test_node_methods.py holds every record to
+what ``@dataclass`` makes of the same fields. The module is generated from
+the classes themselves::
 
     python -m liganimate.lang.node_methods          # rewrite lang/_node_methods.py
     python -m liganimate.lang.node_methods --check  # exit 1 if it is stale
 
 A class whose fields differ from what the module was written for (an edited
 class not yet regenerated) gets its methods compiled here, from the same
-source, at the old cost; tests/lang/test_node_methods.py fails until the
-module is regenerated, and checks the methods behave as ``@dataclass``'s.
+source, at the old cost, and by ``@dataclass``; tests/lang/test_node_methods.py
+fails until the module is regenerated.
 Fields are plain: a default or a default factory at most (no ``init=False``,
 ``repr=False``, ``compare=False`` or keyword-only fields, no ``__post_init__``);
 a class that needs more keeps ``@dataclass``.
@@ -28,6 +37,7 @@ a class that needs more keeps ``@dataclass``.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import importlib
 import importlib.util
@@ -56,6 +66,8 @@ FACTORY = _Factory()
 MADE: list = []
 #: Those of them with a docstring of their own (the others get @dataclass's, their signature).
 _OWN_DOC: set = set()
+#: Those of them made from the written-out module without @dataclass (the others: an edited class, not yet written out).
+WRITTEN: set = set()
 
 
 def shape(cls: type) -> tuple:
@@ -74,8 +86,13 @@ def shape(cls: type) -> tuple:
             raise TypeError(
                 f"{cls.__qualname__}.{f.name}: a record's fields are plain (init, repr, compare, positional)"
             )
-        out.append((f.name, kind, f.type if isinstance(f.type, str) else repr(f.type)))
+        out.append(_entry(f.name, kind, f.type if isinstance(f.type, str) else repr(f.type), f.hash))
     return tuple(out)
+
+
+def _entry(name: str, kind: str, annotation: str, hashed: bool | None) -> tuple:
+    # A field declared field(hash=False) is left out of the hash, as @dataclass leaves it out.
+    return (name, kind, annotation) if hashed is not False else (name, kind, annotation, "unhashed")
 
 
 def source(cls: type, maker: str) -> str:
@@ -88,7 +105,7 @@ def source(cls: type, maker: str) -> str:
     """
     (_, frozen), *spec = shape(cls)
     params, body = ["self"], []
-    for name, kind, _ in spec:
+    for name, kind, *_ in spec:
         value = name
         if kind == "required":
             params.append(name)
@@ -99,7 +116,8 @@ def source(cls: type, maker: str) -> str:
             value = f"_f[{name!r}]() if {name} is FACTORY else {name}"
         # A frozen class's own __setattr__ refuses: @dataclass sets its fields through object's.
         body.append(f"        _set(self, {name!r}, {value})" if frozen else f"        self.{name} = {value}")
-    names = [name for name, _, _ in spec]
+    names = [name for name, *_ in spec]
+    hashed = "".join(f"self.{name}," for name, _, _, *unhashed in spec if not unhashed)
     shown = ", ".join(f"{n}={{self.{n}!r}}" for n in names)
     mine = "".join(f"self.{n}," for n in names)
     theirs = "".join(f"other.{n}," for n in names)
@@ -118,7 +136,7 @@ def source(cls: type, maker: str) -> str:
             "        return NotImplemented",
             "",
             *(
-                ["    def __hash__(self):", f"        return hash(({mine}))", ""]
+                ["    def __hash__(self):", f"        return hash(({hashed}))", ""]
                 if frozen
                 else ["    __hash__ = None", ""]
             ),
@@ -154,6 +172,155 @@ def _key(cls: type) -> str:
     return f"{cls.__module__}:{cls.__qualname__}"
 
 
+#: What a field's value in the class body cannot be for the written-out path: what only @dataclass handles.
+_ONLY_DATACLASS = ("ClassVar", "InitVar", "KW_ONLY")
+
+
+def _plain(f: dataclasses.Field) -> bool:
+    # What shape() accepts of a field (a field(...) not yet processed has kw_only MISSING: positional).
+    return f.init and f.repr and f.compare and f.kw_only in (dataclasses.MISSING, False)
+
+
+def _kind(f: dataclasses.Field) -> str:
+    if f.default_factory is not dataclasses.MISSING:
+        return "factory"
+    return "required" if f.default is dataclasses.MISSING else "default"
+
+
+def written_shape(cls: type, frozen: bool) -> tuple | None:
+    """:func:`shape` of the class ``@record`` would make, read from the class as written, before any ``@dataclass``.
+
+    None where only ``@dataclass`` can say (a ``ClassVar``, ``InitVar`` or
+    keyword-only marker, a field that is not plain, a mutable default, a
+    ``__post_init__``, a base frozen otherwise): such a class is made by
+    ``@dataclass``, which also raises its errors.
+    """
+    if hasattr(cls, "__post_init__"):
+        return None
+    out: list = [("frozen", frozen)]
+    inherited: dict = {}
+    for base in cls.__mro__[-1:0:-1]:  # as @dataclass collects them: the farthest base first
+        base_fields = base.__dict__.get("__dataclass_fields__")
+        if base_fields is None:
+            continue
+        if base.__dict__["__dataclass_params__"].frozen != frozen:
+            return None
+        for f in base_fields.values():
+            if f._field_type is not _FIELD or not _plain(f) or not isinstance(f.type, str):
+                return None
+            inherited[f.name] = _entry(f.name, _kind(f), f.type, f.hash)
+    body = cls.__dict__
+    for name, annotation in body.get("__annotations__", {}).items():
+        if not isinstance(annotation, str) or any(word in annotation for word in _ONLY_DATACLASS):
+            return None
+        value = body.get(name, dataclasses.MISSING)
+        hashed = None
+        if isinstance(value, dataclasses.Field):
+            if not _plain(value):
+                return None
+            kind, hashed = _kind(value), value.hash
+        elif value is dataclasses.MISSING:
+            kind = "required"
+        elif value.__class__.__hash__ is None:  # a mutable default: @dataclass refuses it
+            return None
+        else:
+            kind = "default"
+        inherited[name] = _entry(name, kind, annotation, hashed)
+    return (*out, *inherited.values())
+
+
+#: A class @dataclass made with no methods: its field kind and parameters are what :func:`_assembled` sets.
+_PLAIN: Any = dataclasses.dataclass(init=False, repr=False, eq=False)(
+    type("Plain", (), {"__annotations__": {"x": "int"}})
+)
+#: The kind of an ordinary field (dataclasses marks each field: ordinary, ClassVar or InitVar).
+_FIELD = dataclasses.fields(_PLAIN)[0]._field_type  # type: ignore[attr-defined]
+_PARAMS: dict = {}
+
+
+def _params(frozen: bool, slots: bool) -> Any:
+    """``__dataclass_params__`` as ``@dataclass(frozen=frozen, slots=slots, init=False, repr=False, eq=False)`` sets it."""
+    key = (frozen, slots)
+    if key not in _PARAMS:
+        params = copy.copy(_PLAIN.__dataclass_params__)
+        params.frozen = frozen
+        if hasattr(params, "slots"):  # recorded since Python 3.12
+            params.slots = slots
+        _PARAMS[key] = params
+    return _PARAMS[key]
+
+
+def _slots_of(cls: type) -> tuple:
+    slots = cls.__dict__.get("__slots__", ())
+    return (slots,) if isinstance(slots, str) else tuple(slots)
+
+
+def _frozen_setattr(cls: type, names: frozenset) -> tuple:
+    def __setattr__(self, name, value):
+        if type(self) is cls or name in names:
+            raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
+        super(cls, self).__setattr__(name, value)
+
+    def __delattr__(self, name):
+        if type(self) is cls or name in names:
+            raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
+        super(cls, self).__delattr__(name)
+
+    return __setattr__, __delattr__
+
+
+def _getstate(self) -> list:
+    return [getattr(self, f.name) for f in dataclasses.fields(self)]
+
+
+def _setstate(self, state) -> None:
+    for f, value in zip(dataclasses.fields(self), state, strict=True):
+        object.__setattr__(self, f.name, value)  # a frozen class's own __setattr__ refuses
+
+
+def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
+    """The class ``@dataclass`` would make of ``cls`` (its fields, parameters, slots, frozen attributes), methods aside.
+
+    What ``dataclasses.dataclass(cls, init=False, repr=False, eq=False)``
+    does, for a class whose :func:`written_shape` is known, without its
+    inspection of each annotation and default (most of a node class's cost).
+    """
+    fields: dict = {}
+    for base in cls.__mro__[-1:0:-1]:
+        fields.update(base.__dict__.get("__dataclass_fields__", {}))
+    for name, annotation in cls.__dict__.get("__annotations__", {}).items():
+        value = cls.__dict__.get(name, dataclasses.MISSING)
+        f: Any = value if isinstance(value, dataclasses.Field) else dataclasses.field(default=value)
+        f.name, f.type, f._field_type = name, annotation, _FIELD
+        if f.kw_only is dataclasses.MISSING:
+            f.kw_only = False
+        fields[name] = f
+        if value is not f:
+            continue
+        if f.default is dataclasses.MISSING:  # as @dataclass: a field(...) leaves its default, or nothing, behind
+            delattr(cls, name)
+        else:
+            setattr(cls, name, f.default)
+    cls.__dataclass_params__ = _params(frozen, slots)
+    cls.__dataclass_fields__ = fields
+    if "__match_args__" not in cls.__dict__:
+        cls.__match_args__ = tuple(fields)  # type: ignore[misc]
+    if slots:
+        body = dict(cls.__dict__)
+        inherited = {name for base in cls.__mro__[1:-1] for name in _slots_of(base)}
+        body["__slots__"] = tuple(name for name in fields if name not in inherited)
+        for name in (*fields, "__dict__", "__weakref__"):
+            body.pop(name, None)
+        qualname = cls.__qualname__
+        cls = type(cls)(cls.__name__, cls.__bases__, body)
+        cls.__qualname__ = qualname
+        if frozen:
+            cls.__getstate__, cls.__setstate__ = _getstate, _setstate
+    if frozen:
+        cls.__setattr__, cls.__delattr__ = _frozen_setattr(cls, frozenset(fields))
+    return cls
+
+
 def _make(cls: Any, frozen: bool, slots: bool) -> Any:
     made: Any = _makers().get(_key(cls))
     own_doc = cls.__dict__.get("__doc__")
@@ -165,10 +332,15 @@ def _make(cls: Any, frozen: bool, slots: bool) -> Any:
         own.add("__hash__")
     if made is not None and not own_doc and made[2] is not None:
         cls.__doc__ = made[2]  # set first: @dataclass would compute it through inspect.signature
-    # @dataclass still makes the fields, the slots and a frozen class's __setattr__ and __delattr__.
-    cls = dataclasses.dataclass(cls, frozen=frozen, slots=slots, init=False, repr=False, eq=False)
-    stale = made is None or made[0] != shape(cls)
-    maker = _compiled(cls) if stale else made[1]
+    stale = made is None or made[0] != written_shape(cls, frozen)
+    if stale:
+        # @dataclass makes the fields, the slots and a frozen class's __setattr__ and __delattr__.
+        cls = dataclasses.dataclass(cls, frozen=frozen, slots=slots, init=False, repr=False, eq=False)
+        maker = _compiled(cls)
+    else:
+        cls = _assembled(cls, frozen, slots)
+        maker = made[1]
+        WRITTEN.add(cls)
     fields = dataclasses.fields(cls)
     defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
     factories = {f.name: f.default_factory for f in fields if f.default_factory is not dataclasses.MISSING}
@@ -267,7 +439,7 @@ def main(argv=None) -> int:
     from .generated import regenerate
 
     return regenerate(
-        argv, "liganimate.lang.node_methods", Path(__file__).with_name(_MODULE), module_text, main.__doc__ or ""
+        argv, "liganimate.lang.node_methods", [(Path(__file__).with_name(_MODULE), module_text)], main.__doc__ or ""
     )
 
 

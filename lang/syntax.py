@@ -228,7 +228,49 @@ class Syntax(NamedTuple):
 SYNTAX: dict[str, Syntax] = {}
 
 
-def value_rule(rule: str, *readers: Reader) -> None:
-    """Declare a sub-rule whose value is not a node: what its one reader gives, or the tuple of its readers' values."""
+def value_rule(rule: str, *readers: Reader, production: str | None = None) -> None:
+    """Declare a sub-rule whose value is not a node: what its one reader gives, or the tuple of its readers' values.
+
+    ``production``, if given, is the rule's right-hand side in Lark's
+    notation, written into lang/lig.lark by ``python -m liganimate.lang.tables``.
+    """
     assert rule not in SYNTAX, rule
     SYNTAX[rule] = Syntax(rule, None, tuple((str(i), r) for i, r in enumerate(readers)), None)
+    if production is not None:
+        produce(rule, production)
+
+
+# ------------------------------------------------------------ productions
+# A statement's production is declared beside its node (lang/ast.py), as
+# pycparser's parser keeps each production beside the code that builds its
+# node: one place says what a statement is written as, what node it makes
+# and how the node's fields are read. lang/grammar.py writes them into
+# lig.lark's generated section, which every reader of the grammar (the
+# tables, Lark, the highlighters, the tests) reads as before.
+
+#: Grammar rule -> its right-hand side (Lark's notation), in declaration order.
+PRODUCTIONS: dict[str, str] = {}
+
+#: The rules that are statements: ``?statement``'s alternatives, in declaration order.
+STATEMENTS: list[str] = []
+
+
+def produce(rule: str, production: str, statement: bool = False) -> None:
+    """Declare grammar rule ``rule`` as ``production`` (a statement's, with ``statement``).
+
+    Parameters
+    ----------
+    rule : str
+        The rule's name, lower case (a name starting with ``_`` is inlined by Lark).
+    production : str
+        Its right-hand side in Lark's notation: terminals in capitals (a word
+        no terminal of lig.lark defines yet becomes a case-insensitive
+        keyword of that spelling), rules in lower case, quoted punctuation,
+        alternatives with ``|``.
+    statement : bool
+        Whether it is one of the statements (an alternative of ``?statement``).
+    """
+    assert rule not in PRODUCTIONS and rule == rule.lower(), rule
+    PRODUCTIONS[rule] = " ".join(production.split())
+    if statement:
+        STATEMENTS.append(rule)

@@ -22,8 +22,11 @@ installed) :func:`load` returns None and the tables are computed from the
 grammar instead, so editing ``lig.lark`` keeps working, only slower to start
 until the tables are regenerated with::
 
-    python -m liganimate.lang.tables          # rewrite lang/_tables.py
-    python -m liganimate.lang.tables --check  # exit 1 if it is stale
+    python -m liganimate.lang.tables          # rewrite lig.lark's statements, then lang/_tables.py
+    python -m liganimate.lang.tables --check  # exit 1 if either is stale
+
+(the statements' productions are declared beside their nodes in lang/ast.py;
+lang/grammar.py writes them into lig.lark).
 
 tests/lang/test_parser_scale.py fails while the committed tables differ
 from freshly generated ones.
@@ -282,12 +285,16 @@ def fresh_module_text() -> str:
 
 
 def main(argv=None) -> int:
-    """Regenerate ``lang/_tables.py`` (or with ``--check``, report whether it is current)."""
+    """Write lig.lark's statements again, then ``lang/_tables.py`` (or with ``--check``, report whether they are current)."""
+    from . import grammar
     from .generated import regenerate
 
-    return regenerate(
-        argv, "liganimate.lang.tables", Path(__file__).with_name(_MODULE), fresh_module_text, main.__doc__ or ""
-    )
+    lark_file = Path(__file__).with_name("lig.lark")
+    files = [
+        (lark_file, lambda: grammar.fresh_text(lark_file.read_text(encoding="utf-8"))),
+        (Path(__file__).with_name(_MODULE), fresh_module_text),
+    ]
+    return regenerate(argv, "liganimate.lang.tables", files, main.__doc__ or "")
 
 
 if __name__ == "__main__":

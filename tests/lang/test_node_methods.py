@@ -1,7 +1,8 @@
 """Records (the syntax tree's node classes and others): dataclasses whose methods come from lang/_node_methods.py.
 
 * The generated module is the one the classes give today (as lang/_tables.py is for the grammar).
-* Every record took its methods from it: none paid for compiling them at import.
+* Every record took its methods from it: none paid for compiling them at import, nor for
+  ``@dataclass``'s inspection of its fields (the class is assembled from what was written out).
 * The methods behave as ``@dataclass``'s own (frozen and slots as asked), class by class: the
   same signature and docstring, repr, equality, hashing, immutability, defaults and factories.
 """
@@ -12,6 +13,8 @@ import dataclasses
 import importlib
 import inspect
 import os
+import pickle
+from typing import ClassVar
 
 import pytest
 from paths import ROOT_DIR
@@ -42,13 +45,14 @@ def test_every_node_class_took_its_methods_from_the_generated_module():
     for cls in classes:
         assert makers[N._key(cls)][0] == N.shape(cls), cls.__qualname__
         assert cls.__init__.__code__.co_filename.endswith("_node_methods.py"), cls.__qualname__
+        assert cls in N.WRITTEN, cls.__qualname__  # assembled without @dataclass
 
 
 def twin(cls: type) -> type:
     """``cls`` as @dataclass makes it from the same fields and options (the reference)."""
     spec = []
     for f in dataclasses.fields(cls):
-        extra = {}
+        extra: dict = {"hash": f.hash}
         if f.default is not dataclasses.MISSING:
             extra["default"] = f.default
         if f.default_factory is not dataclasses.MISSING:
@@ -56,6 +60,12 @@ def twin(cls: type) -> type:
         spec.append((f.name, f.type, dataclasses.field(**extra)))
     frozen = cls.__dataclass_params__.frozen
     return dataclasses.make_dataclass(cls.__name__, spec, slots="__slots__" in cls.__dict__, frozen=frozen)
+
+
+def _described(cls: type) -> list:
+    """What ``dataclasses.fields`` tells of each field (the metadata aside: the twin has none)."""
+    keys = ("name", "type", "default", "default_factory", "init", "repr", "hash", "compare", "kw_only")
+    return [tuple(getattr(f, k) for k in keys) for f in dataclasses.fields(cls)]
 
 
 def test_methods_behave_as_dataclass_ones():
@@ -67,6 +77,11 @@ def test_methods_behave_as_dataclass_ones():
         if not cls.__doc__ or cls.__doc__.startswith(cls.__name__ + "("):  # no docstring of its own
             assert cls.__doc__ == ref.__doc__, name
         assert cls.__match_args__ == ref.__match_args__, name
+        assert _described(cls) == _described(ref), name
+        for option in ("init", "repr", "eq", "order", "unsafe_hash", "frozen"):
+            assert getattr(cls.__dataclass_params__, option) == getattr(ref.__dataclass_params__, option) or (
+                option in ("init", "repr", "eq")  # written out, not made by @dataclass
+            ), (name, option)
         assert ("__slots__" in cls.__dict__) == ("__slots__" in ref.__dict__), name
         names = [f.name for f in dataclasses.fields(cls)]
         values = [f"v{i}" for i in range(len(names))]
@@ -148,3 +163,84 @@ def test_a_record_refuses_what_it_does_not_write():
         @N.record
         class Hidden:
             a: int = dataclasses.field(default=0, repr=False)
+
+
+def test_fields_as_declared():
+    # What the passes read of a field (its metadata: binds, holds, parts) and the defaults left on a class.
+    (target,) = [f for f in dataclasses.fields(A.Assign) if f.name == "target"]
+    assert target.metadata["binds"] == "assigns" and target.type == "Name"
+    assert dataclasses.fields(A.Node)[0].name == "pos" and "pos" in A.Node.__slots__
+    assert A.BinOp.__slots__ == ("op", "left", "right", "op_pos") and not hasattr(
+        A.BinOp(A.NOWHERE, "+", 1, 2), "__dict__"
+    )
+    assert A.Program.__match_args__ == ("pos", "filename", "source", "body", "primitives")
+
+
+def test_a_frozen_slots_record_pickles_and_refuses_changes():
+    from liganimate.runtime.host import JointArgs
+
+    assert JointArgs in N.WRITTEN
+    names = [f.name for f in dataclasses.fields(JointArgs)]
+    value = JointArgs(*range(len(names)))
+    assert pickle.loads(pickle.dumps(value)) == value
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        setattr(value, names[0], 5)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        delattr(value, names[0])
+
+
+def test_an_edited_class_is_made_by_dataclass(monkeypatch):
+    # Its module was written out for other fields: the written methods do not fit, so @dataclass makes it.
+    written = dict(N._makers())
+    key = f"{__name__}:test_an_edited_class_is_made_by_dataclass.<locals>.Edited"
+    written[key] = written["liganimate.lang.ast:Var"]  # (pos, name): the class below has one more field
+    monkeypatch.setattr(N, "_makers", lambda: written)
+
+    @N.node
+    class Edited(A.Node):
+        name: str
+        extra: int = 0
+
+    assert Edited not in N.WRITTEN and Edited(A.NOWHERE, "X").extra == 0
+    assert str(inspect.signature(Edited)) == str(inspect.signature(twin(Edited)))
+    N.MADE.remove(Edited)
+
+    @N.node
+    class Edited(A.Node):  # type: ignore[no-redef]  # now as written out: assembled
+        name: str
+
+    assert Edited in N.WRITTEN and repr(Edited(A.NOWHERE, "X")).endswith(f"Edited(pos={A.NOWHERE!r}, name='X')")
+    N.MADE.remove(Edited)
+    N.WRITTEN.discard(Edited)
+
+
+def test_what_only_dataclass_handles_is_left_to_it():
+    # A ClassVar, a mutable default, a __post_init__: not read from the class as written (None), so
+    # @dataclass makes (or refuses) such a class, never the written-out path.
+    class Counted:
+        count: ClassVar[int] = 0  # noqa: RUF012
+        name: str
+
+    class Listed:
+        items: list = []  # noqa: RUF012
+
+    class Checked:
+        name: str
+
+        def __post_init__(self) -> None:
+            pass
+
+    for cls in (Counted, Listed, Checked):
+        assert N.written_shape(cls, False) is None, cls.__name__
+
+    class Plain:
+        name: str
+        size: int = 1
+        items: list = dataclasses.field(default_factory=list)
+
+    assert N.written_shape(Plain, True) == (
+        ("frozen", True),
+        ("name", "required", "str"),
+        ("size", "default", "int"),
+        ("items", "factory", "list"),
+    )

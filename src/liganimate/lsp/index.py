@@ -123,8 +123,8 @@ class _Walker:
                 self.name(n, scope, "load")
         elif kind is A.FigureStmt:
             self.name(s.link, scope, "link")
-        elif kind is A.Animate:
-            self.name(s.model, scope, "use")
+        for attr, _ in _USES.get(kind, ()):
+            self.name(getattr(s, attr), scope, "use")
         self.rest(s, scope)
 
     def _end(self, pos) -> int:
@@ -182,21 +182,26 @@ def _named_fields(s) -> set:
 
 #: Each statement that binds names -> its fields that do, and how; the role each gets in the index.
 _BINDS = A.statement_fields("binds")
+#: Each statement with a field naming a variable it reads without an expression (``uses=True``) -> those fields.
+_USES = A.statement_fields("uses")
 _ROLES = {"declares": "declaration", "assigns": "assignment", "figure": "use"}  # FIGURE changes a model it uses
 
-_STATEMENTS = frozenset(_BINDS) | frozenset(
-    {
-        A.If,
-        A.Load,
-        A.FigureStmt,
-        A.Animate,
-        A.Scene,
-        A.Print,
-        A.Background,
-        A.DrawWith,
-        A.DrawPoly,
-        A.PrimitiveDef,
-    }
+_STATEMENTS = (
+    frozenset(_BINDS)
+    | frozenset(_USES)
+    | frozenset(
+        {
+            A.If,
+            A.Load,
+            A.FigureStmt,
+            A.Scene,
+            A.Print,
+            A.Background,
+            A.DrawWith,
+            A.DrawPoly,
+            A.PrimitiveDef,
+        }
+    )
 )
 
 
