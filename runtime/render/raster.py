@@ -308,7 +308,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
         _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, packed)
         return first_index + n
     starts = bounds[:-1]
-    offset, count = spans.offset, spans.count
+    offset, count = spans.offset, spans.pixels
     los = np.minimum.reduceat(offset, starts).tolist()
     his = np.maximum.reduceat(offset + count, starts).tolist()
     if flat_z is None:
@@ -341,7 +341,7 @@ class _Spans(NamedTuple):
     offset: np.ndarray  #: (P,) int64: pixel number of the span's first pixel, counted from ``origin``
     wstart: np.ndarray  #: (P,) 1/z at the span's first pixel
     step: np.ndarray  #: (P,) 1/z step from pixel to pixel
-    count: np.ndarray  #: (P,) int64: the span's pixels (some spans are empty)
+    pixels: np.ndarray  #: (P,) int64: the span's pixels (some spans are empty)
     tag: np.ndarray  #: (T,) int64: the key tag of each trapezoid's fragments
     nrows: np.ndarray  #: (T,) int64: each trapezoid's spans, in order
     bounds: list  #: B + 1 span numbers: band k's spans are ``bounds[k]:bounds[k + 1]``
@@ -357,7 +357,7 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
     (only in a fresh draw): the tags are ``number << 8 | grey level``, and
     the keys were all the background's grey level.
     """
-    offset, wstart, step, count = spans.offset, spans.wstart, spans.step, spans.count
+    offset, wstart, step, count = spans.offset, spans.wstart, spans.step, spans.pixels
     # ends[k]: fragments up to the end of span k; ends0 has a 0 before them.
     ends0 = np.empty(len(count) + 1, dtype=np.int64)
     ends0[0] = 0
@@ -773,10 +773,10 @@ def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: 
         ends = nrows.cumsum()
         bounds, tbounds = [0, total], [0, len(nrows)]
         # The rows drawn: one depth buffer covers them (and no more).
-        live = nrows > 0
+        drawn = nrows > 0
         rows = (
-            int(np.minimum.reduce(first_row, where=live, initial=H)),
-            int(np.maximum.reduce(first_row + nrows, where=live, initial=0)),
+            int(np.minimum.reduce(first_row, where=drawn, initial=H)),
+            int(np.maximum.reduce(first_row + nrows, where=drawn, initial=0)),
         )
     # Row 13: the trapezoid's first row centre minus the number of spans before it.
     first_row -= ends

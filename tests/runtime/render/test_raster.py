@@ -19,7 +19,7 @@ def fragments(tris, cull, cam):
     spans = _spans(np.asarray(tris, float), cull, cam, 0)
     if spans is None:
         return np.zeros(0, np.int64)
-    count = spans.count
+    count = spans.pixels
     pix = _expand(spans.offset, spans.wstart, spans.step, count, count.cumsum(), count, count)[0]
     return pix + spans.origin
 
