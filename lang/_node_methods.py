@@ -1058,6 +1058,49 @@ def lang_ast__Print(_d, _f, FACTORY, _set=object.__setattr__):
     return __init__, __repr__, __eq__, __hash__
 
 
+def lang_ast__Part(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, accepts, what, many=_d['many']):
+        _set(self, 'accepts', accepts)
+        _set(self, 'what', what)
+        _set(self, 'many', many)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(accepts={self.accepts!r}, what={self.what!r}, many={self.many!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.accepts,self.what,self.many,) == (other.accepts,other.what,other.many,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.accepts,self.what,self.many,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def lang_ast__Declaration(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, rule, runtime, places, misplaced, hint, parts):
+        _set(self, 'rule', rule)
+        _set(self, 'runtime', runtime)
+        _set(self, 'places', places)
+        _set(self, 'misplaced', misplaced)
+        _set(self, 'hint', hint)
+        _set(self, 'parts', parts)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(rule={self.rule!r}, runtime={self.runtime!r}, places={self.places!r}, misplaced={self.misplaced!r}, hint={self.hint!r}, parts={self.parts!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.rule,self.runtime,self.places,self.misplaced,self.hint,self.parts,) == (other.rule,other.runtime,other.places,other.misplaced,other.hint,other.parts,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.rule,self.runtime,self.places,self.misplaced,self.hint,self.parts,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
 def lang_ast__Declared(_d, _f, FACTORY, _set=object.__setattr__):
     def __init__(self, pos):
         self.pos = pos
@@ -1787,6 +1830,8 @@ MAKERS = {
     'liganimate.lang.ast:Background': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Background, "Background(pos: 'Pos', items: 'list')"),
     'liganimate.lang.ast:PrintItem': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('value', 'required', 'object')), lang_ast__PrintItem, "PrintItem(pos: 'Pos', kind: 'str', value: 'object')"),
     'liganimate.lang.ast:Print': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Print, "Print(pos: 'Pos', items: 'list')"),
+    'liganimate.lang.ast:Part': ((('options', True, True, False), ('accepts', 'required', 'tuple[Type, ...]'), ('what', 'required', 'str'), ('many', 'default', 'bool')), lang_ast__Part, None),
+    'liganimate.lang.ast:Declaration': ((('options', True, True, False), ('rule', 'required', 'str'), ('runtime', 'required', 'str'), ('places', 'required', 'frozenset[str]'), ('misplaced', 'required', 'str'), ('hint', 'required', 'str | None'), ('parts', 'required', 'tuple[tuple[str, Part], ...]')), lang_ast__Declaration, None),
     'liganimate.lang.ast:Declared': ((('options', False, True, False), ('pos', 'required', 'Pos')), lang_ast__Declared, None),
     'liganimate.lang.ast:ViewPoint': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('point', 'required', 'Node')), lang_ast__ViewPoint, "ViewPoint(pos: 'Pos', point: 'Node')"),
     'liganimate.lang.ast:ViewWidth': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('width', 'required', 'Node')), lang_ast__ViewWidth, "ViewWidth(pos: 'Pos', width: 'Node')"),
