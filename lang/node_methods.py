@@ -31,8 +31,9 @@ class not yet regenerated) gets its methods compiled here, from the same
 source, at the old cost, and by ``@dataclass``; tests/lang/test_node_methods.py
 fails until the module is regenerated.
 Fields are plain: a default or a default factory at most (no ``init=False``,
-``repr=False``, ``compare=False`` or keyword-only fields, no ``__post_init__``);
-a class that needs more keeps ``@dataclass``.
+``repr=False``, ``compare=False`` or keyword-only fields); ``__init__`` calls
+the class's ``__post_init__`` if it has one, as ``@dataclass``'s does. A
+class that needs more keeps ``@dataclass``.
 """
 
 from __future__ import annotations
@@ -71,10 +72,14 @@ WRITTEN: set = set()
 
 
 def shape(cls: type) -> tuple:
-    """What a class's generated methods depend on: frozen or not, and each field's name, kind of default and annotation."""
-    if hasattr(cls, "__post_init__"):
-        raise TypeError(f"{cls.__qualname__}: a record has no __post_init__ (use @dataclass)")
-    out: list = [("frozen", cls.__dataclass_params__.frozen)]  # type: ignore[attr-defined]
+    """What a class's generated methods depend on: its options, and each field's name, kind of default and annotation.
+
+    The options are ``("options", frozen, eq, post_init)``: frozen, compared
+    by value (``eq``, else by identity, as ``@dataclass(eq=False)``), and
+    whether ``__init__`` ends by calling the class's ``__post_init__``.
+    """
+    params = cls.__dataclass_params__  # type: ignore[attr-defined]
+    out: list = [_options(params.frozen, params.eq, hasattr(cls, "__post_init__"))]
     for f in dataclasses.fields(cls):
         if f.default_factory is not dataclasses.MISSING:
             kind = "factory"
@@ -90,6 +95,10 @@ def shape(cls: type) -> tuple:
     return tuple(out)
 
 
+def _options(frozen: bool, eq: bool, post_init: bool) -> tuple:
+    return ("options", frozen, eq, post_init)
+
+
 def _entry(name: str, kind: str, annotation: str, hashed: bool | None) -> tuple:
     # A field declared field(hash=False) is left out of the hash, as @dataclass leaves it out.
     return (name, kind, annotation) if hashed is not False else (name, kind, annotation, "unhashed")
@@ -103,7 +112,7 @@ def source(cls: type, maker: str) -> str:
     class. Field names are Python identifiers declared in the classes,
     never program text.
     """
-    (_, frozen), *spec = shape(cls)
+    (_, frozen, eq, post_init), *spec = shape(cls)
     params, body = ["self"], []
     for name, kind, *_ in spec:
         value = name
@@ -116,6 +125,8 @@ def source(cls: type, maker: str) -> str:
             value = f"_f[{name!r}]() if {name} is FACTORY else {name}"
         # A frozen class's own __setattr__ refuses: @dataclass sets its fields through object's.
         body.append(f"        _set(self, {name!r}, {value})" if frozen else f"        self.{name} = {value}")
+    if post_init:
+        body.append("        self.__post_init__()")
     names = [name for name, *_ in spec]
     hashed = "".join(f"self.{name}," for name, _, _, *unhashed in spec if not unhashed)
     shown = ", ".join(f"{n}={{self.{n}!r}}" for n in names)
@@ -130,20 +141,27 @@ def source(cls: type, maker: str) -> str:
             "    def __repr__(self):",
             f'        return self.__class__.__qualname__ + f"({shown})"',
             "",
-            "    def __eq__(self, other):",
-            "        if other.__class__ is self.__class__:",
-            f"            return ({mine}) == ({theirs})",
-            "        return NotImplemented",
-            "",
-            *(
-                ["    def __hash__(self):", f"        return hash(({hashed}))", ""]
-                if frozen
-                else ["    __hash__ = None", ""]
-            ),
+            *(_eq_lines(frozen, mine, theirs, hashed) if eq else ["    __eq__ = __hash__ = None", ""]),
             "    return __init__, __repr__, __eq__, __hash__",
             "",
         ]
     )
+
+
+def _eq_lines(frozen: bool, mine: str, theirs: str, hashed: str) -> list:
+    # Compared by value; only a frozen class is hashable (by the same fields).
+    return [
+        "    def __eq__(self, other):",
+        "        if other.__class__ is self.__class__:",
+        f"            return ({mine}) == ({theirs})",
+        "        return NotImplemented",
+        "",
+        *(
+            ["    def __hash__(self):", f"        return hash(({hashed}))", ""]
+            if frozen
+            else ["    __hash__ = None", ""]
+        ),
+    ]
 
 
 def _compiled(cls: type):
@@ -187,17 +205,15 @@ def _kind(f: dataclasses.Field) -> str:
     return "required" if f.default is dataclasses.MISSING else "default"
 
 
-def written_shape(cls: type, frozen: bool) -> tuple | None:
+def written_shape(cls: type, frozen: bool, eq: bool = True) -> tuple | None:
     """:func:`shape` of the class ``@record`` would make, read from the class as written, before any ``@dataclass``.
 
     None where only ``@dataclass`` can say (a ``ClassVar``, ``InitVar`` or
     keyword-only marker, a field that is not plain, a mutable default, a
-    ``__post_init__``, a base frozen otherwise): such a class is made by
-    ``@dataclass``, which also raises its errors.
+    base frozen otherwise): such a class is made by ``@dataclass``, which
+    also raises its errors.
     """
-    if hasattr(cls, "__post_init__"):
-        return None
-    out: list = [("frozen", frozen)]
+    out: list = [_options(frozen, eq, hasattr(cls, "__post_init__"))]
     inherited: dict = {}
     for base in cls.__mro__[-1:0:-1]:  # as @dataclass collects them: the farthest base first
         base_fields = base.__dict__.get("__dataclass_fields__")
@@ -230,20 +246,21 @@ def written_shape(cls: type, frozen: bool) -> tuple | None:
 
 
 #: A class @dataclass made with no methods: its field kind and parameters are what :func:`_assembled` sets.
+# (With a docstring of its own: else @dataclass computes one with inspect.signature, whose first call costs 2 ms.)
 _PLAIN: Any = dataclasses.dataclass(init=False, repr=False, eq=False)(
-    type("Plain", (), {"__annotations__": {"x": "int"}})
+    type("Plain", (), {"__annotations__": {"x": "int"}, "__doc__": "One field."})
 )
 #: The kind of an ordinary field (dataclasses marks each field: ordinary, ClassVar or InitVar).
 _FIELD = dataclasses.fields(_PLAIN)[0]._field_type  # type: ignore[attr-defined]
 _PARAMS: dict = {}
 
 
-def _params(frozen: bool, slots: bool) -> Any:
-    """``__dataclass_params__`` as ``@dataclass(frozen=frozen, slots=slots, init=False, repr=False, eq=False)`` sets it."""
-    key = (frozen, slots)
+def _params(frozen: bool, slots: bool, eq: bool) -> Any:
+    """``__dataclass_params__`` as ``@dataclass(frozen=frozen, slots=slots, eq=eq)`` sets it."""
+    key = (frozen, slots, eq)
     if key not in _PARAMS:
         params = copy.copy(_PLAIN.__dataclass_params__)
-        params.frozen = frozen
+        params.init, params.repr, params.eq, params.frozen = True, True, eq, frozen
         if hasattr(params, "slots"):  # recorded since Python 3.12
             params.slots = slots
         _PARAMS[key] = params
@@ -278,11 +295,11 @@ def _setstate(self, state) -> None:
         object.__setattr__(self, f.name, value)  # a frozen class's own __setattr__ refuses
 
 
-def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
+def _assembled(cls: Any, frozen: bool, slots: bool, eq: bool) -> Any:
     """The class ``@dataclass`` would make of ``cls`` (its fields, parameters, slots, frozen attributes), methods aside.
 
-    What ``dataclasses.dataclass(cls, init=False, repr=False, eq=False)``
-    does, for a class whose :func:`written_shape` is known, without its
+    What ``dataclasses.dataclass(cls, frozen=frozen, slots=slots, eq=eq)``
+    does (but write the methods), for a class whose :func:`written_shape` is known, without its
     inspection of each annotation and default (most of a node class's cost).
     """
     fields: dict = {}
@@ -301,7 +318,7 @@ def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
             delattr(cls, name)
         else:
             setattr(cls, name, f.default)
-    cls.__dataclass_params__ = _params(frozen, slots)
+    cls.__dataclass_params__ = _params(frozen, slots, eq)
     cls.__dataclass_fields__ = fields
     if "__match_args__" not in cls.__dict__:
         cls.__match_args__ = tuple(fields)  # type: ignore[misc]
@@ -321,24 +338,27 @@ def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
     return cls
 
 
-def _make(cls: Any, frozen: bool, slots: bool) -> Any:
+def _make(cls: Any, frozen: bool, slots: bool, eq: bool = True) -> Any:
     made: Any = _makers().get(_key(cls))
     own_doc = cls.__dict__.get("__doc__")
     # What the class defines itself, @dataclass keeps: so do we. A __hash__ of None beside an own
     # __eq__ is Python's doing, not the class's.
     own = {name for name in ("__init__", "__repr__", "__eq__") if name in cls.__dict__}
+    if not eq:
+        own |= {"__eq__", "__hash__"}  # compared by identity: object's, as @dataclass(eq=False) leaves them
     class_hash = cls.__dict__.get("__hash__", dataclasses.MISSING)
     if not (class_hash is dataclasses.MISSING or (class_hash is None and "__eq__" in cls.__dict__)):
         own.add("__hash__")
     if made is not None and not own_doc and made[2] is not None:
         cls.__doc__ = made[2]  # set first: @dataclass would compute it through inspect.signature
-    stale = made is None or made[0] != written_shape(cls, frozen)
+    stale = made is None or made[0] != written_shape(cls, frozen, eq)
     if stale:
         # @dataclass makes the fields, the slots and a frozen class's __setattr__ and __delattr__.
         cls = dataclasses.dataclass(cls, frozen=frozen, slots=slots, init=False, repr=False, eq=False)
+        cls.__dataclass_params__ = _params(frozen, slots, eq)  # the methods it left out are ours (below)
         maker = _compiled(cls)
     else:
-        cls = _assembled(cls, frozen, slots)
+        cls = _assembled(cls, frozen, slots, eq)
         maker = made[1]
         WRITTEN.add(cls)
     fields = dataclasses.fields(cls)
@@ -364,13 +384,13 @@ def _make(cls: Any, frozen: bool, slots: bool) -> Any:
 @overload
 def record(cls: _C, /) -> _C: ...
 @overload
-def record(*, frozen: bool = False, slots: bool = False) -> Callable[[_C], _C]: ...
+def record(*, frozen: bool = False, slots: bool = False, eq: bool = True) -> Callable[[_C], _C]: ...
 @dataclass_transform(field_specifiers=(dataclasses.field,))
-def record(cls=None, /, *, frozen=False, slots=False):
-    """``@dataclass`` (``frozen``, ``slots`` as there), with the methods written out in lang/_node_methods.py."""
+def record(cls=None, /, *, frozen=False, slots=False, eq=True):
+    """``@dataclass`` (``frozen``, ``slots``, ``eq`` as there), with the methods written out in lang/_node_methods.py."""
 
     def wrap(cls):
-        return _make(cls, frozen, slots)
+        return _make(cls, frozen, slots, eq)
 
     return wrap if cls is None else wrap(cls)
 
