@@ -291,12 +291,13 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
     W, H = camera.size
     band_rows = None if W * H <= _ONE_BAND_PIXELS else max(1, _BAND_PIXELS // W)
     # A fresh image's depth keys are this draw's alone, so their tags may
-    # carry each triangle's grey level in their low byte, and "nothing drawn"
-    # may be the background's grey level (a key below any surface's): the
-    # depth keys then cast to bytes are the image (see _band).
+    # carry each triangle's grey level in their low byte, less the
+    # background's (modulo 256): the depth keys cast to bytes, plus the
+    # background's grey level, are then the image, EMPTY (0) giving the
+    # background (see _band).
     packed = zbuf is None and shade.ndim == 1 and np.ndim(background) == 0 and n <= _PACKED_TRIANGLES
-    empty = background if packed else EMPTY
-    spans = _spans(tris, cull, camera, first_index, band_rows, shade if packed else None) if n else None
+    grey = shade - np.uint8(background) if packed else None
+    spans = _spans(tris, cull, camera, first_index, band_rows, grey) if n else None
     if spans is None:
         return first_index + n
     flat_img = img.reshape((-1,) + img.shape[2:])
@@ -304,8 +305,8 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
     bounds, tbounds = spans.bounds, spans.tbounds
     if len(bounds) == 2:
         lo, hi = spans.origin, spans.origin + spans.size
-        zb = np.full(hi - lo, empty, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
-        _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, packed)
+        zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
+        _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, background if packed else None)
         return first_index + n
     starts = bounds[:-1]
     offset, count = spans.offset, spans.pixels
@@ -314,7 +315,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
     if flat_z is None:
         # One buffer for every band: clearing it while it is still in the
         # cache is cheaper than fresh zeroed pages from the kernel.
-        scratch = np.full(max(h - l for l, h in zip(los, his)), empty, dtype=np.int64)
+        scratch = np.zeros(max(h - l for l, h in zip(los, his)), dtype=np.int64)
     for i, (lo, hi) in enumerate(zip(los, his)):
         sl, tl = slice(bounds[i], bounds[i + 1]), slice(tbounds[i], tbounds[i + 1])
         if flat_z is not None:
@@ -322,11 +323,11 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
         else:
             zb = scratch[: hi - lo]
             if i:
-                zb.fill(empty)
+                zb.fill(EMPTY)
         band = _Spans(
             offset[sl] - lo, spans.wstart[sl], spans.step[sl], count[sl], spans.tag[tl], spans.nrows[tl], [], [], 0, 0
         )
-        _band(zb, flat_img[lo:hi], band, shade, first_index, flat_z is None, packed)
+        _band(zb, flat_img[lo:hi], band, shade, first_index, flat_z is None, background if packed else None)
     return first_index + n
 
 
@@ -354,8 +355,8 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
     """Depth-test one band's spans into its depth keys and image (views of the band's pixel range).
 
     ``fresh``: the depth keys were all EMPTY before this draw.  ``packed``
-    (only in a fresh draw): the tags are ``number << 8 | grey level``, and
-    the keys were all the background's grey level.
+    (only in a fresh draw): None, or the background's grey level ``b`` (an
+    int 0..255), the tags being ``number << 8 | (grey level - b) % 256``.
     """
     offset, wstart, step, count = spans.offset, spans.wstart, spans.step, spans.pixels
     # ends[k]: fragments up to the end of span k; ends0 has a 0 before them.
@@ -373,9 +374,8 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         frags[1:] -= frags[:-1].copy()
         pix, key = _expand(offset, wstart, step, count, ends, spans.tag, frags)
         np.maximum.at(zb, pix, key)
-        if packed:
-            # Each key's low byte is the grey level of the winner, or the background.
-            np.copyto(im, zb, casting="unsafe")
+        if packed is not None:
+            _unpack(im, zb, packed)
             return
         if fresh:
             # Every key in the buffer is this draw's: each fragment may
@@ -406,12 +406,19 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
             pix, key = _expand(offset[sl], wstart[sl], step[sl], cut, cut.cumsum(), tag[sl], cut)
             np.maximum.at(zb, pix, key)
             lo = hi
-    if packed:
-        np.copyto(im, zb, casting="unsafe")
+    if packed is not None:
+        _unpack(im, zb, packed)
         return
     num = zb & _INDEX_MASK
     sel = ((zb != EMPTY) & (num >= first_index)).nonzero()[0]
     im[sel] = shade.take(num.take(sel) - first_index, axis=0)
+
+
+def _unpack(im, zb, background: int) -> None:
+    """Pixels from a packed draw's depth keys: the low byte (the winner's grey level less the background's) plus the background's."""
+    np.copyto(im, zb, casting="unsafe")  # (a cast to bytes keeps the low byte)
+    if background:
+        im += np.uint8(background)
 
 
 # Shared read-only aranges, grown as needed (replaced, never modified, so
@@ -498,8 +505,8 @@ def _check(triangles, shade, cull):
     tris = np.asarray(triangles, dtype=np.float64)
     if tris.ndim != 3 or tris.shape[1:] != (3, 3):
         raise RenderError(f"Triangles must be an array of shape (N, 3, 3), not {tris.shape}.")
-    if not np.isfinite(tris).all():
-        raise RenderError("A triangle has a coordinate that is not a finite number.")
+    # (Whether every coordinate is finite is checked by _camera_triangles,
+    # on its component-major copy while that is still in the cache.)
     s = np.asarray(shade)
     if s.shape not in ((len(tris),), (len(tris), 3)):
         raise RenderError(
@@ -603,6 +610,8 @@ def _camera_triangles(tris, cull, camera: Camera):
     # more per element than the arithmetic.
     n = len(tris)
     v = np.ascontiguousarray(tris.reshape(n, 9).T).reshape(3, 3, n)
+    if not np.logical_and.reduce(np.isfinite(v), axis=None):
+        raise RenderError("A triangle has a coordinate that is not a finite number.")
     # Facing is decided in world space (camera space is left-handed): the
     # sign of ((v1 - v0) x (v2 - v0)) . (eye - v0), cross product
     # component k being a[k+1] b[k+2] - a[k+2] b[k+1].

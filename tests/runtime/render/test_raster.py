@@ -386,6 +386,13 @@ def test_input_errors():
         rasterize(sq, [0, 0], CAM, background=300)
     with pytest.raises(RenderError):
         rasterize(sq * np.nan, [0, 0], CAM)
+    # Checked before culling, and in a framebuffer's draw too.
+    inf = sq.copy()
+    inf[1, 2, 0] = np.inf
+    with pytest.raises(RenderError, match="finite"):
+        rasterize(inf, [0, 0], CAM, cull=[True, True])
+    with pytest.raises(RenderError, match="finite"):
+        Framebuffer(CAM.size).draw(inf, [0, 0], CAM)
     with pytest.raises(RenderError):
         rasterize(sq, [0, 0], CAM, cull=[True])
     with pytest.raises(RenderError, match="size"):
