@@ -305,7 +305,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
     bounds, tbounds = spans.bounds, spans.tbounds
     if len(bounds) == 2:
         lo, hi = spans.origin, spans.origin + spans.size
-        zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
+        zb = None if flat_z is None else flat_z[lo:hi]  # (None: made by _band, when it needs it)
         _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, background if packed else None)
         return first_index + n
     starts = bounds[:-1]
@@ -354,7 +354,8 @@ class _Spans(NamedTuple):
 def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
     """Depth-test one band's spans into its depth keys and image (views of the band's pixel range).
 
-    ``fresh``: the depth keys were all EMPTY before this draw.  ``packed``
+    ``zb`` None stands for new depth keys, all EMPTY.  ``fresh``: the depth
+    keys were all EMPTY before this draw.  ``packed``
     (only in a fresh draw): None, or the background's grey level ``b`` (an
     int 0..255), the tags being ``number << 8 | (grey level - b) % 256``.
     """
@@ -373,6 +374,10 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         frags = ends0.take(spans.nrows.cumsum())
         frags[1:] -= frags[:-1].copy()
         pix, key = _expand(offset, wstart, step, count, ends, spans.tag, frags)
+        if zb is None:
+            # Zeroed only now, so that it is still in the cache for the
+            # depth test rather than pushed out by the fragments' arrays.
+            zb = np.zeros(len(im), dtype=np.int64)
         np.maximum.at(zb, pix, key)
         if packed is not None:
             _unpack(im, zb, packed)
@@ -397,6 +402,8 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         return
     # Too many fragments for one go (deep overlap): depth-test chunk by
     # chunk, then find this draw's winners by scanning the band.
+    if zb is None:
+        zb = np.zeros(len(im), dtype=np.int64)
     tag = spans.tag.repeat(spans.nrows)  # each span's
     lo = 0
     for hi in np.searchsorted(ends, np.arange(_CHUNK, ends[-1], _CHUNK), side="right").tolist() + [len(count)]:
@@ -445,8 +452,6 @@ def _expand(offset, wstart, step, count, ends, tag, tag_count):
     n = int(ends[-1])
     iar, far = _aranges(n)
     starts = ends - count
-    pix = (offset - starts).repeat(count)
-    pix += iar[:n]
     # 1/z = wstart + (i - start) * step for fragment i.  Anchoring the
     # ramp at fragment 0 instead saves two passes; its extra rounding is
     # about 1e-16 * start * |step| (start < _CHUNK + W, and |step| at most
@@ -457,6 +462,9 @@ def _expand(offset, wstart, step, count, ends, tag, tag_count):
     key = w.view(np.int64)
     key &= _DEPTH_MASK
     key += tag.repeat(tag_count)
+    # (The pixel numbers last: the depth test reads them next.)
+    pix = (offset - starts).repeat(count)
+    pix += iar[:n]
     return pix, key
 
 
