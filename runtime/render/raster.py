@@ -143,7 +143,7 @@ def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: i
     shade, bg = _same_kind(shade, bg)
     cam = camera.supersampled(aa)
     W, H = cam.size
-    img = np.full((H, W) + np.shape(bg), bg, dtype=np.uint8)
+    img = np.empty((H, W) + np.shape(bg), dtype=np.uint8)  # (filled by _draw)
     # Nothing drawn yet: the depth buffer need only span the pixels touched.
     _draw(None, img, tris, shade, cam, cull, 0, bg)
     return downsample(img, aa)
@@ -281,9 +281,10 @@ class Framebuffer:
 
 
 def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
-    """Draw triangles into ``img`` (its depth keys ``zbuf``, or None for a fresh image of ``background``).
+    """Draw triangles into ``img`` (its depth keys ``zbuf``, or None for a new image, of ``background``).
 
-    Returns the next draw's first triangle number.
+    A new image's pixels are all written here, the background where nothing
+    is drawn.  Returns the next draw's first triangle number.
     """
     n = len(tris)
     if first_index + n >= _MAX_TRIANGLES:
@@ -298,13 +299,20 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
     packed = zbuf is None and shade.ndim == 1 and np.ndim(background) == 0 and n <= _PACKED_TRIANGLES
     grey = shade - np.uint8(background) if packed else None
     spans = _spans(tris, cull, camera, first_index, band_rows, grey) if n else None
+    single = spans is not None and len(spans.bounds) == 2
+    if zbuf is None and not (single and packed):
+        img[...] = background
     if spans is None:
         return first_index + n
     flat_img = img.reshape((-1,) + img.shape[2:])
     flat_z = None if zbuf is None else zbuf.reshape(-1)
     bounds, tbounds = spans.bounds, spans.tbounds
-    if len(bounds) == 2:
+    if single:
         lo, hi = spans.origin, spans.origin + spans.size
+        if zbuf is None and packed:
+            # _band writes every pixel of rows lo..hi; the rest is background.
+            flat_img[:lo] = background
+            flat_img[hi:] = background
         zb = None if flat_z is None else flat_z[lo:hi]  # (None: made by _band, when it needs it)
         _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, background if packed else None)
         return first_index + n
@@ -364,7 +372,7 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
     ends0 = np.empty(len(count) + 1, dtype=np.int64)
     ends0[0] = 0
     ends = np.cumsum(count, out=ends0[1:])
-    if ends[-1] == 0:
+    if ends[-1] == 0 and packed is None:
         return
     if ends[-1] <= _CHUNK:
         # A trapezoid's fragments are consecutive, so its tag is repeated
