@@ -29,7 +29,9 @@ Reported, side by side:
 "Old" is the rasterizer before its optimisation (issue 13): the file
 ``runtime/render/raster.py`` of commit ``PREVIOUS`` (before bands of rows,
 per-trapezoid tables and anti-aliasing), read with ``git show`` when the
-benchmark runs and loaded as a module from a temporary file.  Without git
+benchmark runs and loaded as a module from a temporary file;
+``--previous COMMIT`` takes it from another commit instead (e.g. the one
+before a change, to see the change's effect in one run).  Without git
 or without that history (an installed copy, a shallow clone) the output
 says so and the old figures are null.  (Until the rasterizer got an
 independent, deliberately slow cross-check reference, "old" was a frozen
@@ -37,7 +39,10 @@ copy of that same version under tests/; it no longer is.)
 
 Frame costs are CPU time of this process (``time.process_time``), best of
 several rounds with old and new interleaved: on a shared machine, wall time
-also counts other processes' turns.
+also counts other processes' turns.  The load average is printed first and
+last: other processes also compete for the caches and memory, which CPU
+time does feel (in the runs of issue 22 the same frames cost up to 10%
+more at a load of 2 than of 1 on this project's two-core machine).
 
 The last line printed is one JSON object with the figures.  Keys
 ``old_ms_<case>``, ``old_ratio_1080p_480p`` and ``old_ratio_4k_1080p`` are
@@ -69,6 +74,7 @@ from concurrent.futures import ThreadPoolExecutor
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
+from _clock import load, load_text  # noqa: E402
 
 from liganimate.runtime.render.camera import Camera  # noqa: E402
 from liganimate.runtime.render.imagefiles import write_png  # noqa: E402
@@ -287,8 +293,8 @@ def bench_png(frames: int, rounds: int, workers: int, mode: str) -> float:
             return _best_rate(run, frames, rounds)
 
 
-def previous_rasterizer():
-    """The old rasterizer's ``rasterize``, out of git history, or why it is not available.
+def previous_rasterizer(commit: str = PREVIOUS):
+    """The old rasterizer's ``rasterize`` (that of ``commit``), out of git history, or why it is not available.
 
     Returns
     -------
@@ -296,7 +302,7 @@ def previous_rasterizer():
         ``(rasterize, source)`` with ``source`` naming the commit and file,
         or ``(None, reason)``.
     """
-    where = f"{PREVIOUS}:runtime/render/raster.py"
+    where = f"{commit}:runtime/render/raster.py"
     try:
         shown = subprocess.run(
             ["git", "-C", _REPO, "show", where], capture_output=True, text=True, check=False, timeout=60
@@ -307,10 +313,10 @@ def previous_rasterizer():
         first = (shown.stderr.strip().splitlines() or ["no output"])[0]
         return None, f"git show {where} failed: {first}"
     with tempfile.TemporaryDirectory() as folder:
-        path = os.path.join(folder, f"raster_{PREVIOUS}.py")
+        path = os.path.join(folder, f"raster_{commit}.py")
         with open(path, "w", encoding="utf-8") as f:
             f.write(shown.stdout)
-        spec = importlib.util.spec_from_file_location(f"raster_{PREVIOUS}", path)
+        spec = importlib.util.spec_from_file_location(f"raster_{commit}", path)
         if spec is None or spec.loader is None:
             return None, f"{where} could not be loaded as a module"
         module = importlib.util.module_from_spec(spec)
@@ -420,8 +426,11 @@ def bench_costs(frames: int, rounds: int, old=None, film=None) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="a short run (under a minute)")
+    ap.add_argument("--previous", default=PREVIOUS, metavar="COMMIT", help=f"the old rasterizer's commit ({PREVIOUS})")
     args = ap.parse_args(argv)
     frames, rounds = (50, 5) if args.quick else (200, 15)
+    print(load_text())
+    load_start = load()[0]
 
     tris, _ = scene(0)
     img = rasterize(*scene(0), _camera())
@@ -456,7 +465,7 @@ def main(argv=None) -> int:
         f"film scene ({os.path.basename(FILM_SCENE)}, thesis look): {len(ftris)} triangles, {SIZE[0]}x{SIZE[1]}, "
         f"{(fimg != 255).sum()} pixels covered, {len(film)} images"
     )
-    old, source = previous_rasterizer()
+    old, source = previous_rasterizer(args.previous)
     same_image = same_film = None
     if old is None:
         print(f"previous rasterizer not available: {source}; timing this one only")
@@ -492,6 +501,7 @@ def main(argv=None) -> int:
             elif impl == "old" and case not in ("aa2", "aa4"):
                 figures[f"{impl}_ms_{case}"] = None
     ratios.setdefault("old", (None, None))
+    print(load_text())
     print(
         json.dumps(
             {
@@ -515,6 +525,8 @@ def main(argv=None) -> int:
                 "aa2_cost_x": round(aa2, 2),
                 "aa4_cost_x": round(aa4, 2),
                 "cores": os.cpu_count(),
+                "load_start": round(load_start, 2),
+                "load_end": round(load()[0], 2),
                 "quick": args.quick,
             }
         )
