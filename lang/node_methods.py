@@ -403,12 +403,13 @@ def node(cls: _C) -> _C:
 
 #: The packages whose modules may declare records (a module is written out when it uses @record or @node).
 PACKAGES = ("liganimate.lang", "liganimate.compiler", "liganimate.runtime")
-_USES = re.compile(r"^@(?:record|node)\b", re.MULTILINE)
+_USES = r"^@(?:record|node)\b"  # compiled by users(), which only the generator runs
 
 
 def users() -> list:
     """The names of the modules of :data:`PACKAGES` that declare records, sorted."""
     found = []
+    uses = re.compile(_USES, re.MULTILINE)
     for package in PACKAGES:
         spec = importlib.util.find_spec(package)
         assert spec is not None and spec.submodule_search_locations
@@ -416,7 +417,7 @@ def users() -> list:
             for folder, _, files in os.walk(root):
                 for name in files:
                     path = os.path.join(folder, name)
-                    if name.endswith(".py") and _USES.search(Path(path).read_text(encoding="utf-8")):
+                    if name.endswith(".py") and uses.search(Path(path).read_text(encoding="utf-8")):
                         rel = os.path.relpath(path, root)[: -len(".py")].replace(os.sep, ".")
                         found.append(f"{package}.{rel}".removesuffix(".__init__"))
     return sorted(found)
