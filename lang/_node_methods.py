@@ -1058,6 +1058,49 @@ def lang_ast__Print(_d, _f, FACTORY, _set=object.__setattr__):
     return __init__, __repr__, __eq__, __hash__
 
 
+def lang_ast__Part(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, accepts, what, many=_d['many']):
+        _set(self, 'accepts', accepts)
+        _set(self, 'what', what)
+        _set(self, 'many', many)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(accepts={self.accepts!r}, what={self.what!r}, many={self.many!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.accepts,self.what,self.many,) == (other.accepts,other.what,other.many,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.accepts,self.what,self.many,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def lang_ast__Declaration(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, rule, runtime, places, misplaced, hint, parts):
+        _set(self, 'rule', rule)
+        _set(self, 'runtime', runtime)
+        _set(self, 'places', places)
+        _set(self, 'misplaced', misplaced)
+        _set(self, 'hint', hint)
+        _set(self, 'parts', parts)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(rule={self.rule!r}, runtime={self.runtime!r}, places={self.places!r}, misplaced={self.misplaced!r}, hint={self.hint!r}, parts={self.parts!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.rule,self.runtime,self.places,self.misplaced,self.hint,self.parts,) == (other.rule,other.runtime,other.places,other.misplaced,other.hint,other.parts,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.rule,self.runtime,self.places,self.misplaced,self.hint,self.parts,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
 def lang_ast__Declared(_d, _f, FACTORY, _set=object.__setattr__):
     def __init__(self, pos):
         self.pos = pos
@@ -1503,6 +1546,79 @@ def lang_vocabulary__Block(_d, _f, FACTORY, _set=object.__setattr__):
     return __init__, __repr__, __eq__, __hash__
 
 
+def runtime_figure_tree__Link(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, name, shape, scale=_d['scale'], source=_d['source']):
+        _set(self, 'name', name)
+        _set(self, 'shape', shape)
+        _set(self, 'scale', scale)
+        _set(self, 'source', source)
+        self.__post_init__()
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(name={self.name!r}, shape={self.shape!r}, scale={self.scale!r}, source={self.source!r})"
+
+    __eq__ = __hash__ = None
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def runtime_figure_tree__Joint(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, id, primary, secondary, loc1, loc2, extremes, slide=_d['slide'], axes=_d['axes'], slide_scale=_d['slide_scale']):
+        _set(self, 'id', id)
+        _set(self, 'primary', primary)
+        _set(self, 'secondary', secondary)
+        _set(self, 'loc1', loc1)
+        _set(self, 'loc2', loc2)
+        _set(self, 'extremes', extremes)
+        _set(self, 'slide', slide)
+        _set(self, 'axes', axes)
+        _set(self, 'slide_scale', slide_scale)
+        self.__post_init__()
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(id={self.id!r}, primary={self.primary!r}, secondary={self.secondary!r}, loc1={self.loc1!r}, loc2={self.loc2!r}, extremes={self.extremes!r}, slide={self.slide!r}, axes={self.axes!r}, slide_scale={self.slide_scale!r})"
+
+    __eq__ = __hash__ = None
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def runtime_figure_tree__JointKind(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, slide=_d['slide'], axis=_d['axis']):
+        _set(self, 'slide', slide)
+        _set(self, 'axis', axis)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(slide={self.slide!r}, axis={self.axis!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.slide,self.axis,) == (other.slide,other.axis,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.slide,self.axis,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def runtime_figure_tree__Figure(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, links, joints=_d['joints'], root=_d['root'], main=_d['main'], placement=_d['placement']):
+        _set(self, 'links', links)
+        _set(self, 'joints', joints)
+        _set(self, 'root', root)
+        _set(self, 'main', main)
+        _set(self, 'placement', placement)
+        self.__post_init__()
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(links={self.links!r}, joints={self.joints!r}, root={self.root!r}, main={self.main!r}, placement={self.placement!r})"
+
+    __eq__ = __hash__ = None
+
+    return __init__, __repr__, __eq__, __hash__
+
+
 def runtime_host__TableArgs(_d, _f, FACTORY, _set=object.__setattr__):
     def __init__(self, columns, numbers, at):
         _set(self, 'columns', columns)
@@ -1575,84 +1691,179 @@ def runtime_host__GoalArgs(_d, _f, FACTORY, _set=object.__setattr__):
     return __init__, __repr__, __eq__, __hash__
 
 
+def runtime_ik_options__ReachOptions(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, movable=_d['movable'], translate=_d['translate'], solver=_d['solver'], tolerance=_d['tolerance'], max_iterations=_d['max_iterations'], restarts=_d['restarts']):
+        _set(self, 'movable', movable)
+        _set(self, 'translate', translate)
+        _set(self, 'solver', solver)
+        _set(self, 'tolerance', tolerance)
+        _set(self, 'max_iterations', max_iterations)
+        _set(self, 'restarts', restarts)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(movable={self.movable!r}, translate={self.translate!r}, solver={self.solver!r}, tolerance={self.tolerance!r}, max_iterations={self.max_iterations!r}, restarts={self.restarts!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.movable,self.translate,self.solver,self.tolerance,self.max_iterations,self.restarts,) == (other.movable,other.translate,other.solver,other.tolerance,other.max_iterations,other.restarts,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.movable,self.translate,self.solver,self.tolerance,self.max_iterations,self.restarts,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def runtime_motion_keyframe__Keyframe(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, frame, position, method=_d['method'], ramp=_d['ramp']):
+        _set(self, 'frame', frame)
+        _set(self, 'position', position)
+        _set(self, 'method', method)
+        _set(self, 'ramp', ramp)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(frame={self.frame!r}, position={self.position!r}, method={self.method!r}, ramp={self.ramp!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.frame,self.position,self.method,self.ramp,) == (other.frame,other.position,other.method,other.ramp,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.frame,self.position,self.method,self.ramp,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def runtime_motion_morph__Target(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, key, shape, triangles):
+        _set(self, 'key', key)
+        _set(self, 'shape', shape)
+        _set(self, 'triangles', triangles)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(key={self.key!r}, shape={self.shape!r}, triangles={self.triangles!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.key,self.shape,self.triangles,) == (other.key,other.shape,other.triangles,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.key,self.shape,self.triangles,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
+def runtime_motion_morph__ShapeKey(_d, _f, FACTORY, _set=object.__setattr__):
+    def __init__(self, frame, target, method=_d['method'], ramp=_d['ramp']):
+        _set(self, 'frame', frame)
+        _set(self, 'target', target)
+        _set(self, 'method', method)
+        _set(self, 'ramp', ramp)
+
+    def __repr__(self):
+        return self.__class__.__qualname__ + f"(frame={self.frame!r}, target={self.target!r}, method={self.method!r}, ramp={self.ramp!r})"
+
+    def __eq__(self, other):
+        if other.__class__ is self.__class__:
+            return (self.frame,self.target,self.method,self.ramp,) == (other.frame,other.target,other.method,other.ramp,)
+        return NotImplemented
+
+    def __hash__(self):
+        return hash((self.frame,self.target,self.method,self.ramp,))
+
+    return __init__, __repr__, __eq__, __hash__
+
+
 #: module:class -> (its fields as shape() gives them, the maker of its methods, its signature doc)
 MAKERS = {
-    'liganimate.compiler:Compiled': ((('frozen', False), ('python', 'required', 'str'), ('warnings', 'required', 'list'), ('checked', 'required', 'Checked')), compiler__Compiled, None),
-    'liganimate.compiler.check:Checked': ((('frozen', False), ('program', 'required', 'A.Program'), ('main', 'required', 'Scope'), ('primitives', 'required', 'dict'), ('types', 'required', 'dict'), ('scenes', 'required', 'dict'), ('warnings', 'required', 'list'), ('libraries', 'factory', 'list'), ('loads', 'factory', 'dict'), ('loaded_names', 'factory', 'dict'), ('loaded_primitives', 'factory', 'dict')), compiler_check__Checked, None),
-    'liganimate.compiler.library:Library': ((('frozen', False), ('name', 'required', 'str'), ('path', 'required', 'str'), ('display', 'required', 'str'), ('python', 'required', 'str'), ('types', 'required', 'dict'), ('signatures', 'required', 'dict'), ('descriptions', 'required', 'dict'), ('warnings', 'factory', 'list'), ('names', 'factory', 'dict'), ('deps', 'default', 'tuple'), ('scenes', 'default', 'bool')), compiler_library__Library, None),
-    'liganimate.compiler.loads:Loaded': ((('frozen', False), ('libraries', 'factory', 'list'), ('loads', 'factory', 'dict'), ('names', 'factory', 'dict'), ('primitives', 'factory', 'dict'), ('top', 'factory', 'set')), compiler_loads__Loaded, None),
-    'liganimate.compiler.primitives:Slot': ((('frozen', False), ('keyword', 'required', 'str'), ('param', 'required', 'str'), ('group', 'required', 'int | None')), compiler_primitives__Slot, "Slot(keyword: 'str', param: 'str', group: 'int | None')"),
-    'liganimate.compiler.primitives:Signature': ((('frozen', False), ('name', 'required', 'str'), ('slots', 'required', 'list'), ('defaults', 'factory', 'dict'), ('param_types', 'factory', 'dict')), compiler_primitives__Signature, None),
-    'liganimate.compiler.scopes:Scope': ((('frozen', False), ('name', 'required', 'str'), ('types', 'factory', 'dict'), ('declared', 'factory', 'dict'), ('implicit', 'factory', 'set'), ('params', 'factory', 'list')), compiler_scopes__Scope, None),
-    'liganimate.compiler.scopes:SceneInfo': ((('frozen', False), ('animated', 'factory', 'list'), ('models', 'factory', 'list'), ('assigned', 'factory', 'set')), compiler_scopes__SceneInfo, None),
-    'liganimate.compiler.scopes:State': ((('frozen', False), ('signatures', 'required', 'dict'), ('types', 'factory', 'dict'), ('scenes', 'factory', 'dict'), ('out', 'default', 'Sink'), ('scope', 'factory', 'Scope'), ('primitive', 'default', 'A.PrimitiveDef | None'), ('scene', 'default', 'SceneInfo | None')), compiler_scopes__State, None),
-    'liganimate.lang.ast:Node': ((('frozen', False), ('pos', 'required', 'Pos')), lang_ast__Node, "Node(pos: 'Pos')"),
-    'liganimate.lang.ast:Num': ((('frozen', False), ('pos', 'required', 'Pos'), ('value', 'required', 'int | float'), ('text', 'required', 'str')), lang_ast__Num, "Num(pos: 'Pos', value: 'int | float', text: 'str')"),
-    'liganimate.lang.ast:Var': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'str')), lang_ast__Var, "Var(pos: 'Pos', name: 'str')"),
-    'liganimate.lang.ast:Call': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'str'), ('args', 'required', 'list')), lang_ast__Call, "Call(pos: 'Pos', name: 'str', args: 'list')"),
-    'liganimate.lang.ast:Tuple': ((('frozen', False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Tuple, "Tuple(pos: 'Pos', items: 'list')"),
-    'liganimate.lang.ast:BinOp': ((('frozen', False), ('pos', 'required', 'Pos'), ('op', 'required', 'str'), ('left', 'required', 'Node'), ('right', 'required', 'Node'), ('op_pos', 'default', 'Pos')), lang_ast__BinOp, "BinOp(pos: 'Pos', op: 'str', left: 'Node', right: 'Node', op_pos: 'Pos' = Pos(line=0, column=0, end_line=0, end_column=0))"),
-    'liganimate.lang.ast:Neg': ((('frozen', False), ('pos', 'required', 'Pos'), ('operand', 'required', 'Node')), lang_ast__Neg, "Neg(pos: 'Pos', operand: 'Node')"),
-    'liganimate.lang.ast:Modifier': ((('frozen', False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('arg', 'required', 'Node'), ('axis', 'default', 'str | None')), lang_ast__Modifier, None),
-    'liganimate.lang.ast:Modified': ((('frozen', False), ('pos', 'required', 'Pos'), ('target', 'required', 'Node'), ('modifiers', 'required', 'list')), lang_ast__Modified, "Modified(pos: 'Pos', target: 'Node', modifiers: 'list')"),
-    'liganimate.lang.ast:Clause': ((('frozen', False), ('pos', 'required', 'Pos'), ('keyword', 'required', 'str'), ('value', 'required', 'Node')), lang_ast__Clause, "Clause(pos: 'Pos', keyword: 'str', value: 'Node')"),
-    'liganimate.lang.ast:PrimCall': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'str'), ('clauses', 'required', 'list')), lang_ast__PrimCall, "PrimCall(pos: 'Pos', name: 'str', clauses: 'list')"),
-    'liganimate.lang.ast:JointExpr': ((('frozen', False), ('pos', 'required', 'Pos'), ('args', 'required', 'list'), ('slide', 'default', 'bool'), ('axis', 'default', 'Node | None')), lang_ast__JointExpr, "JointExpr(pos: 'Pos', args: 'list', slide: 'bool' = False, axis: 'Node | None' = None)"),
-    'liganimate.lang.ast:Strip': ((('frozen', False), ('pos', 'required', 'Pos'), ('motion', 'required', 'Node'), ('joints', 'required', 'list')), lang_ast__Strip, "Strip(pos: 'Pos', motion: 'Node', joints: 'list')"),
-    'liganimate.lang.ast:Sync': ((('frozen', False), ('pos', 'required', 'Pos'), ('motions', 'required', 'list')), lang_ast__Sync, "Sync(pos: 'Pos', motions: 'list')"),
-    'liganimate.lang.ast:Compare': ((('frozen', False), ('pos', 'required', 'Pos'), ('op', 'required', 'str'), ('left', 'required', 'Node'), ('right', 'required', 'Node')), lang_ast__Compare, "Compare(pos: 'Pos', op: 'str', left: 'Node', right: 'Node')"),
-    'liganimate.lang.ast:BoolOp': ((('frozen', False), ('pos', 'required', 'Pos'), ('op', 'required', 'str'), ('left', 'required', 'Node'), ('right', 'required', 'Node')), lang_ast__BoolOp, "BoolOp(pos: 'Pos', op: 'str', left: 'Node', right: 'Node')"),
-    'liganimate.lang.ast:Not': ((('frozen', False), ('pos', 'required', 'Pos'), ('operand', 'required', 'Node')), lang_ast__Not, "Not(pos: 'Pos', operand: 'Node')"),
-    'liganimate.lang.ast:Name': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'str')), lang_ast__Name, None),
-    'liganimate.lang.ast:Decl': ((('frozen', False), ('pos', 'required', 'Pos'), ('type', 'required', 'str'), ('names', 'required', 'list')), lang_ast__Decl, "Decl(pos: 'Pos', type: 'str', names: 'list')"),
-    'liganimate.lang.ast:Assign': ((('frozen', False), ('pos', 'required', 'Pos'), ('target', 'required', 'Name'), ('op', 'required', 'str'), ('value', 'required', 'Node')), lang_ast__Assign, "Assign(pos: 'Pos', target: 'Name', op: 'str', value: 'Node')"),
-    'liganimate.lang.ast:Keyframe': ((('frozen', False), ('pos', 'required', 'Pos'), ('frame', 'required', 'Node'), ('position', 'required', 'list'), ('method', 'required', 'Name | None')), lang_ast__Keyframe, "Keyframe(pos: 'Pos', frame: 'Node', position: 'list', method: 'Name | None')"),
-    'liganimate.lang.ast:KeyframeAssign': ((('frozen', False), ('pos', 'required', 'Pos'), ('target', 'required', 'Name'), ('joint', 'required', 'Node'), ('index', 'required', 'Node'), ('op', 'required', 'str'), ('keyframe', 'required', 'Keyframe')), lang_ast__KeyframeAssign, "KeyframeAssign(pos: 'Pos', target: 'Name', joint: 'Node', index: 'Node', op: 'str', keyframe: 'Keyframe')"),
-    'liganimate.lang.ast:DoHeader': ((('frozen', False), ('pos', 'required', 'Pos'), ('label', 'required', 'int'), ('var', 'required', 'Name'), ('start', 'required', 'Node'), ('stop', 'required', 'Node'), ('step', 'required', 'Node | None')), lang_ast__DoHeader, None),
-    'liganimate.lang.ast:Continue': ((('frozen', False), ('pos', 'required', 'Pos'), ('label', 'required', 'int')), lang_ast__Continue, "Continue(pos: 'Pos', label: 'int')"),
-    'liganimate.lang.ast:Do': ((('frozen', False), ('pos', 'required', 'Pos'), ('label', 'required', 'int'), ('var', 'required', 'Name'), ('start', 'required', 'Node'), ('stop', 'required', 'Node'), ('step', 'required', 'Node | None'), ('body', 'required', 'list'), ('end_pos', 'default', 'Pos')), lang_ast__Do, None),
-    'liganimate.lang.ast:If': ((('frozen', False), ('pos', 'required', 'Pos'), ('cond', 'required', 'Node'), ('then', 'required', 'list'), ('orelse', 'required', 'list | None')), lang_ast__If, "If(pos: 'Pos', cond: 'Node', then: 'list', orelse: 'list | None')"),
-    'liganimate.lang.ast:JointStmt': ((('frozen', False), ('pos', 'required', 'Pos'), ('args', 'required', 'list'), ('slide', 'default', 'bool'), ('axis', 'default', 'Node | None')), lang_ast__JointStmt, "JointStmt(pos: 'Pos', args: 'list', slide: 'bool' = False, axis: 'Node | None' = None)"),
-    'liganimate.lang.ast:ModelBlock': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('joints', 'required', 'list')), lang_ast__ModelBlock, "ModelBlock(pos: 'Pos', name: 'Name', joints: 'list')"),
-    'liganimate.lang.ast:RootTrack': ((('frozen', False), ('pos', 'required', 'Pos'), ('orientation', 'default', 'bool')), lang_ast__RootTrack, None),
-    'liganimate.lang.ast:MorphTrack': ((('frozen', False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('link', 'required', 'str')), lang_ast__MorphTrack, None),
-    'liganimate.lang.ast:MotionJoint': ((('frozen', False), ('pos', 'required', 'Pos'), ('joint', 'required', 'Node'), ('start', 'required', 'list | None'), ('keyframes', 'required', 'list')), lang_ast__MotionJoint, "MotionJoint(pos: 'Pos', joint: 'Node', start: 'list | None', keyframes: 'list')"),
-    'liganimate.lang.ast:MotionTable': ((('frozen', False), ('pos', 'required', 'Pos'), ('columns', 'required', 'list'), ('rows', 'required', 'str'), ('rows_pos', 'required', 'Pos'), ('data', 'default', 'object')), lang_ast__MotionTable, None),
-    'liganimate.lang.ast:MotionBlock': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('joints', 'required', 'list'), ('tables', 'factory', 'list')), lang_ast__MotionBlock, "MotionBlock(pos: 'Pos', name: 'Name', joints: 'list', tables: 'list' = <factory>)"),
-    'liganimate.lang.ast:GoalSpec': ((('frozen', False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('point', 'required', 'Node | None'), ('target', 'required', 'Node | None'), ('normal', 'required', 'Node | None')), lang_ast__GoalSpec, None),
-    'liganimate.lang.ast:Goal': ((('frozen', False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('link', 'required', 'Name | None'), ('joint', 'required', 'Node | None'), ('point', 'required', 'Node | None'), ('target', 'required', 'Node | None'), ('normal', 'required', 'Node | None'), ('weight', 'required', 'Node | None')), lang_ast__Goal, None),
-    'liganimate.lang.ast:Option': ((('frozen', False), ('pos', 'required', 'Pos'), ('word', 'required', 'str'), ('value', 'required', 'Node')), lang_ast__Option, None),
-    'liganimate.lang.ast:ReachBlock': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('model', 'required', 'Node'), ('frames', 'required', 'Node'), ('method', 'required', 'Name | None'), ('start', 'required', 'Node | None'), ('goals', 'required', 'list'), ('joints', 'default', 'list | None'), ('chain', 'default', 'Node | None'), ('translate', 'default', 'Name | None'), ('solver', 'default', 'Name | None'), ('tolerance', 'default', 'Node | None'), ('iterations', 'default', 'Node | None'), ('options', 'factory', 'dict')), lang_ast__ReachBlock, "ReachBlock(pos: 'Pos', name: 'Name', model: 'Node', frames: 'Node', method: 'Name | None', start: 'Node | None', goals: 'list', joints: 'list | None' = None, chain: 'Node | None' = None, translate: 'Name | None' = None, solver: 'Name | None' = None, tolerance: 'Node | None' = None, iterations: 'Node | None' = None, options: 'dict' = <factory>)"),
-    'liganimate.lang.ast:FigureStmt': ((('frozen', False), ('pos', 'required', 'Pos'), ('model', 'required', 'Name'), ('kind', 'required', 'str | None'), ('link', 'default', 'Name | None'), ('joint', 'default', 'Node | None')), lang_ast__FigureStmt, "FigureStmt(pos: 'Pos', model: 'Name', kind: 'str | None', link: 'Name | None' = None, joint: 'Node | None' = None)"),
-    'liganimate.lang.ast:Scene': ((('frozen', False), ('pos', 'required', 'Pos'), ('scene_id', 'required', 'Node'), ('init', 'required', 'list'), ('length', 'required', 'Node'), ('sameframe', 'required', 'Node | None'), ('body', 'required', 'list'), ('start_pos', 'default', 'Pos')), lang_ast__Scene, "Scene(pos: 'Pos', scene_id: 'Node', init: 'list', length: 'Node', sameframe: 'Node | None', body: 'list', start_pos: 'Pos' = Pos(line=0, column=0, end_line=0, end_column=0))"),
-    'liganimate.lang.ast:Animate': ((('frozen', False), ('pos', 'required', 'Pos'), ('model', 'required', 'Name'), ('start', 'required', 'Node'), ('end', 'required', 'Node'), ('motion', 'required', 'Node'), ('repeat', 'required', 'bool')), lang_ast__Animate, "Animate(pos: 'Pos', model: 'Name', start: 'Node', end: 'Node', motion: 'Node', repeat: 'bool')"),
-    'liganimate.lang.ast:Background': ((('frozen', False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Background, "Background(pos: 'Pos', items: 'list')"),
-    'liganimate.lang.ast:PrintItem': ((('frozen', False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('value', 'required', 'object')), lang_ast__PrintItem, "PrintItem(pos: 'Pos', kind: 'str', value: 'object')"),
-    'liganimate.lang.ast:Print': ((('frozen', False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Print, "Print(pos: 'Pos', items: 'list')"),
-    'liganimate.lang.ast:Declared': ((('frozen', False), ('pos', 'required', 'Pos')), lang_ast__Declared, None),
-    'liganimate.lang.ast:ViewPoint': ((('frozen', False), ('pos', 'required', 'Pos'), ('point', 'required', 'Node')), lang_ast__ViewPoint, "ViewPoint(pos: 'Pos', point: 'Node')"),
-    'liganimate.lang.ast:ViewWidth': ((('frozen', False), ('pos', 'required', 'Pos'), ('width', 'required', 'Node')), lang_ast__ViewWidth, "ViewWidth(pos: 'Pos', width: 'Node')"),
-    'liganimate.lang.ast:Shoot': ((('frozen', False), ('pos', 'required', 'Pos')), lang_ast__Shoot, "Shoot(pos: 'Pos')"),
-    'liganimate.lang.ast:ShootRange': ((('frozen', False), ('pos', 'required', 'Pos'), ('first', 'required', 'Node'), ('last', 'required', 'Node')), lang_ast__ShootRange, "ShootRange(pos: 'Pos', first: 'Node', last: 'Node')"),
-    'liganimate.lang.ast:Stop': ((('frozen', False), ('pos', 'required', 'Pos')), lang_ast__Stop, "Stop(pos: 'Pos')"),
-    'liganimate.lang.ast:Return': ((('frozen', False), ('pos', 'required', 'Pos')), lang_ast__Return, "Return(pos: 'Pos')"),
-    'liganimate.lang.ast:ProgramEnd': ((('frozen', False), ('pos', 'required', 'Pos')), lang_ast__ProgramEnd, "ProgramEnd(pos: 'Pos')"),
-    'liganimate.lang.ast:DrawWith': ((('frozen', False), ('pos', 'required', 'Pos'), ('modifiers', 'required', 'list')), lang_ast__DrawWith, "DrawWith(pos: 'Pos', modifiers: 'list')"),
-    'liganimate.lang.ast:DrawPoly': ((('frozen', False), ('pos', 'required', 'Pos'), ('points', 'required', 'list')), lang_ast__DrawPoly, "DrawPoly(pos: 'Pos', points: 'list')"),
-    'liganimate.lang.ast:Load': ((('frozen', False), ('pos', 'required', 'Pos'), ('library', 'required', 'str'), ('library_pos', 'required', 'Pos'), ('names', 'required', 'list')), lang_ast__Load, "Load(pos: 'Pos', library: 'str', library_pos: 'Pos', names: 'list')"),
-    'liganimate.lang.ast:PatWord': ((('frozen', False), ('pos', 'required', 'Pos'), ('word', 'required', 'str')), lang_ast__PatWord, "PatWord(pos: 'Pos', word: 'str')"),
-    'liganimate.lang.ast:PatParam': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'str')), lang_ast__PatParam, "PatParam(pos: 'Pos', name: 'str')"),
-    'liganimate.lang.ast:PatOptional': ((('frozen', False), ('pos', 'required', 'Pos'), ('items', 'required', 'list'), ('defaults', 'required', 'list')), lang_ast__PatOptional, "PatOptional(pos: 'Pos', items: 'list', defaults: 'list')"),
-    'liganimate.lang.ast:PatternDef': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'str'), ('items', 'required', 'list')), lang_ast__PatternDef, "PatternDef(pos: 'Pos', name: 'str', items: 'list')"),
-    'liganimate.lang.ast:PrimitiveDef': ((('frozen', False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('body', 'required', 'list'), ('pattern', 'default', 'PatternDef | None')), lang_ast__PrimitiveDef, "PrimitiveDef(pos: 'Pos', name: 'Name', body: 'list', pattern: 'PatternDef | None' = None)"),
-    'liganimate.lang.ast:Program': ((('frozen', False), ('pos', 'required', 'Pos'), ('filename', 'required', 'str'), ('source', 'required', 'str'), ('body', 'required', 'list'), ('primitives', 'factory', 'list')), lang_ast__Program, "Program(pos: 'Pos', filename: 'str', source: 'str', body: 'list', primitives: 'list' = <factory>)"),
-    'liganimate.lang.diagnostics:Diagnostic': ((('frozen', False), ('filename', 'required', 'str'), ('pos', 'required', 'Pos'), ('message', 'required', 'str'), ('hint', 'default', 'str | None'), ('severity', 'default', 'str'), ('source', 'default', 'str | None'), ('notes', 'factory', 'list')), lang_diagnostics__Diagnostic, None),
-    'liganimate.lang.source:Source': ((('frozen', False), ('filename', 'required', 'str'), ('text', 'required', 'str'), ('lexed', 'required', 'str'), ('warnings', 'factory', 'list')), lang_source__Source, None),
-    'liganimate.lang.vocabulary:Modifier': ((('frozen', True), ('kind', 'required', 'str'), ('label', 'required', 'str'), ('methods', 'required', 'dict', 'unhashed'), ('accepts', 'default', 'tuple'), ('accepts_noun', 'default', 'str'), ('nonzero', 'default', 'bool'), ('axis', 'default', 'bool')), lang_vocabulary__Modifier, None),
-    'liganimate.lang.vocabulary:Operator': ((('frozen', True), ('symbol', 'required', 'str'), ('rule', 'required', 'str'), ('left', 'required', 'tuple'), ('right', 'required', 'tuple'), ('result', 'required', 'str | None'), ('runtime', 'default', 'str | None'), ('at_operator', 'default', 'bool'), ('animated', 'default', 'bool'), ('group_right', 'default', 'bool')), lang_vocabulary__Operator, None),
-    'liganimate.lang.vocabulary:Function': ((('frozen', True), ('name', 'required', 'str'), ('params', 'required', 'tuple'), ('result', 'required', 'Type | None'), ('runtime', 'required', 'str')), lang_vocabulary__Function, None),
-    'liganimate.lang.vocabulary:Block': ((('frozen', True), ('opener', 'required', 'str'), ('closer', 'required', 'str'), ('shown', 'required', 'str')), lang_vocabulary__Block, None),
-    'liganimate.runtime.host:TableArgs': ((('frozen', True), ('columns', 'required', 'tuple'), ('numbers', 'required', 'str'), ('at', 'required', 'int')), runtime_host__TableArgs, None),
-    'liganimate.runtime.host:JointArgs': ((('frozen', True), ('jid', 'required', 'int'), ('primary_name', 'required', 'str | None'), ('primary', 'required', 'object'), ('primary_location', 'required', 'object'), ('secondary', 'required', 'object'), ('secondary_name', 'required', 'str | None'), ('secondary_location', 'required', 'object'), ('extremes', 'required', 'tuple'), ('at', 'required', 'int'), ('kind', 'default', 'tuple')), runtime_host__JointArgs, None),
-    'liganimate.runtime.host:GoalArgs': ((('frozen', True), ('kind', 'required', 'str'), ('link', 'required', 'str | None'), ('joint', 'required', 'int | None'), ('point', 'required', 'object'), ('target', 'required', 'object'), ('normal', 'required', 'object'), ('weight', 'required', 'float | None'), ('at', 'required', 'int')), runtime_host__GoalArgs, None),
+    'liganimate.compiler:Compiled': ((('options', False, True, False), ('python', 'required', 'str'), ('warnings', 'required', 'list'), ('checked', 'required', 'Checked')), compiler__Compiled, None),
+    'liganimate.compiler.check:Checked': ((('options', False, True, False), ('program', 'required', 'A.Program'), ('main', 'required', 'Scope'), ('primitives', 'required', 'dict'), ('types', 'required', 'dict'), ('scenes', 'required', 'dict'), ('warnings', 'required', 'list'), ('libraries', 'factory', 'list'), ('loads', 'factory', 'dict'), ('loaded_names', 'factory', 'dict'), ('loaded_primitives', 'factory', 'dict')), compiler_check__Checked, None),
+    'liganimate.compiler.library:Library': ((('options', False, True, False), ('name', 'required', 'str'), ('path', 'required', 'str'), ('display', 'required', 'str'), ('python', 'required', 'str'), ('types', 'required', 'dict'), ('signatures', 'required', 'dict'), ('descriptions', 'required', 'dict'), ('warnings', 'factory', 'list'), ('names', 'factory', 'dict'), ('deps', 'default', 'tuple'), ('scenes', 'default', 'bool')), compiler_library__Library, None),
+    'liganimate.compiler.loads:Loaded': ((('options', False, True, False), ('libraries', 'factory', 'list'), ('loads', 'factory', 'dict'), ('names', 'factory', 'dict'), ('primitives', 'factory', 'dict'), ('top', 'factory', 'set')), compiler_loads__Loaded, None),
+    'liganimate.compiler.primitives:Slot': ((('options', False, True, False), ('keyword', 'required', 'str'), ('param', 'required', 'str'), ('group', 'required', 'int | None')), compiler_primitives__Slot, "Slot(keyword: 'str', param: 'str', group: 'int | None')"),
+    'liganimate.compiler.primitives:Signature': ((('options', False, True, False), ('name', 'required', 'str'), ('slots', 'required', 'list'), ('defaults', 'factory', 'dict'), ('param_types', 'factory', 'dict')), compiler_primitives__Signature, None),
+    'liganimate.compiler.scopes:Scope': ((('options', False, True, False), ('name', 'required', 'str'), ('types', 'factory', 'dict'), ('declared', 'factory', 'dict'), ('implicit', 'factory', 'set'), ('params', 'factory', 'list')), compiler_scopes__Scope, None),
+    'liganimate.compiler.scopes:SceneInfo': ((('options', False, True, False), ('animated', 'factory', 'list'), ('models', 'factory', 'list'), ('assigned', 'factory', 'set')), compiler_scopes__SceneInfo, None),
+    'liganimate.compiler.scopes:State': ((('options', False, True, False), ('signatures', 'required', 'dict'), ('types', 'factory', 'dict'), ('scenes', 'factory', 'dict'), ('out', 'default', 'Sink'), ('scope', 'factory', 'Scope'), ('primitive', 'default', 'A.PrimitiveDef | None'), ('scene', 'default', 'SceneInfo | None')), compiler_scopes__State, None),
+    'liganimate.lang.ast:Node': ((('options', False, True, False), ('pos', 'required', 'Pos')), lang_ast__Node, "Node(pos: 'Pos')"),
+    'liganimate.lang.ast:Num': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('value', 'required', 'int | float'), ('text', 'required', 'str')), lang_ast__Num, "Num(pos: 'Pos', value: 'int | float', text: 'str')"),
+    'liganimate.lang.ast:Var': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'str')), lang_ast__Var, "Var(pos: 'Pos', name: 'str')"),
+    'liganimate.lang.ast:Call': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'str'), ('args', 'required', 'list')), lang_ast__Call, "Call(pos: 'Pos', name: 'str', args: 'list')"),
+    'liganimate.lang.ast:Tuple': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Tuple, "Tuple(pos: 'Pos', items: 'list')"),
+    'liganimate.lang.ast:BinOp': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('op', 'required', 'str'), ('left', 'required', 'Node'), ('right', 'required', 'Node'), ('op_pos', 'default', 'Pos')), lang_ast__BinOp, "BinOp(pos: 'Pos', op: 'str', left: 'Node', right: 'Node', op_pos: 'Pos' = Pos(line=0, column=0, end_line=0, end_column=0))"),
+    'liganimate.lang.ast:Neg': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('operand', 'required', 'Node')), lang_ast__Neg, "Neg(pos: 'Pos', operand: 'Node')"),
+    'liganimate.lang.ast:Modifier': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('arg', 'required', 'Node'), ('axis', 'default', 'str | None')), lang_ast__Modifier, None),
+    'liganimate.lang.ast:Modified': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('target', 'required', 'Node'), ('modifiers', 'required', 'list')), lang_ast__Modified, "Modified(pos: 'Pos', target: 'Node', modifiers: 'list')"),
+    'liganimate.lang.ast:Clause': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('keyword', 'required', 'str'), ('value', 'required', 'Node')), lang_ast__Clause, "Clause(pos: 'Pos', keyword: 'str', value: 'Node')"),
+    'liganimate.lang.ast:PrimCall': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'str'), ('clauses', 'required', 'list')), lang_ast__PrimCall, "PrimCall(pos: 'Pos', name: 'str', clauses: 'list')"),
+    'liganimate.lang.ast:JointExpr': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('args', 'required', 'list'), ('slide', 'default', 'bool'), ('axis', 'default', 'Node | None')), lang_ast__JointExpr, "JointExpr(pos: 'Pos', args: 'list', slide: 'bool' = False, axis: 'Node | None' = None)"),
+    'liganimate.lang.ast:Strip': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('motion', 'required', 'Node'), ('joints', 'required', 'list')), lang_ast__Strip, "Strip(pos: 'Pos', motion: 'Node', joints: 'list')"),
+    'liganimate.lang.ast:Sync': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('motions', 'required', 'list')), lang_ast__Sync, "Sync(pos: 'Pos', motions: 'list')"),
+    'liganimate.lang.ast:Compare': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('op', 'required', 'str'), ('left', 'required', 'Node'), ('right', 'required', 'Node')), lang_ast__Compare, "Compare(pos: 'Pos', op: 'str', left: 'Node', right: 'Node')"),
+    'liganimate.lang.ast:BoolOp': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('op', 'required', 'str'), ('left', 'required', 'Node'), ('right', 'required', 'Node')), lang_ast__BoolOp, "BoolOp(pos: 'Pos', op: 'str', left: 'Node', right: 'Node')"),
+    'liganimate.lang.ast:Not': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('operand', 'required', 'Node')), lang_ast__Not, "Not(pos: 'Pos', operand: 'Node')"),
+    'liganimate.lang.ast:Name': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'str')), lang_ast__Name, None),
+    'liganimate.lang.ast:Decl': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('type', 'required', 'str'), ('names', 'required', 'list')), lang_ast__Decl, "Decl(pos: 'Pos', type: 'str', names: 'list')"),
+    'liganimate.lang.ast:Assign': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('target', 'required', 'Name'), ('op', 'required', 'str'), ('value', 'required', 'Node')), lang_ast__Assign, "Assign(pos: 'Pos', target: 'Name', op: 'str', value: 'Node')"),
+    'liganimate.lang.ast:Keyframe': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('frame', 'required', 'Node'), ('position', 'required', 'list'), ('method', 'required', 'Name | None')), lang_ast__Keyframe, "Keyframe(pos: 'Pos', frame: 'Node', position: 'list', method: 'Name | None')"),
+    'liganimate.lang.ast:KeyframeAssign': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('target', 'required', 'Name'), ('joint', 'required', 'Node'), ('index', 'required', 'Node'), ('op', 'required', 'str'), ('keyframe', 'required', 'Keyframe')), lang_ast__KeyframeAssign, "KeyframeAssign(pos: 'Pos', target: 'Name', joint: 'Node', index: 'Node', op: 'str', keyframe: 'Keyframe')"),
+    'liganimate.lang.ast:DoHeader': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('label', 'required', 'int'), ('var', 'required', 'Name'), ('start', 'required', 'Node'), ('stop', 'required', 'Node'), ('step', 'required', 'Node | None')), lang_ast__DoHeader, None),
+    'liganimate.lang.ast:Continue': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('label', 'required', 'int')), lang_ast__Continue, "Continue(pos: 'Pos', label: 'int')"),
+    'liganimate.lang.ast:Do': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('label', 'required', 'int'), ('var', 'required', 'Name'), ('start', 'required', 'Node'), ('stop', 'required', 'Node'), ('step', 'required', 'Node | None'), ('body', 'required', 'list'), ('end_pos', 'default', 'Pos')), lang_ast__Do, None),
+    'liganimate.lang.ast:If': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('cond', 'required', 'Node'), ('then', 'required', 'list'), ('orelse', 'required', 'list | None')), lang_ast__If, "If(pos: 'Pos', cond: 'Node', then: 'list', orelse: 'list | None')"),
+    'liganimate.lang.ast:JointStmt': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('args', 'required', 'list'), ('slide', 'default', 'bool'), ('axis', 'default', 'Node | None')), lang_ast__JointStmt, "JointStmt(pos: 'Pos', args: 'list', slide: 'bool' = False, axis: 'Node | None' = None)"),
+    'liganimate.lang.ast:ModelBlock': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('joints', 'required', 'list')), lang_ast__ModelBlock, "ModelBlock(pos: 'Pos', name: 'Name', joints: 'list')"),
+    'liganimate.lang.ast:RootTrack': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('orientation', 'default', 'bool')), lang_ast__RootTrack, None),
+    'liganimate.lang.ast:MorphTrack': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('link', 'required', 'str')), lang_ast__MorphTrack, None),
+    'liganimate.lang.ast:MotionJoint': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('joint', 'required', 'Node'), ('start', 'required', 'list | None'), ('keyframes', 'required', 'list')), lang_ast__MotionJoint, "MotionJoint(pos: 'Pos', joint: 'Node', start: 'list | None', keyframes: 'list')"),
+    'liganimate.lang.ast:MotionTable': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('columns', 'required', 'list'), ('rows', 'required', 'str'), ('rows_pos', 'required', 'Pos'), ('data', 'default', 'object')), lang_ast__MotionTable, None),
+    'liganimate.lang.ast:MotionBlock': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('joints', 'required', 'list'), ('tables', 'factory', 'list')), lang_ast__MotionBlock, "MotionBlock(pos: 'Pos', name: 'Name', joints: 'list', tables: 'list' = <factory>)"),
+    'liganimate.lang.ast:GoalSpec': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('point', 'required', 'Node | None'), ('target', 'required', 'Node | None'), ('normal', 'required', 'Node | None')), lang_ast__GoalSpec, None),
+    'liganimate.lang.ast:Goal': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('link', 'required', 'Name | None'), ('joint', 'required', 'Node | None'), ('point', 'required', 'Node | None'), ('target', 'required', 'Node | None'), ('normal', 'required', 'Node | None'), ('weight', 'required', 'Node | None')), lang_ast__Goal, None),
+    'liganimate.lang.ast:Option': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('word', 'required', 'str'), ('value', 'required', 'Node')), lang_ast__Option, None),
+    'liganimate.lang.ast:ReachBlock': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('model', 'required', 'Node'), ('frames', 'required', 'Node'), ('method', 'required', 'Name | None'), ('start', 'required', 'Node | None'), ('goals', 'required', 'list'), ('joints', 'default', 'list | None'), ('chain', 'default', 'Node | None'), ('translate', 'default', 'Name | None'), ('solver', 'default', 'Name | None'), ('tolerance', 'default', 'Node | None'), ('iterations', 'default', 'Node | None'), ('options', 'factory', 'dict')), lang_ast__ReachBlock, "ReachBlock(pos: 'Pos', name: 'Name', model: 'Node', frames: 'Node', method: 'Name | None', start: 'Node | None', goals: 'list', joints: 'list | None' = None, chain: 'Node | None' = None, translate: 'Name | None' = None, solver: 'Name | None' = None, tolerance: 'Node | None' = None, iterations: 'Node | None' = None, options: 'dict' = <factory>)"),
+    'liganimate.lang.ast:FigureStmt': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('model', 'required', 'Name'), ('kind', 'required', 'str | None'), ('link', 'default', 'Name | None'), ('joint', 'default', 'Node | None')), lang_ast__FigureStmt, "FigureStmt(pos: 'Pos', model: 'Name', kind: 'str | None', link: 'Name | None' = None, joint: 'Node | None' = None)"),
+    'liganimate.lang.ast:Scene': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('scene_id', 'required', 'Node'), ('init', 'required', 'list'), ('length', 'required', 'Node'), ('sameframe', 'required', 'Node | None'), ('body', 'required', 'list'), ('start_pos', 'default', 'Pos')), lang_ast__Scene, "Scene(pos: 'Pos', scene_id: 'Node', init: 'list', length: 'Node', sameframe: 'Node | None', body: 'list', start_pos: 'Pos' = Pos(line=0, column=0, end_line=0, end_column=0))"),
+    'liganimate.lang.ast:Animate': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('model', 'required', 'Name'), ('start', 'required', 'Node'), ('end', 'required', 'Node'), ('motion', 'required', 'Node'), ('repeat', 'required', 'bool')), lang_ast__Animate, "Animate(pos: 'Pos', model: 'Name', start: 'Node', end: 'Node', motion: 'Node', repeat: 'bool')"),
+    'liganimate.lang.ast:Background': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Background, "Background(pos: 'Pos', items: 'list')"),
+    'liganimate.lang.ast:PrintItem': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('kind', 'required', 'str'), ('value', 'required', 'object')), lang_ast__PrintItem, "PrintItem(pos: 'Pos', kind: 'str', value: 'object')"),
+    'liganimate.lang.ast:Print': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('items', 'required', 'list')), lang_ast__Print, "Print(pos: 'Pos', items: 'list')"),
+    'liganimate.lang.ast:Part': ((('options', True, True, False), ('accepts', 'required', 'tuple[Type, ...]'), ('what', 'required', 'str'), ('many', 'default', 'bool')), lang_ast__Part, None),
+    'liganimate.lang.ast:Declaration': ((('options', True, True, False), ('rule', 'required', 'str'), ('runtime', 'required', 'str'), ('places', 'required', 'frozenset[str]'), ('misplaced', 'required', 'str'), ('hint', 'required', 'str | None'), ('parts', 'required', 'tuple[tuple[str, Part], ...]')), lang_ast__Declaration, None),
+    'liganimate.lang.ast:Declared': ((('options', False, True, False), ('pos', 'required', 'Pos')), lang_ast__Declared, None),
+    'liganimate.lang.ast:ViewPoint': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('point', 'required', 'Node')), lang_ast__ViewPoint, "ViewPoint(pos: 'Pos', point: 'Node')"),
+    'liganimate.lang.ast:ViewWidth': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('width', 'required', 'Node')), lang_ast__ViewWidth, "ViewWidth(pos: 'Pos', width: 'Node')"),
+    'liganimate.lang.ast:Shoot': ((('options', False, True, False), ('pos', 'required', 'Pos')), lang_ast__Shoot, "Shoot(pos: 'Pos')"),
+    'liganimate.lang.ast:ShootRange': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('first', 'required', 'Node'), ('last', 'required', 'Node')), lang_ast__ShootRange, "ShootRange(pos: 'Pos', first: 'Node', last: 'Node')"),
+    'liganimate.lang.ast:Stop': ((('options', False, True, False), ('pos', 'required', 'Pos')), lang_ast__Stop, "Stop(pos: 'Pos')"),
+    'liganimate.lang.ast:Return': ((('options', False, True, False), ('pos', 'required', 'Pos')), lang_ast__Return, "Return(pos: 'Pos')"),
+    'liganimate.lang.ast:ProgramEnd': ((('options', False, True, False), ('pos', 'required', 'Pos')), lang_ast__ProgramEnd, "ProgramEnd(pos: 'Pos')"),
+    'liganimate.lang.ast:DrawWith': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('modifiers', 'required', 'list')), lang_ast__DrawWith, "DrawWith(pos: 'Pos', modifiers: 'list')"),
+    'liganimate.lang.ast:DrawPoly': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('points', 'required', 'list')), lang_ast__DrawPoly, "DrawPoly(pos: 'Pos', points: 'list')"),
+    'liganimate.lang.ast:Load': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('library', 'required', 'str'), ('library_pos', 'required', 'Pos'), ('names', 'required', 'list')), lang_ast__Load, "Load(pos: 'Pos', library: 'str', library_pos: 'Pos', names: 'list')"),
+    'liganimate.lang.ast:PatWord': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('word', 'required', 'str')), lang_ast__PatWord, "PatWord(pos: 'Pos', word: 'str')"),
+    'liganimate.lang.ast:PatParam': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'str')), lang_ast__PatParam, "PatParam(pos: 'Pos', name: 'str')"),
+    'liganimate.lang.ast:PatOptional': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('items', 'required', 'list'), ('defaults', 'required', 'list')), lang_ast__PatOptional, "PatOptional(pos: 'Pos', items: 'list', defaults: 'list')"),
+    'liganimate.lang.ast:PatternDef': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'str'), ('items', 'required', 'list')), lang_ast__PatternDef, "PatternDef(pos: 'Pos', name: 'str', items: 'list')"),
+    'liganimate.lang.ast:PrimitiveDef': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('name', 'required', 'Name'), ('body', 'required', 'list'), ('pattern', 'default', 'PatternDef | None')), lang_ast__PrimitiveDef, "PrimitiveDef(pos: 'Pos', name: 'Name', body: 'list', pattern: 'PatternDef | None' = None)"),
+    'liganimate.lang.ast:Program': ((('options', False, True, False), ('pos', 'required', 'Pos'), ('filename', 'required', 'str'), ('source', 'required', 'str'), ('body', 'required', 'list'), ('primitives', 'factory', 'list')), lang_ast__Program, "Program(pos: 'Pos', filename: 'str', source: 'str', body: 'list', primitives: 'list' = <factory>)"),
+    'liganimate.lang.diagnostics:Diagnostic': ((('options', False, True, False), ('filename', 'required', 'str'), ('pos', 'required', 'Pos'), ('message', 'required', 'str'), ('hint', 'default', 'str | None'), ('severity', 'default', 'str'), ('source', 'default', 'str | None'), ('notes', 'factory', 'list')), lang_diagnostics__Diagnostic, None),
+    'liganimate.lang.source:Source': ((('options', False, True, False), ('filename', 'required', 'str'), ('text', 'required', 'str'), ('lexed', 'required', 'str'), ('warnings', 'factory', 'list')), lang_source__Source, None),
+    'liganimate.lang.vocabulary:Modifier': ((('options', True, True, False), ('kind', 'required', 'str'), ('label', 'required', 'str'), ('methods', 'required', 'dict', 'unhashed'), ('accepts', 'default', 'tuple'), ('accepts_noun', 'default', 'str'), ('nonzero', 'default', 'bool'), ('axis', 'default', 'bool')), lang_vocabulary__Modifier, None),
+    'liganimate.lang.vocabulary:Operator': ((('options', True, True, False), ('symbol', 'required', 'str'), ('rule', 'required', 'str'), ('left', 'required', 'tuple'), ('right', 'required', 'tuple'), ('result', 'required', 'str | None'), ('runtime', 'default', 'str | None'), ('at_operator', 'default', 'bool'), ('animated', 'default', 'bool'), ('group_right', 'default', 'bool')), lang_vocabulary__Operator, None),
+    'liganimate.lang.vocabulary:Function': ((('options', True, True, False), ('name', 'required', 'str'), ('params', 'required', 'tuple'), ('result', 'required', 'Type | None'), ('runtime', 'required', 'str')), lang_vocabulary__Function, None),
+    'liganimate.lang.vocabulary:Block': ((('options', True, True, False), ('opener', 'required', 'str'), ('closer', 'required', 'str'), ('shown', 'required', 'str')), lang_vocabulary__Block, None),
+    'liganimate.runtime.figure.tree:Link': ((('options', True, False, True), ('name', 'required', 'str | None'), ('shape', 'required', 'object'), ('scale', 'default', 'float'), ('source', 'default', 'LinkSource | None')), runtime_figure_tree__Link, None),
+    'liganimate.runtime.figure.tree:Joint': ((('options', True, False, True), ('id', 'required', 'int'), ('primary', 'required', 'int'), ('secondary', 'required', 'int'), ('loc1', 'required', 'np.ndarray'), ('loc2', 'required', 'np.ndarray'), ('extremes', 'required', 'np.ndarray'), ('slide', 'default', 'bool'), ('axes', 'default', 'np.ndarray | None'), ('slide_scale', 'default', 'float')), runtime_figure_tree__Joint, None),
+    'liganimate.runtime.figure.tree:JointKind': ((('options', True, True, False), ('slide', 'default', 'bool'), ('axis', 'default', 'object')), runtime_figure_tree__JointKind, None),
+    'liganimate.runtime.figure.tree:Figure': ((('options', True, False, True), ('links', 'required', 'tuple[Link, ...]'), ('joints', 'default', 'tuple[Joint, ...]'), ('root', 'default', 'int'), ('main', 'default', 'int'), ('placement', 'default', 'np.ndarray | None')), runtime_figure_tree__Figure, None),
+    'liganimate.runtime.host:TableArgs': ((('options', True, True, False), ('columns', 'required', 'tuple'), ('numbers', 'required', 'str'), ('at', 'required', 'int')), runtime_host__TableArgs, None),
+    'liganimate.runtime.host:JointArgs': ((('options', True, True, False), ('jid', 'required', 'int'), ('primary_name', 'required', 'str | None'), ('primary', 'required', 'object'), ('primary_location', 'required', 'object'), ('secondary', 'required', 'object'), ('secondary_name', 'required', 'str | None'), ('secondary_location', 'required', 'object'), ('extremes', 'required', 'tuple'), ('at', 'required', 'int'), ('kind', 'default', 'tuple')), runtime_host__JointArgs, None),
+    'liganimate.runtime.host:GoalArgs': ((('options', True, True, False), ('kind', 'required', 'str'), ('link', 'required', 'str | None'), ('joint', 'required', 'int | None'), ('point', 'required', 'object'), ('target', 'required', 'object'), ('normal', 'required', 'object'), ('weight', 'required', 'float | None'), ('at', 'required', 'int')), runtime_host__GoalArgs, None),
+    'liganimate.runtime.ik.options:ReachOptions': ((('options', True, True, False), ('movable', 'default', 'int | tuple[int, ...] | None'), ('translate', 'default', 'bool'), ('solver', 'default', 'str'), ('tolerance', 'default', 'float | None'), ('max_iterations', 'default', 'int | None'), ('restarts', 'default', 'int')), runtime_ik_options__ReachOptions, None),
+    'liganimate.runtime.motion.keyframe:Keyframe': ((('options', True, True, False), ('frame', 'required', 'float'), ('position', 'required', 'tuple[float, float, float]'), ('method', 'default', 'str'), ('ramp', 'default', 'float')), runtime_motion_keyframe__Keyframe, None),
+    'liganimate.runtime.motion.morph:Target': ((('options', True, True, False), ('key', 'required', 'str'), ('shape', 'required', 'Any'), ('triangles', 'required', 'int')), runtime_motion_morph__Target, None),
+    'liganimate.runtime.motion.morph:ShapeKey': ((('options', True, True, False), ('frame', 'required', 'float'), ('target', 'required', 'Target | None'), ('method', 'default', 'str'), ('ramp', 'default', 'float')), runtime_motion_morph__ShapeKey, None),
 }

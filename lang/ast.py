@@ -21,11 +21,11 @@ statement lists it holds (``holds``, read by lang/visitor.py's ``BLOCKS``).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, field, fields
 from typing import Any, Self
 
 from . import syntax as R
-from .node_methods import node
+from .node_methods import node, record
 from .numbers import literal
 from .syntax import SYNTAX, Syntax, upper_name, value_rule
 from .vocabulary import NUMBER, Type
@@ -747,7 +747,7 @@ class Print(Node):
 PLACES = frozenset({"top", "scene", "scene-body", "primitive"})
 
 
-@dataclass(frozen=True, slots=True)
+@record(frozen=True, slots=True)
 class Part:
     """One part of a declared statement: an expression of one of ``accepts`` (or, ``many``, a list of them).
 
@@ -764,7 +764,7 @@ def part(*accepts: Type, what: str, many: bool = False) -> Any:
     return field(metadata={"part": Part(tuple(accepts), what, many)})
 
 
-@dataclass(frozen=True, slots=True)
+@record(frozen=True, slots=True)
 class Declaration:
     """How a declared statement is checked and lowered (see :func:`declared`)."""
 

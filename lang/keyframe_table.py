@@ -9,7 +9,6 @@ runs only to say where a row is wrong.
 
 from __future__ import annotations
 
-import base64
 import re
 import warnings
 import zlib
@@ -83,11 +82,15 @@ def read_rows(rows: str, pos: Pos, columns: int) -> np.ndarray:
 
 def pack(rows: str) -> str:
     """The rows' numbers as the lowered module carries them: their text, deflated, in base 64 (about half the size)."""
+    import base64  # here: a program without a TABLE (most) never needs it, and a cold check would pay 1 ms
+
     return base64.b64encode(zlib.compress(numbers_text(rows).encode("ascii", "replace"), 1)).decode("ascii")
 
 
 def unpack(packed: str) -> np.ndarray | None:
     """The numbers of :func:`pack`, as a flat float array (None if they do not read)."""
+    import base64
+
     return parse_numbers(zlib.decompress(base64.b64decode(packed)).decode("ascii"))
 
 

@@ -31,12 +31,14 @@ class not yet regenerated) gets its methods compiled here, from the same
 source, at the old cost, and by ``@dataclass``; tests/lang/test_node_methods.py
 fails until the module is regenerated.
 Fields are plain: a default or a default factory at most (no ``init=False``,
-``repr=False``, ``compare=False`` or keyword-only fields, no ``__post_init__``);
-a class that needs more keeps ``@dataclass``.
+``repr=False``, ``compare=False`` or keyword-only fields); ``__init__`` calls
+the class's ``__post_init__`` if it has one, as ``@dataclass``'s does. A
+class that needs more keeps ``@dataclass``.
 """
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import importlib
 import importlib.util
@@ -70,10 +72,14 @@ WRITTEN: set = set()
 
 
 def shape(cls: type) -> tuple:
-    """What a class's generated methods depend on: frozen or not, and each field's name, kind of default and annotation."""
-    if hasattr(cls, "__post_init__"):
-        raise TypeError(f"{cls.__qualname__}: a record has no __post_init__ (use @dataclass)")
-    out: list = [("frozen", cls.__dataclass_params__.frozen)]  # type: ignore[attr-defined]
+    """What a class's generated methods depend on: its options, and each field's name, kind of default and annotation.
+
+    The options are ``("options", frozen, eq, post_init)``: frozen, compared
+    by value (``eq``, else by identity, as ``@dataclass(eq=False)``), and
+    whether ``__init__`` ends by calling the class's ``__post_init__``.
+    """
+    params = cls.__dataclass_params__  # type: ignore[attr-defined]
+    out: list = [_options(params.frozen, params.eq, hasattr(cls, "__post_init__"))]
     for f in dataclasses.fields(cls):
         if f.default_factory is not dataclasses.MISSING:
             kind = "factory"
@@ -89,6 +95,10 @@ def shape(cls: type) -> tuple:
     return tuple(out)
 
 
+def _options(frozen: bool, eq: bool, post_init: bool) -> tuple:
+    return ("options", frozen, eq, post_init)
+
+
 def _entry(name: str, kind: str, annotation: str, hashed: bool | None) -> tuple:
     # A field declared field(hash=False) is left out of the hash, as @dataclass leaves it out.
     return (name, kind, annotation) if hashed is not False else (name, kind, annotation, "unhashed")
@@ -102,7 +112,7 @@ def source(cls: type, maker: str) -> str:
     class. Field names are Python identifiers declared in the classes,
     never program text.
     """
-    (_, frozen), *spec = shape(cls)
+    (_, frozen, eq, post_init), *spec = shape(cls)
     params, body = ["self"], []
     for name, kind, *_ in spec:
         value = name
@@ -115,6 +125,8 @@ def source(cls: type, maker: str) -> str:
             value = f"_f[{name!r}]() if {name} is FACTORY else {name}"
         # A frozen class's own __setattr__ refuses: @dataclass sets its fields through object's.
         body.append(f"        _set(self, {name!r}, {value})" if frozen else f"        self.{name} = {value}")
+    if post_init:
+        body.append("        self.__post_init__()")
     names = [name for name, *_ in spec]
     hashed = "".join(f"self.{name}," for name, _, _, *unhashed in spec if not unhashed)
     shown = ", ".join(f"{n}={{self.{n}!r}}" for n in names)
@@ -129,20 +141,27 @@ def source(cls: type, maker: str) -> str:
             "    def __repr__(self):",
             f'        return self.__class__.__qualname__ + f"({shown})"',
             "",
-            "    def __eq__(self, other):",
-            "        if other.__class__ is self.__class__:",
-            f"            return ({mine}) == ({theirs})",
-            "        return NotImplemented",
-            "",
-            *(
-                ["    def __hash__(self):", f"        return hash(({hashed}))", ""]
-                if frozen
-                else ["    __hash__ = None", ""]
-            ),
+            *(_eq_lines(frozen, mine, theirs, hashed) if eq else ["    __eq__ = __hash__ = None", ""]),
             "    return __init__, __repr__, __eq__, __hash__",
             "",
         ]
     )
+
+
+def _eq_lines(frozen: bool, mine: str, theirs: str, hashed: str) -> list:
+    # Compared by value; only a frozen class is hashable (by the same fields).
+    return [
+        "    def __eq__(self, other):",
+        "        if other.__class__ is self.__class__:",
+        f"            return ({mine}) == ({theirs})",
+        "        return NotImplemented",
+        "",
+        *(
+            ["    def __hash__(self):", f"        return hash(({hashed}))", ""]
+            if frozen
+            else ["    __hash__ = None", ""]
+        ),
+    ]
 
 
 def _compiled(cls: type):
@@ -157,11 +176,16 @@ def _signature_doc(cls: type) -> str:
 
 
 def _makers() -> dict:
-    try:
-        from . import _node_methods
-    except ImportError:  # not generated yet: every class is compiled as it is made
-        return {}
-    return _node_methods.MAKERS
+    if "makers" not in _WRITTEN_OUT:
+        try:
+            from . import _node_methods
+        except ImportError:  # not generated yet: every class is compiled as it is made
+            return {}
+        _WRITTEN_OUT["makers"] = _node_methods.MAKERS
+    return _WRITTEN_OUT["makers"]
+
+
+_WRITTEN_OUT: dict = {}  # "makers": lang/_node_methods.py's MAKERS, once imported
 
 
 _C = TypeVar("_C", bound=type)
@@ -186,17 +210,15 @@ def _kind(f: dataclasses.Field) -> str:
     return "required" if f.default is dataclasses.MISSING else "default"
 
 
-def written_shape(cls: type, frozen: bool) -> tuple | None:
+def written_shape(cls: type, frozen: bool, eq: bool = True) -> tuple | None:
     """:func:`shape` of the class ``@record`` would make, read from the class as written, before any ``@dataclass``.
 
     None where only ``@dataclass`` can say (a ``ClassVar``, ``InitVar`` or
     keyword-only marker, a field that is not plain, a mutable default, a
-    ``__post_init__``, a base frozen otherwise): such a class is made by
-    ``@dataclass``, which also raises its errors.
+    base frozen otherwise): such a class is made by ``@dataclass``, which
+    also raises its errors.
     """
-    if hasattr(cls, "__post_init__"):
-        return None
-    out: list = [("frozen", frozen)]
+    out: list = [_options(frozen, eq, hasattr(cls, "__post_init__"))]
     inherited: dict = {}
     for base in cls.__mro__[-1:0:-1]:  # as @dataclass collects them: the farthest base first
         base_fields = base.__dict__.get("__dataclass_fields__")
@@ -228,19 +250,26 @@ def written_shape(cls: type, frozen: bool) -> tuple | None:
     return (*out, *inherited.values())
 
 
-def _probe(frozen: bool, slots: bool) -> Any:
-    """A one-field class made by ``@dataclass`` with these options (its parameters and its field kind are shared)."""
-    key = (frozen, slots)
-    if key not in _PROBES:
-        _PROBES[key] = dataclasses.dataclass(frozen=frozen, slots=slots)(
-            type("Probe", (), {"__annotations__": {"x": "int"}})
-        )
-    return _PROBES[key]
-
-
-_PROBES: dict = {}
+#: A class @dataclass made with no methods: its field kind and parameters are what :func:`_assembled` sets.
+# (With a docstring of its own: else @dataclass computes one with inspect.signature, whose first call costs 2 ms.)
+_PLAIN: Any = dataclasses.dataclass(init=False, repr=False, eq=False)(
+    type("Plain", (), {"__annotations__": {"x": "int"}, "__doc__": "One field."})
+)
 #: The kind of an ordinary field (dataclasses marks each field: ordinary, ClassVar or InitVar).
-_FIELD = dataclasses.fields(_probe(False, False))[0]._field_type  # type: ignore[attr-defined]
+_FIELD = dataclasses.fields(_PLAIN)[0]._field_type  # type: ignore[attr-defined]
+_PARAMS: dict = {}
+
+
+def _params(frozen: bool, slots: bool, eq: bool) -> Any:
+    """``__dataclass_params__`` as ``@dataclass(frozen=frozen, slots=slots, eq=eq)`` sets it."""
+    key = (frozen, slots, eq)
+    if key not in _PARAMS:
+        params = copy.copy(_PLAIN.__dataclass_params__)
+        params.init, params.repr, params.eq, params.frozen = True, True, eq, frozen
+        if hasattr(params, "slots"):  # recorded since Python 3.12
+            params.slots = slots
+        _PARAMS[key] = params
+    return _PARAMS[key]
 
 
 def _slots_of(cls: type) -> tuple:
@@ -271,12 +300,29 @@ def _setstate(self, state) -> None:
         object.__setattr__(self, f.name, value)  # a frozen class's own __setattr__ refuses
 
 
-def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
-    """The class ``@dataclass`` would make of ``cls`` (its fields, parameters, slots, frozen attributes), methods aside.
+def _methods(qualname: str, fields, maker, own: set) -> dict:
+    """The methods ``maker`` makes for a class of these fields, by name, but those the class defines itself."""
+    defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
+    factories = {f.name: f.default_factory for f in fields if f.default_factory is not dataclasses.MISSING}
+    init, repr_, eq, hash_ = maker(defaults, factories, FACTORY)
+    init.__annotations__ = {**{f.name: f.type for f in fields}, "return": None}
+    made = {"__init__": init, "__repr__": reprlib.recursive_repr("...")(repr_), "__eq__": eq, "__hash__": hash_}
+    for name, fn in made.items():
+        if fn is not None:
+            fn.__qualname__ = f"{qualname}.{name}"
+    # A mutable class with __eq__ is unhashable (__hash__ None), as @dataclass makes it.
+    return {name: fn for name, fn in made.items() if name not in own}
 
-    What ``dataclasses.dataclass(cls, init=False, repr=False, eq=False)``
-    does, for a class whose :func:`written_shape` is known, without its
-    inspection of each annotation and default (most of a node class's cost).
+
+def _assembled(cls: Any, frozen: bool, slots: bool, eq: bool, maker, own: set) -> Any:
+    """The class ``@dataclass`` would make of ``cls``, with the methods ``maker`` makes.
+
+    What ``dataclasses.dataclass(cls, frozen=frozen, slots=slots, eq=eq)``
+    does (its fields, parameters, slots, frozen attributes), for a class
+    whose :func:`written_shape` is known, without its inspection of each
+    annotation and default (most of a node class's cost). A class with slots
+    is made again, as @dataclass makes it, and then with its methods already
+    in it (setting each afterwards costs as much again).
     """
     fields: dict = {}
     for base in cls.__mro__[-1:0:-1]:
@@ -294,12 +340,13 @@ def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
             delattr(cls, name)
         else:
             setattr(cls, name, f.default)
-    cls.__dataclass_params__ = _probe(frozen, slots).__dataclass_params__
+    cls.__dataclass_params__ = _params(frozen, slots, eq)
     cls.__dataclass_fields__ = fields
     if "__match_args__" not in cls.__dict__:
         cls.__match_args__ = tuple(fields)  # type: ignore[misc]
+    methods = _methods(cls.__qualname__, fields.values(), maker, own)
     if slots:
-        body = dict(cls.__dict__)
+        body = {**cls.__dict__, **methods}
         inherited = {name for base in cls.__mro__[1:-1] for name in _slots_of(base)}
         body["__slots__"] = tuple(name for name in fields if name not in inherited)
         for name in (*fields, "__dict__", "__weakref__"):
@@ -309,43 +356,37 @@ def _assembled(cls: Any, frozen: bool, slots: bool) -> Any:
         cls.__qualname__ = qualname
         if frozen:
             cls.__getstate__, cls.__setstate__ = _getstate, _setstate
+    else:
+        for name, fn in methods.items():
+            setattr(cls, name, fn)
     if frozen:
         cls.__setattr__, cls.__delattr__ = _frozen_setattr(cls, frozenset(fields))
     return cls
 
 
-def _make(cls: Any, frozen: bool, slots: bool) -> Any:
+def _make(cls: Any, frozen: bool, slots: bool, eq: bool = True) -> Any:
     made: Any = _makers().get(_key(cls))
     own_doc = cls.__dict__.get("__doc__")
     # What the class defines itself, @dataclass keeps: so do we. A __hash__ of None beside an own
     # __eq__ is Python's doing, not the class's.
     own = {name for name in ("__init__", "__repr__", "__eq__") if name in cls.__dict__}
+    if not eq:
+        own |= {"__eq__", "__hash__"}  # compared by identity: object's, as @dataclass(eq=False) leaves them
     class_hash = cls.__dict__.get("__hash__", dataclasses.MISSING)
     if not (class_hash is dataclasses.MISSING or (class_hash is None and "__eq__" in cls.__dict__)):
         own.add("__hash__")
     if made is not None and not own_doc and made[2] is not None:
         cls.__doc__ = made[2]  # set first: @dataclass would compute it through inspect.signature
-    stale = made is None or made[0] != written_shape(cls, frozen)
+    stale = made is None or made[0] != written_shape(cls, frozen, eq)
     if stale:
         # @dataclass makes the fields, the slots and a frozen class's __setattr__ and __delattr__.
         cls = dataclasses.dataclass(cls, frozen=frozen, slots=slots, init=False, repr=False, eq=False)
-        maker = _compiled(cls)
+        cls.__dataclass_params__ = _params(frozen, slots, eq)  # the methods it left out are ours:
+        for name, fn in _methods(cls.__qualname__, dataclasses.fields(cls), _compiled(cls), own).items():
+            setattr(cls, name, fn)
     else:
-        cls = _assembled(cls, frozen, slots)
-        maker = made[1]
+        cls = _assembled(cls, frozen, slots, eq, made[1], own)
         WRITTEN.add(cls)
-    fields = dataclasses.fields(cls)
-    defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
-    factories = {f.name: f.default_factory for f in fields if f.default_factory is not dataclasses.MISSING}
-    init, repr_, eq, hash_ = maker(defaults, factories, FACTORY)
-    init.__annotations__ = {**{f.name: f.type for f in fields}, "return": None}
-    methods = [(init, "__init__"), (reprlib.recursive_repr("...")(repr_), "__repr__"), (eq, "__eq__")]
-    for fn, name in [*methods, (hash_, "__hash__")]:
-        if name in own:
-            continue
-        if fn is not None:
-            fn.__qualname__ = f"{cls.__qualname__}.{name}"
-        setattr(cls, name, fn)  # a mutable class with __eq__ is unhashable (__hash__ None), as @dataclass makes it
     if not own_doc and (stale or made[2] is None):
         cls.__doc__ = _signature_doc(cls)
     if own_doc:
@@ -357,13 +398,13 @@ def _make(cls: Any, frozen: bool, slots: bool) -> Any:
 @overload
 def record(cls: _C, /) -> _C: ...
 @overload
-def record(*, frozen: bool = False, slots: bool = False) -> Callable[[_C], _C]: ...
+def record(*, frozen: bool = False, slots: bool = False, eq: bool = True) -> Callable[[_C], _C]: ...
 @dataclass_transform(field_specifiers=(dataclasses.field,))
-def record(cls=None, /, *, frozen=False, slots=False):
-    """``@dataclass`` (``frozen``, ``slots`` as there), with the methods written out in lang/_node_methods.py."""
+def record(cls=None, /, *, frozen=False, slots=False, eq=True):
+    """``@dataclass`` (``frozen``, ``slots``, ``eq`` as there), with the methods written out in lang/_node_methods.py."""
 
     def wrap(cls):
-        return _make(cls, frozen, slots)
+        return _make(cls, frozen, slots, eq)
 
     return wrap if cls is None else wrap(cls)
 
@@ -376,12 +417,13 @@ def node(cls: _C) -> _C:
 
 #: The packages whose modules may declare records (a module is written out when it uses @record or @node).
 PACKAGES = ("liganimate.lang", "liganimate.compiler", "liganimate.runtime")
-_USES = re.compile(r"^@(?:record|node)\b", re.MULTILINE)
+_USES = r"^@(?:record|node)\b"  # compiled by users(), which only the generator runs
 
 
 def users() -> list:
     """The names of the modules of :data:`PACKAGES` that declare records, sorted."""
     found = []
+    uses = re.compile(_USES, re.MULTILINE)
     for package in PACKAGES:
         spec = importlib.util.find_spec(package)
         assert spec is not None and spec.submodule_search_locations
@@ -389,7 +431,7 @@ def users() -> list:
             for folder, _, files in os.walk(root):
                 for name in files:
                     path = os.path.join(folder, name)
-                    if name.endswith(".py") and _USES.search(Path(path).read_text(encoding="utf-8")):
+                    if name.endswith(".py") and uses.search(Path(path).read_text(encoding="utf-8")):
                         rel = os.path.relpath(path, root)[: -len(".py")].replace(os.sep, ".")
                         found.append(f"{package}.{rel}".removesuffix(".__init__"))
     return sorted(found)

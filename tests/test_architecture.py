@@ -40,10 +40,18 @@ CONTRACT = {
         # compiler.load_program executes the module it lowered, piece by piece.
         "liganimate.runtime.loader",
     ),
-    "liganimate.runtime.motion": ("liganimate.lang.numbers", "liganimate.lang.messages", "liganimate.runtime.errors"),
+    # lang.node_methods: @record, the dataclasses whose methods are written out (a leaf: see
+    # test_the_record_maker_imports_nothing_of_the_language below).
+    "liganimate.runtime.motion": (
+        "liganimate.lang.numbers",
+        "liganimate.lang.messages",
+        "liganimate.lang.node_methods",
+        "liganimate.runtime.errors",
+    ),
     "liganimate.runtime.figure": (
         "liganimate.lang.numbers",
         "liganimate.lang.messages",
+        "liganimate.lang.node_methods",
         "liganimate.runtime.errors",
         "liganimate.runtime.values",
         "liganimate.runtime.motion",
@@ -51,6 +59,7 @@ CONTRACT = {
     "liganimate.runtime.ik": (
         "liganimate.lang.numbers",
         "liganimate.lang.messages",
+        "liganimate.lang.node_methods",
         "liganimate.runtime.errors",
         "liganimate.runtime.figure",
         "liganimate.runtime.motion",
@@ -184,6 +193,19 @@ def test_the_tools_may_compile(tmp_path, monkeypatch):
         assert _reported(tmp_path, monkeypatch, f"{tool}.extra", text) == []
     (report,) = _reported(tmp_path, monkeypatch, "liganimate.runtime.view.extra", "import liganimate.view_cli\n")
     assert "imports liganimate.view_cli" in report
+
+
+def test_the_record_maker_imports_nothing_of_the_language():
+    # The runtime's inner packages may use @record because lang/node_methods.py is a leaf: besides its
+    # own written-out methods and the generated files' command line, nothing of lang/ (no syntax tree,
+    # no parser) comes with it.
+    assert imports_of("liganimate.lang.node_methods") <= {
+        "liganimate.lang.node_methods",  # module_text reads the classes it made, as imported
+        "liganimate.lang._node_methods",
+        "liganimate.lang.generated",
+    }
+    assert imports_of("liganimate.lang._node_methods") == set()
+    assert imports_of("liganimate.lang.generated") == set()
 
 
 def test_no_module_below_the_command_line_imports_it():

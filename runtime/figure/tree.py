@@ -31,13 +31,13 @@ from __future__ import annotations
 import dataclasses
 import operator
 from collections.abc import Sequence
-from dataclasses import dataclass
 from functools import cached_property
 from typing import NamedTuple, overload
 
 import numpy as np
 
 from liganimate.lang import messages
+from liganimate.lang.node_methods import record
 from liganimate.lang.numbers import INT_MAX, MAX_ANGLE, magnitude
 from liganimate.runtime.errors import FigureError
 
@@ -262,7 +262,7 @@ class LinkSource(NamedTuple):
     mimic: tuple | None = None  # (leader joint's source name, multiplier, offset)
 
 
-@dataclass(frozen=True, eq=False)
+@record(frozen=True, eq=False)
 class Link:
     """A rigid segment of a figure.
 
@@ -302,7 +302,7 @@ class Link:
         return self.name if self.name is not None else "<anonymous>"
 
 
-@dataclass(frozen=True, eq=False)
+@record(frozen=True, eq=False)
 class Joint:
     """A joint between two links of a figure.
 
@@ -380,7 +380,7 @@ class TraversalLevel(NamedTuple):
     reversed: np.ndarray
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class JointKind:
     """What a JOINT statement says beyond its extremes: SLIDE and AXIS.
 
@@ -422,7 +422,7 @@ class JointSpec(NamedTuple):
     axis: object = None  # AXIS (x, y, z), or None
 
 
-@dataclass(frozen=True, eq=False)
+@record(frozen=True, eq=False)
 class Figure:
     """An articulated model: a tree of links joined by joints.
 

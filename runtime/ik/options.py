@@ -10,12 +10,11 @@ one object on. A new option is a field here.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from liganimate.lang.node_methods import record
 from liganimate.runtime.ik.names import DEFAULT_SOLVER
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ReachOptions:
     """How a pose is solved: the one value REACH, :func:`reach`, :func:`reach_keyframes` and :func:`solve_pose` pass on.
 

@@ -7,13 +7,14 @@ track is stored.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from liganimate.lang.node_methods import record
 
 RAMP = 3.0
 """Frames a LINEAR segment spends reaching its cruise speed (before SCALE FRAMES)."""
 
 
-@dataclass(frozen=True, slots=True)
+# @record: a dataclass whose methods are written out (lang/node_methods.py), cheaper to make at start-up.
+@record(frozen=True, slots=True)
 class Keyframe:
     """A joint's (or the root's) position at one frame, and how the track gets there.
 

@@ -27,11 +27,11 @@ The laws are written out in ``docs/semantics-motion.md``.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
+from liganimate.lang.node_methods import record
 from liganimate.runtime.errors import MotionError
 from liganimate.runtime.motion import interpolation
 from liganimate.runtime.motion import track as tr
@@ -56,7 +56,7 @@ def _gaps(m: Motion) -> tuple[frozenset[Any], frozenset[Any]]:
 ONE = (1.0, 1.0, 1.0)
 
 
-@dataclass(frozen=True, slots=True)
+@record(frozen=True, slots=True)
 class Target:
     """A shape a SHAPE keyframe names: ``key`` identifies it by content, ``shape`` is the value (a Graphical)."""
 
@@ -65,7 +65,7 @@ class Target:
     triangles: int
 
 
-@dataclass(frozen=True, slots=True)
+@record(frozen=True, slots=True)
 class ShapeKey:
     """One keyframe of a SHAPE track: the target (None: the link's own shape) reached at ``frame``."""
 

@@ -55,6 +55,8 @@ depths tie.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from liganimate.runtime.errors import RenderError
@@ -143,7 +145,7 @@ def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: i
     W, H = cam.size
     img = np.full((H, W) + np.shape(bg), bg, dtype=np.uint8)
     # Nothing drawn yet: the depth buffer need only span the pixels touched.
-    _draw(None, img, tris, shade, cam, cull, 0)
+    _draw(None, img, tris, shade, cam, cull, 0, bg)
     return downsample(img, aa)
 
 
@@ -278,70 +280,110 @@ class Framebuffer:
         return out
 
 
-def _draw(zbuf, img, tris, shade, camera, cull, first_index):
+def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
+    """Draw triangles into ``img`` (its depth keys ``zbuf``, or None for a fresh image of ``background``).
+
+    Returns the next draw's first triangle number.
+    """
     n = len(tris)
     if first_index + n >= _MAX_TRIANGLES:
         raise RenderError(f"Too many triangles in one image (more than {_MAX_TRIANGLES - 1}).")
     W, H = camera.size
     band_rows = None if W * H <= _ONE_BAND_PIXELS else max(1, _BAND_PIXELS // W)
-    spans = _spans(tris, cull, camera, first_index, band_rows) if n else None
+    # A fresh image's depth keys are this draw's alone, so their tags may
+    # carry each triangle's grey level in their low byte, and "nothing drawn"
+    # may be the background's grey level (a key below any surface's): the
+    # depth keys then cast to bytes are the image (see _band).
+    packed = zbuf is None and shade.ndim == 1 and np.ndim(background) == 0 and n <= _PACKED_TRIANGLES
+    empty = background if packed else EMPTY
+    spans = _spans(tris, cull, camera, first_index, band_rows, shade if packed else None) if n else None
     if spans is None:
         return first_index + n
-    offset, wstart, step, tag, count, bounds = spans
     flat_img = img.reshape((-1,) + img.shape[2:])
     flat_z = None if zbuf is None else zbuf.reshape(-1)
+    bounds, tbounds = spans.bounds, spans.tbounds
     if len(bounds) == 2:
-        lo = int(np.minimum.reduce(offset))
-        hi = int(np.maximum.reduce(offset + count))
-        zb = np.zeros(hi - lo, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
-        offset -= lo
-        _band(zb, flat_img[lo:hi], offset, wstart, step, tag, count, shade, first_index, flat_z is None)
+        lo, hi = spans.origin, spans.origin + spans.size
+        zb = np.full(hi - lo, empty, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
+        _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, packed)
         return first_index + n
     starts = bounds[:-1]
+    offset, count = spans.offset, spans.pixels
     los = np.minimum.reduceat(offset, starts).tolist()
     his = np.maximum.reduceat(offset + count, starts).tolist()
     if flat_z is None:
         # One buffer for every band: clearing it while it is still in the
         # cache is cheaper than fresh zeroed pages from the kernel.
-        scratch = np.zeros(max(h - l for l, h in zip(los, his)), dtype=np.int64)
+        scratch = np.full(max(h - l for l, h in zip(los, his)), empty, dtype=np.int64)
     for i, (lo, hi) in enumerate(zip(los, his)):
-        sl = slice(bounds[i], bounds[i + 1])
+        sl, tl = slice(bounds[i], bounds[i + 1]), slice(tbounds[i], tbounds[i + 1])
         if flat_z is not None:
             zb = flat_z[lo:hi]
         else:
             zb = scratch[: hi - lo]
             if i:
-                zb.fill(EMPTY)
-        _band(
-            zb,
-            flat_img[lo:hi],
-            offset[sl] - lo,
-            wstart[sl],
-            step[sl],
-            tag[sl],
-            count[sl],
-            shade,
-            first_index,
-            flat_z is None,
+                zb.fill(empty)
+        band = _Spans(
+            offset[sl] - lo, spans.wstart[sl], spans.step[sl], count[sl], spans.tag[tl], spans.nrows[tl], [], [], 0, 0
         )
+        _band(zb, flat_img[lo:hi], band, shade, first_index, flat_z is None, packed)
     return first_index + n
 
 
-def _band(zb, im, offset, wstart, step, tag, count, shade, first_index, fresh):
-    """Depth-test one band's spans (P,) into its depth keys and image (views of the band's pixel range).
+# At most this many triangles (2**24) in a draw whose keys carry grey levels:
+# tag (number << 8 | grey) must fit the key's low 32 bits.
+_PACKED_TRIANGLES = 1 << 24
 
-    ``fresh``: the depth keys were all EMPTY before this draw.
+
+class _Spans(NamedTuple):
+    """What :func:`_spans` gives: spans (P,) grouped by trapezoid, trapezoids (T,) grouped by band."""
+
+    offset: np.ndarray  #: (P,) int64: pixel number of the span's first pixel, counted from ``origin``
+    wstart: np.ndarray  #: (P,) 1/z at the span's first pixel
+    step: np.ndarray  #: (P,) 1/z step from pixel to pixel
+    pixels: np.ndarray  #: (P,) int64: the span's pixels (some spans are empty)
+    tag: np.ndarray  #: (T,) int64: the key tag of each trapezoid's fragments
+    nrows: np.ndarray  #: (T,) int64: each trapezoid's spans, in order
+    bounds: list  #: B + 1 span numbers: band k's spans are ``bounds[k]:bounds[k + 1]``
+    tbounds: list  #: B + 1 trapezoid numbers: band k's trapezoids
+    origin: int  #: with one band: the pixel number offsets count from (the first row drawn's)
+    size: int  #: with one band: the pixels from ``origin`` to the end of the last row drawn
+
+
+def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
+    """Depth-test one band's spans into its depth keys and image (views of the band's pixel range).
+
+    ``fresh``: the depth keys were all EMPTY before this draw.  ``packed``
+    (only in a fresh draw): the tags are ``number << 8 | grey level``, and
+    the keys were all the background's grey level.
     """
-    ends = count.cumsum()
+    offset, wstart, step, count = spans.offset, spans.wstart, spans.step, spans.pixels
+    # ends[k]: fragments up to the end of span k; ends0 has a 0 before them.
+    ends0 = np.empty(len(count) + 1, dtype=np.int64)
+    ends0[0] = 0
+    ends = np.cumsum(count, out=ends0[1:])
+    if ends[-1] == 0:
+        return
     if ends[-1] <= _CHUNK:
-        pix, key = _expand(offset, wstart, step, tag, count, ends)
+        # A trapezoid's fragments are consecutive, so its tag is repeated
+        # over all of them at once (np.repeat costs about as much per input
+        # element as per output element, and there are ten times fewer
+        # trapezoids than spans).
+        frags = ends0.take(spans.nrows.cumsum())
+        frags[1:] -= frags[:-1].copy()
+        pix, key = _expand(offset, wstart, step, count, ends, spans.tag, frags)
         np.maximum.at(zb, pix, key)
+        if packed:
+            # Each key's low byte is the grey level of the winner, or the background.
+            np.copyto(im, zb, casting="unsafe")
+            return
         if fresh:
             # Every key in the buffer is this draw's: each fragment may
             # paint its pixel's winner (some pixels several times, alike).
             key = zb.take(pix)
             key &= _INDEX_MASK
-            key -= first_index
+            if first_index:
+                key -= first_index
             im[pix] = shade.take(key, axis=0)
             return
         won = (zb.take(pix) == key).nonzero()[0]
@@ -355,13 +397,18 @@ def _band(zb, im, offset, wstart, step, tag, count, shade, first_index, fresh):
         return
     # Too many fragments for one go (deep overlap): depth-test chunk by
     # chunk, then find this draw's winners by scanning the band.
+    tag = spans.tag.repeat(spans.nrows)  # each span's
     lo = 0
     for hi in np.searchsorted(ends, np.arange(_CHUNK, ends[-1], _CHUNK), side="right").tolist() + [len(count)]:
         if hi > lo:
             sl = slice(lo, hi)
-            pix, key = _expand(offset[sl], wstart[sl], step[sl], tag[sl], count[sl], None)
+            cut = count[sl]
+            pix, key = _expand(offset[sl], wstart[sl], step[sl], cut, cut.cumsum(), tag[sl], cut)
             np.maximum.at(zb, pix, key)
             lo = hi
+    if packed:
+        np.copyto(im, zb, casting="unsafe")
+        return
     num = zb & _INDEX_MASK
     sel = ((zb != EMPTY) & (num >= first_index)).nonzero()[0]
     im[sel] = shade.take(num.take(sel) - first_index, axis=0)
@@ -383,10 +430,11 @@ def _aranges(n: int):
     return iar, far
 
 
-def _expand(offset, wstart, step, tag, count, ends):
-    """Spans (P,) to fragments: pixel numbers (F,) and depth keys (F,)."""
-    if ends is None:
-        ends = count.cumsum()
+def _expand(offset, wstart, step, count, ends, tag, tag_count):
+    """Spans (P,) to fragments: pixel numbers (F,) and depth keys (F,).
+
+    ``ends`` is ``count.cumsum()``; the fragments' tags are ``tag.repeat(tag_count)``.
+    """
     n = int(ends[-1])
     iar, far = _aranges(n)
     starts = ends - count
@@ -401,7 +449,7 @@ def _expand(offset, wstart, step, tag, count, ends):
     w += (wstart - starts * step).repeat(count)
     key = w.view(np.int64)
     key &= _DEPTH_MASK
-    key += tag.repeat(count)
+    key += tag.repeat(tag_count)
     return pix, key
 
 
@@ -473,16 +521,18 @@ def _check(triangles, shade, cull):
     return tris, s, cull
 
 
-def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None = None):
-    """Triangles (N, 3, 3) to spans, grouped into bands of rows.
+def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None = None, grey=None) -> _Spans | None:
+    """Triangles (N, 3, 3) to spans, grouped by trapezoid and into bands of rows.
 
-    Returns ``(offset, wstart, step, tag, count, bounds)``, or None when
-    nothing is visible.  The first five have shape (P,), one entry per span:
-    pixel offset ``row * W + first column``, 1/z at its first pixel, 1/z
-    step, key tag and length (some spans may be empty).  ``bounds`` (list of
-    B + 1 int) splits them into bands: spans ``bounds[k]:bounds[k + 1]`` lie
-    in rows ``[b * band_rows, (b + 1) * band_rows)`` for some band ``b``
-    that grows with ``k``.  ``band_rows`` None means one band.
+    Returns the spans (see :class:`_Spans`), or None when nothing is
+    visible.  A span's ``offset`` is ``row * W + first column`` counted
+    from ``origin``.  Spans ``bounds[k]:bounds[k + 1]`` (trapezoids
+    ``tbounds[k]:tbounds[k + 1]``) lie in rows ``[b * band_rows, (b + 1) *
+    band_rows)`` for some band ``b`` that grows with ``k``; ``band_rows``
+    None means one band.  A trapezoid's tag is ``first_index`` plus its
+    triangle's number, or, given the triangles' ``grey`` levels (uint8, and
+    ``first_index`` 0), its number shifted left by 8 bits with its grey
+    level in the low byte.
 
     Every step works on whole (k, N) or (k, P) blocks: with a few hundred
     triangles, the cost of a frame is mostly the number of numpy calls.
@@ -492,22 +542,22 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     if drawn is None:
         return None
     cam, front, src = drawn
-    found = _trapezoids(_pixel_vertices(cam, camera), front, src, first_index, (W, H))
+    found = _trapezoids(_pixel_vertices(cam, camera), front, src, first_index, (W, H), grey)
     if found is None:
         return None
-    table, first_row, nrows, total = found
-    table, nrows, bounds = _banded(table, first_row, nrows, total, band_rows, H)
+    table, first_row, nrows, total, tag = found
+    table, nrows, tag, bounds, tbounds, rows = _banded(table, first_row, nrows, total, tag, band_rows, H)
 
     # One entry per (trapezoid, row), grouped by trapezoid, so np.repeat
     # spreads per-trapezoid values over them: it costs a few instructions
     # per element where a gather (np.take, fancy indexing) costs 15-30.
     t = table.repeat(nrows, axis=1)
-    cy = np.add(_aranges(total)[1][:total], t[12])
+    cy = np.add(_aranges(total)[1][:total], t[13])
     # Crossings of the long and the short edge (rows 0 and 1 of xab), then
     # the first and one past the last pixel column (rows 0 and 1 of cols).
     xab = np.subtract(cy, t[2:4])
     xab *= t[4:6]
-    xab /= t[13:15]
+    xab /= t[6:8]
     xab += t[0:2]
     cols = np.empty((2, total))
     np.minimum(xab[0], xab[1], out=cols[0])
@@ -518,27 +568,26 @@ def _spans(tris, cull, camera: Camera, first_index: int, band_rows: int | None =
     np.minimum(cols, W, out=cols)
     length = cols[1] - cols[0]
     count = length.astype(np.int64)
-    if np.maximum.reduce(count) <= 0:
-        return None
 
     # 1/z at the first and last pixel centre, clamped to the triangle's range
     # so that a sliver's ill-conditioned plane cannot produce a wild depth.
     # (fmin/fmax also turn a NaN from a degenerate plane into a bound.)
-    wrow = cy * t[8]
-    wrow += t[7]
+    wrow = cy * t[10]
+    wrow += t[9]
     ws = cols + _CENTRES
-    ws *= t[6]
+    ws *= t[8]
     ws += wrow
-    np.fmax(ws, t[9], out=ws)
-    np.fmin(ws, t[10], out=ws)
+    np.fmax(ws, t[11], out=ws)
+    np.fmin(ws, t[12], out=ws)
     step = ws[1] - ws[0]
     length -= 1
     step /= np.maximum(length, 1, out=length)  # (as floats: exact, and no int-to-float pass)
     # Spans of no pixels stay: np.repeat skips them at no cost.
-    cy -= 0.5
+    cy -= 0.5 + rows[0]  # the row, counted from the first row drawn
     cy *= W
     cy += cols[0]
-    return cy.astype(np.int64), ws[0], step, t[11].astype(np.int64), count, bounds
+    origin, size = rows[0] * W, (rows[1] - rows[0]) * W
+    return _Spans(cy.astype(np.int64), ws[0], step, count, tag, nrows, bounds, tbounds, origin, size)
 
 
 def _camera_triangles(tris, cull, camera: Camera):
@@ -599,22 +648,30 @@ def _pixel_vertices(cam: np.ndarray, camera: Camera) -> np.ndarray:
     x = np.multiply(cam[0], s, out=xyw[0])
     x += 0.5 * W
     np.divide(1.0, cam[2], out=xyw[2])
-    # A stable sort of three (a bubble sort, swapping only on a strict <).
-    for i, j in ((0, 1), (1, 2), (0, 1)):
-        swap = xyw[1, j] < xyw[1, i]
-        if np.logical_or.reduce(swap):
-            was = xyw[:, i].copy()
-            np.copyto(xyw[:, i], xyw[:, j], where=swap)
-            np.copyto(xyw[:, j], was, where=swap)
-    return xyw
+    # A stable sort of three: vertices ordered by y, ties kept in their
+    # order.  Its permutation follows from the three comparisons of a later
+    # vertex's y with an earlier one's (y1 < y0, y2 < y1, y2 < y0), packed
+    # into a code 0..7 (two codes cannot occur); one gather then moves x, y
+    # and 1/z of all vertices at once.
+    less = np.empty((3, m), dtype=bool)
+    np.less(xyw[1, 1:], xyw[1, :2], out=less[:2])
+    np.less(xyw[1, 2], xyw[1, 0], out=less[2])
+    code = np.packbits(less, axis=0, bitorder="little")[0]
+    where = (_SORTED * m).take(code, axis=1)  # (3 positions, m): flat index of the vertex there
+    where += _aranges(m)[0][:m]
+    return xyw.reshape(3, 3 * m).take(where.reshape(-1), axis=1).reshape(3, 3, m)
 
 
-def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple):
+# _pixel_vertices' sort: _SORTED[p, code] is the vertex at position p.
+_SORTED = np.array([[0, 1, 0, 0, 0, 1, 2, 2], [1, 0, 2, 1, 1, 2, 0, 1], [2, 2, 1, 2, 2, 0, 1, 0]])
+
+
+def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple, grey=None):
     """:func:`_spans`' third stage: the table of trapezoids (see the notes after :func:`_spans`).
 
-    Returns ``(table, first_row, nrows, total)``: the table (15, 2m), each
-    trapezoid's first row and number of rows, and their sum; or None when
-    no row is covered.
+    Returns ``(table, first_row, nrows, total, tag)``: the table (14, 2m),
+    each trapezoid's first row and number of rows, their sum, and each
+    trapezoid's tag (see :func:`_spans`); or None when no row is covered.
     """
     W, H = size
     m = xyw.shape[2]
@@ -630,7 +687,8 @@ def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple):
     np.maximum(r, 0, out=r)
     np.minimum(r, H, out=r)
     r = r.astype(np.int64)
-    dx, dy, dw = x[1:] - x[0], y[1:] - y[0], w[1:] - w[0]  # vertices 1, 2 minus vertex 0
+    d = xyw[:, 1:] - xyw[:, :1]  # (3, 2, m): vertices 1 and 2 minus vertex 0
+    dx, dy, dw = d
     det = dx[0] * dy[1]
     det -= dx[1] * dy[0]
     visible = det != 0.0
@@ -652,19 +710,15 @@ def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple):
     # the crossing exact whenever it is representable and the product is
     # exact, so a centre exactly on an edge is found exactly on it and the
     # top-left rule decides (e.g. edges between half-pixel points).
-    table = np.empty((15, 2, m))
+    table = np.empty((14, 2, m))
     upper = table[:, 0]
-    table[0] = x0
-    table[1] = x[:2]
-    table[2] = y0
-    table[3] = y[:2]
-    upper[4] = dx[1]
-    np.subtract(x[1:], x[:2], out=table[5])
-    upper[13] = dy[1]
-    np.subtract(y[1:], y[:2], out=table[14])
+    table[0:4:2] = xyw[:2, :1]  # x and y of the long edge's top, vertex 0
+    table[1:4:2] = xyw[:2, :2]  # ... of the short edge's top, vertex 0 or 1
+    table[4:8:2] = d[:2, 1:]  # dx and dy of the long edge, 0 to 2
+    np.subtract(xyw[:2, 1:], xyw[:2, :2], out=table[5:8:2])  # ... of the short edge, 0 to 1 or 1 to 2
     with np.errstate(divide="ignore", invalid="ignore"):
         # 1/z is affine in screen space: 1/z = wc + gx x + gy y.
-        gx, gy, wc = upper[6], upper[8], upper[7]
+        gx, wc, gy = upper[8], upper[9], upper[10]
         np.multiply(dw[0], dy[1], out=gx)
         gx -= dw[1] * dy[0]
         gx /= det
@@ -674,25 +728,28 @@ def _trapezoids(xyw: np.ndarray, front, src, first_index: int, size: tuple):
         np.multiply(gx, x0, out=wc)
         np.subtract(w0, wc, out=wc)
         wc -= gy * y0
-    np.minimum(np.minimum(w0, w[1]), w[2], out=upper[9])
-    np.maximum(np.maximum(w0, w[1]), w[2], out=upper[10])
+    np.minimum(np.minimum(w0, w[1]), w[2], out=upper[11])
+    np.maximum(np.maximum(w0, w[1]), w[2], out=upper[12])
     faces = front if src is None else front.take(src)
     if not np.logical_and.reduce(faces):
-        upper[6:11] *= np.where(faces, 1.0, 1.0 - _BACK_BIAS)
-    table[4, 1] = upper[4]
-    table[13, 1] = upper[13]
-    table[6:11, 1] = upper[6:11]
-    table[11] = first_index + (_aranges(m)[0][:m] if src is None else src)
+        upper[8:13] *= np.where(faces, 1.0, 1.0 - _BACK_BIAS)
+    table[8:13, 1] = upper[8:13]
+    number = _aranges(m)[0][:m] if src is None else src
+    if grey is None:
+        tag = first_index + number
+    else:
+        tag = number << 8
+        tag |= grey.take(number)
     first_row = r[:2].reshape(-1)  # (a view of r, which is not needed any more)
-    return table.reshape(15, 2 * m), first_row, nrows, total
+    return table.reshape(14, 2 * m), first_row, nrows, total, np.concatenate((tag, tag))
 
 
-def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: int, band_rows, H: int):
-    """:func:`_spans`' fourth stage: trapezoids cut at band boundaries and ordered by band; row 12 set.
+def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: int, tag, band_rows, H: int):
+    """:func:`_spans`' fourth stage: trapezoids cut at band boundaries and ordered by band; row 13 set.
 
-    Returns ``(table, nrows, bounds)``.
+    Returns ``(table, nrows, tag, bounds, tbounds, rows)``: ``rows`` is the
+    first row drawn and one past the last with one band, else ``(0, H)``.
     """
-    bounds = [0, total]
     if band_rows is not None and band_rows < H:
         # Cut trapezoids at band boundaries, and order the pieces by band.
         live = nrows.nonzero()[0]
@@ -706,23 +763,32 @@ def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: 
         start = np.maximum(first_row.take(trap), band * band_rows)
         nrows = np.minimum(first_row.take(trap) + nrows.take(trap), (band + 1) * band_rows) - start
         first_row = start
-        table = table.take(trap, axis=1)
+        table, tag = table.take(trap, axis=1), tag.take(trap)
         ends = nrows.cumsum()
-        bounds = [0] + ends.take((band[1:] != band[:-1]).nonzero()[0]).tolist() + [total]
+        change = (band[1:] != band[:-1]).nonzero()[0]
+        bounds = [0] + ends.take(change).tolist() + [total]
+        tbounds = [0] + (change + 1).tolist() + [len(trap)]
+        rows = (0, H)
     else:
         ends = nrows.cumsum()
-    # Row 12: the trapezoid's first row centre minus the number of spans before it.
+        bounds, tbounds = [0, total], [0, len(nrows)]
+        # The rows drawn: one depth buffer covers them (and no more).
+        drawn = nrows > 0
+        rows = (
+            int(np.minimum.reduce(first_row, where=drawn, initial=H)),
+            int(np.maximum.reduce(first_row + nrows, where=drawn, initial=0)),
+        )
+    # Row 13: the trapezoid's first row centre minus the number of spans before it.
     first_row -= ends
     first_row += nrows
-    np.add(first_row, 0.5, out=table[12])
-
-    return table, nrows, bounds
+    np.add(first_row, 0.5, out=table[13])
+    return table, nrows, tag, bounds, tbounds, rows
 
 
 # Rows of _spans' table: 0-1 x of the top of the long and the short edge,
-# 2-3 their y, 4-5 their dx (bottom minus top), 6-8 gx, wc, gy of the plane
-# 1/z = wc + gx x + gy y, 9-10 the least and greatest 1/z, 11 the tag,
-# 12 first row centre minus the number of spans before, 13-14 the edges' dy.
+# 2-3 their y, 4-5 their dx (bottom minus top), 6-7 their dy, 8-10 gx, wc,
+# gy of the plane 1/z = wc + gx x + gy y, 11-12 the least and greatest 1/z,
+# 13 first row centre minus the number of spans before.
 _NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 # From the first and one-past-last pixel column to the first and last centre.

@@ -11,7 +11,10 @@ def run() -> int:
     milliseconds) a KeyboardInterrupt would otherwise print a traceback.
     """
     try:
-        from liganimate.cli import main
+        from liganimate.lang import collector
+
+        with collector.paused():  # importing the command makes no garbage for the collector to look for
+            from liganimate.cli import main
 
         return main()
     except KeyboardInterrupt:

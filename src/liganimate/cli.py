@@ -281,11 +281,15 @@ def guarded(fn):
     KeyboardInterrupt (and :class:`~liganimate.runtime.interrupts.Interrupted`)
     goes through, to :func:`_stopping`.
     """
-    from liganimate.lang.diagnostics import LigDiagnostics
-    from liganimate.lang.display import escape_text
-    from liganimate.lang.messages import sentence
-    from liganimate.runtime.errors import LigError
-    from liganimate.runtime.files import os_error_words
+    from liganimate.lang import collector
+
+    # Importing makes classes and functions, no garbage: the collector would only walk them (lang/collector.py).
+    with collector.paused():
+        from liganimate.lang.diagnostics import LigDiagnostics
+        from liganimate.lang.display import escape_text
+        from liganimate.lang.messages import sentence
+        from liganimate.runtime.errors import LigError
+        from liganimate.runtime.files import os_error_words
 
     try:
         return fn()

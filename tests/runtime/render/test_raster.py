@@ -19,8 +19,9 @@ def fragments(tris, cull, cam):
     spans = _spans(np.asarray(tris, float), cull, cam, 0)
     if spans is None:
         return np.zeros(0, np.int64)
-    offset, wstart, step, tag, count, _ = spans
-    return _expand(offset, wstart, step, tag, count, None)[0]
+    count = spans.pixels
+    pix = _expand(spans.offset, spans.wstart, spans.step, count, count.cumsum(), count, count)[0]
+    return pix + spans.origin
 
 
 def quad(p0, p1, p2, p3):
