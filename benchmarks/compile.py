@@ -26,7 +26,7 @@ noisy; other load only ever slows a round down):
   least CPU of each command's rounds; the median of each round's own
   ratio is reported beside it, steadier on a shared machine (the two move
   by about 0.05 from run to run). Where the cost goes, and why what
-  remains (about 1.3x) is the import of the modules a check runs, is in
+  remains (about 1.2x) is the import of the modules a check runs, is in
   docs/architecture.md ("Start-up").
 * Scale: programs of 1,000, 10,000 and 50,000 lines in two styles (short
   assignment lines ``Xn = n``, and the thesis style above), parsed and

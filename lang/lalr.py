@@ -27,7 +27,7 @@ from lark.lexer import Token
 from lark.parse_tree_builder import ChildFilterLALR_NoPlaceholders, ExpandSingleChild
 
 from .lexer import DOLLAR, NUMBER, OPERATOR, ROWS, SCAN, STRING, WORD, Scanner, Tok
-from .tables import ParserTables, callbacks
+from .tables import ParserTables, callback, refuse_terminal_callbacks
 
 
 class _Inlined(tuple):
@@ -90,10 +90,9 @@ class Driver:
     """
 
     def __init__(self, tables: ParserTables, transformer) -> None:
+        refuse_terminal_callbacks(tables, transformer)
         #: (number of symbols, the rule's name, callback or None for "keep the child"), by rule number.
-        self.rules: list = [
-            self._rule(r, cb) for r, cb in zip(tables.rules, callbacks(tables, transformer), strict=True)
-        ]
+        self.rules: dict = _Rules(tables.rules, transformer)
         #: state -> {symbol: next state, or ~rule to reduce}
         self.actions: list = tables.actions
         self.start = tables.start
@@ -276,6 +275,20 @@ class _Chains(dict):
     def __missing__(self, key: tuple) -> int:
         top = self[key] = self.driver._chain(key)
         return top
+
+
+class _Rules(dict):
+    """Rule number -> :meth:`Driver._rule` of it, made when the parse first reduces the rule (see :func:`.tables.callback`)."""
+
+    def __init__(self, rules: tuple, transformer) -> None:
+        super().__init__()
+        self._rules = rules
+        self._transformer = transformer
+
+    def __missing__(self, number: int) -> tuple:
+        rule = self._rules[number]
+        made = self[number] = Driver._rule(rule, callback(rule, self._transformer))
+        return made
 
 
 class _Spellings(dict):

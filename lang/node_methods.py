@@ -176,11 +176,16 @@ def _signature_doc(cls: type) -> str:
 
 
 def _makers() -> dict:
-    try:
-        from . import _node_methods
-    except ImportError:  # not generated yet: every class is compiled as it is made
-        return {}
-    return _node_methods.MAKERS
+    if "makers" not in _WRITTEN_OUT:
+        try:
+            from . import _node_methods
+        except ImportError:  # not generated yet: every class is compiled as it is made
+            return {}
+        _WRITTEN_OUT["makers"] = _node_methods.MAKERS
+    return _WRITTEN_OUT["makers"]
+
+
+_WRITTEN_OUT: dict = {}  # "makers": lang/_node_methods.py's MAKERS, once imported
 
 
 _C = TypeVar("_C", bound=type)
@@ -295,12 +300,29 @@ def _setstate(self, state) -> None:
         object.__setattr__(self, f.name, value)  # a frozen class's own __setattr__ refuses
 
 
-def _assembled(cls: Any, frozen: bool, slots: bool, eq: bool) -> Any:
-    """The class ``@dataclass`` would make of ``cls`` (its fields, parameters, slots, frozen attributes), methods aside.
+def _methods(qualname: str, fields, maker, own: set) -> dict:
+    """The methods ``maker`` makes for a class of these fields, by name, but those the class defines itself."""
+    defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
+    factories = {f.name: f.default_factory for f in fields if f.default_factory is not dataclasses.MISSING}
+    init, repr_, eq, hash_ = maker(defaults, factories, FACTORY)
+    init.__annotations__ = {**{f.name: f.type for f in fields}, "return": None}
+    made = {"__init__": init, "__repr__": reprlib.recursive_repr("...")(repr_), "__eq__": eq, "__hash__": hash_}
+    for name, fn in made.items():
+        if fn is not None:
+            fn.__qualname__ = f"{qualname}.{name}"
+    # A mutable class with __eq__ is unhashable (__hash__ None), as @dataclass makes it.
+    return {name: fn for name, fn in made.items() if name not in own}
+
+
+def _assembled(cls: Any, frozen: bool, slots: bool, eq: bool, maker, own: set) -> Any:
+    """The class ``@dataclass`` would make of ``cls``, with the methods ``maker`` makes.
 
     What ``dataclasses.dataclass(cls, frozen=frozen, slots=slots, eq=eq)``
-    does (but write the methods), for a class whose :func:`written_shape` is known, without its
-    inspection of each annotation and default (most of a node class's cost).
+    does (its fields, parameters, slots, frozen attributes), for a class
+    whose :func:`written_shape` is known, without its inspection of each
+    annotation and default (most of a node class's cost). A class with slots
+    is made again, as @dataclass makes it, and then with its methods already
+    in it (setting each afterwards costs as much again).
     """
     fields: dict = {}
     for base in cls.__mro__[-1:0:-1]:
@@ -322,8 +344,9 @@ def _assembled(cls: Any, frozen: bool, slots: bool, eq: bool) -> Any:
     cls.__dataclass_fields__ = fields
     if "__match_args__" not in cls.__dict__:
         cls.__match_args__ = tuple(fields)  # type: ignore[misc]
+    methods = _methods(cls.__qualname__, fields.values(), maker, own)
     if slots:
-        body = dict(cls.__dict__)
+        body = {**cls.__dict__, **methods}
         inherited = {name for base in cls.__mro__[1:-1] for name in _slots_of(base)}
         body["__slots__"] = tuple(name for name in fields if name not in inherited)
         for name in (*fields, "__dict__", "__weakref__"):
@@ -333,6 +356,9 @@ def _assembled(cls: Any, frozen: bool, slots: bool, eq: bool) -> Any:
         cls.__qualname__ = qualname
         if frozen:
             cls.__getstate__, cls.__setstate__ = _getstate, _setstate
+    else:
+        for name, fn in methods.items():
+            setattr(cls, name, fn)
     if frozen:
         cls.__setattr__, cls.__delattr__ = _frozen_setattr(cls, frozenset(fields))
     return cls
@@ -355,24 +381,12 @@ def _make(cls: Any, frozen: bool, slots: bool, eq: bool = True) -> Any:
     if stale:
         # @dataclass makes the fields, the slots and a frozen class's __setattr__ and __delattr__.
         cls = dataclasses.dataclass(cls, frozen=frozen, slots=slots, init=False, repr=False, eq=False)
-        cls.__dataclass_params__ = _params(frozen, slots, eq)  # the methods it left out are ours (below)
-        maker = _compiled(cls)
+        cls.__dataclass_params__ = _params(frozen, slots, eq)  # the methods it left out are ours:
+        for name, fn in _methods(cls.__qualname__, dataclasses.fields(cls), _compiled(cls), own).items():
+            setattr(cls, name, fn)
     else:
-        cls = _assembled(cls, frozen, slots, eq)
-        maker = made[1]
+        cls = _assembled(cls, frozen, slots, eq, made[1], own)
         WRITTEN.add(cls)
-    fields = dataclasses.fields(cls)
-    defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
-    factories = {f.name: f.default_factory for f in fields if f.default_factory is not dataclasses.MISSING}
-    init, repr_, eq, hash_ = maker(defaults, factories, FACTORY)
-    init.__annotations__ = {**{f.name: f.type for f in fields}, "return": None}
-    methods = [(init, "__init__"), (reprlib.recursive_repr("...")(repr_), "__repr__"), (eq, "__eq__")]
-    for fn, name in [*methods, (hash_, "__hash__")]:
-        if name in own:
-            continue
-        if fn is not None:
-            fn.__qualname__ = f"{cls.__qualname__}.{name}"
-        setattr(cls, name, fn)  # a mutable class with __eq__ is unhashable (__hash__ None), as @dataclass makes it
     if not own_doc and (stale or made[2] is None):
         cls.__doc__ = _signature_doc(cls)
     if own_doc:
@@ -403,12 +417,13 @@ def node(cls: _C) -> _C:
 
 #: The packages whose modules may declare records (a module is written out when it uses @record or @node).
 PACKAGES = ("liganimate.lang", "liganimate.compiler", "liganimate.runtime")
-_USES = re.compile(r"^@(?:record|node)\b", re.MULTILINE)
+_USES = r"^@(?:record|node)\b"  # compiled by users(), which only the generator runs
 
 
 def users() -> list:
     """The names of the modules of :data:`PACKAGES` that declare records, sorted."""
     found = []
+    uses = re.compile(_USES, re.MULTILINE)
     for package in PACKAGES:
         spec = importlib.util.find_spec(package)
         assert spec is not None and spec.submodule_search_locations
@@ -416,7 +431,7 @@ def users() -> list:
             for folder, _, files in os.walk(root):
                 for name in files:
                     path = os.path.join(folder, name)
-                    if name.endswith(".py") and _USES.search(Path(path).read_text(encoding="utf-8")):
+                    if name.endswith(".py") and uses.search(Path(path).read_text(encoding="utf-8")):
                         rel = os.path.relpath(path, root)[: -len(".py")].replace(os.sep, ".")
                         found.append(f"{package}.{rel}".removesuffix(".__init__"))
     return sorted(found)

@@ -47,6 +47,8 @@ FORBIDDEN = (
     "liganimate.lang.incremental",
     "liganimate.compiler.library",
     "difflib",
+    # Packing a TABLE's numbers (Appendix A has no TABLE).
+    "base64",
     # Posing and morphing segments: Appendix A poses nothing during a check (a graphical sum of
     # graphicals, no figure drawn as one), so the kinematics' walks are never needed.
     "liganimate.runtime.figure.pose",
@@ -73,6 +75,28 @@ def _modules_after_check() -> list[str]:
     report = json.loads(r.stdout.strip().splitlines()[-1])
     assert report["status"] == 0, r.stderr
     return report["modules"]
+
+
+def test_check_makes_its_records_without_dataclass_inspection():
+    # Every record a check makes (the syntax tree's nodes, the checker's and the host's records, the
+    # figures', keyframes' and REACH options' classes) is assembled from lang/_node_methods.py: none
+    # pays for @dataclass's inspection of its fields or for compiling its methods (lang/node_methods.py).
+    probe = _PROBE.replace(
+        '"modules": sorted(sys.modules)',
+        '"modules": sorted(sys.modules), "made": [f"{c.__module__}.{c.__qualname__}" for c in N.MADE], '
+        '"written": [f"{c.__module__}.{c.__qualname__}" for c in N.WRITTEN]',
+    ).replace(
+        "from liganimate.cli import main",
+        "from liganimate.cli import main\nfrom liganimate.lang import node_methods as N",
+    )
+    r = subprocess.run(
+        [sys.executable, "-c", probe, APPENDIX_A], cwd=ROOT_DIR, capture_output=True, text=True, check=False
+    )
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout.strip().splitlines()[-1])
+    made = report["made"]
+    assert len(made) > 80 and "liganimate.runtime.figure.tree.Figure" in made and "liganimate.lang.ast.Program" in made
+    assert sorted(set(made) - set(report["written"])) == []
 
 
 def test_check_imports_no_renderer_solver_or_exchange_module():

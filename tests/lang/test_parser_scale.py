@@ -89,6 +89,30 @@ def test_a_parser_built_from_the_grammar_parses_as_the_shipped_one():
     assert built.parse(text, P.BUILTIN_PRIMITIVES) == P.parse(text).body
 
 
+def test_a_rule_callback_is_made_when_the_rule_is_first_reduced():
+    # The loop makes each rule's callback the first time it reduces that rule: a fresh driver has none,
+    # parsing makes only those it used, and they are the ones Lark makes for the whole grammar.
+    from lark.parse_tree_builder import ParseTreeBuilder
+    from lark.tree import Tree
+
+    from liganimate.lang.lalr import Driver
+    from liganimate.lang.transform import ToAst
+
+    transformer = ToAst()
+    driver = Driver(P.grammar(), transformer)
+    assert len(driver.rules) == 0
+    text = "G :- BOX WIDTH 1, HEIGHT 2, DEPTH 3\nX = (1 + 2) * -3\n"
+    assert driver.parse(text, P.BUILTIN_PRIMITIVES) == P.parse(text).body
+    made = dict(driver.rules)
+    assert 0 < len(made) < len(P.grammar().rules) / 4
+    lark_made = ParseTreeBuilder(list(P.grammar().rules), Tree, False, False, False).create_callback(transformer)
+    for number, (size, origin, cb) in made.items():
+        rule = P.grammar().rules[number]
+        expected = Driver._rule(rule, lark_made[rule])
+        assert (size, origin) == expected[:2] == (len(rule.expansion), rule.origin.name)
+        assert type(cb) is type(expected[2])
+
+
 def test_nothing_is_cached_in_the_temporary_folder(tmp_path):
     # Lark's cache=True pickled the tables into the temporary folder and
     # unpickled whatever it found there on the next start. Starting the

@@ -125,7 +125,7 @@ def _stack_after(prefix: str, primitives: frozenset) -> list | None:
             return None
 
 
-def _feed(stack: list, ttype: str, actions: list, rules: list) -> bool:
+def _feed(stack: list, ttype: str, actions: list, rules: dict) -> bool:
     """Reduce and shift terminal ``ttype`` onto ``stack`` (changed in place); False if the grammar refuses it."""
     while True:
         code = actions[stack[-1]].get(ttype)
