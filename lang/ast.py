@@ -8,12 +8,14 @@ runs, so building it never recurses.
 
 Every statement's node, and each node its parts are made of, is declared
 once, here, as pycparser declares its node shapes once: ``@syntax(rule,
-field=reader, ...)`` names the grammar rule (lang/lig.lark) that makes it and
-how each field is read from the rule's children (lang/syntax.py), and the
-transformer is made from that. A field also says what the other passes
-need to know of it: the names a statement binds (``binds``, read by
-lang/bindings.py) and the statement lists it holds (``holds``, read by
-lang/visitor.py's ``BLOCKS``).
+statement=production, field=reader, ...)`` names the grammar rule that makes
+it, gives a statement's production (written into lang/lig.lark by
+``python -m liganimate.lang.tables``, see lang/grammar.py) and says how each
+field is read from the rule's children (lang/syntax.py); the transformer is
+made from that. A field also says what the other passes need to know of it:
+the names a statement binds (``binds``, read by lang/bindings.py) or uses
+without an expression (``uses``, read by the editor's index) and the
+statement lists it holds (``holds``, read by lang/visitor.py's ``BLOCKS``).
 """
 
 from __future__ import annotations

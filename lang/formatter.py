@@ -450,11 +450,16 @@ class _Layout:
         # A statement holding a PRINT label is not wrapped: a line break there would change the label.
         verbatim = any(self._in_label(self.tokens[i][2], self.tokens[i][6]) for i in range(first, last))
         parts: list = [[]]  # runs of atoms (space, text, token index), and comments on lines of their own
-        for i in range(first, last):
+        kept = [i for i in range(first, last) if self.plans[i] != _DROP]
+        # The comments after the last word written (before a ";", which is dropped) are
+        # written after the statement is laid out, as they are once the ";" is gone
+        # (they are then the next statement's): else the layout would change on a second pass.
+        end = kept[-1] + 1 if kept else last
+        for i in range(first, end):
             if self.plans[i] != _DROP:
                 atoms = parts[-1]
                 atoms.append((self._space(i) if atoms else "", self._spelling(i), i))
-            if i + 1 < last:
+            if i + 1 < end:
                 self._gap_atoms(self.gaps[i + 1], parts)
         lead = indent
         for part in parts:
@@ -467,6 +472,8 @@ class _Layout:
                 here = lead if n == 0 else indent + CONTINUATION
                 self.lines.append(_starred(here, line[len(here) :]) if star else _column_one(line))
             lead = indent + CONTINUATION
+        for k in range(end, last):
+            self._comments(self.gaps[k], indent)
 
     @staticmethod
     def _gap_atoms(items: list, parts: list) -> None:

@@ -190,6 +190,22 @@ def test_every_comment_stays_where_it_was():
     assert format_text(out) == out
 
 
+def test_a_comment_before_a_semicolon_is_laid_out_as_once_the_semicolon_is_gone():
+    # A long statement's trailing comment before ";" took part in where the line broke;
+    # once the ";" was gone it did not, so a second pass broke the line elsewhere
+    # (a fuzzed program found it). The comment is written after the layout, both times.
+    text = (
+        "       G1 = BOX f 0.25 < TRANS ( 30 , 0.0 , 1e308 ) , TRANS JOINTS BY 180 - 360 , TRANS V1 {a b c d} ,"
+        " LIGHTNESS 0.25 * 123456789 * 2.5 > - 1e3 MOD A { a comment } ;\n      X = 1\nc a comment line\n"
+    )
+    out = format_text(text)
+    assert format_text(out) == out
+    assert (
+        out.split("\n")[1]
+        == "              TRANS V1 {a b c d}, LIGHTNESS 0.25 * 123456789 * 2.5> - 1e3 MOD A { a comment }"
+    )
+
+
 def test_the_thesis_listing_convention_is_kept():
     text = "C a comment line\n      REAL A\n*     A = 1\n*     STARTMODEL M\n*       JOINT 1, P, (0,0,0), Q, (0,0,0), (0,0), (0,0), (0,0)\n*     ENDMODEL\n"
     out = format_text(text)
