@@ -16,6 +16,10 @@ Reported, side by side:
   the figures cover proportionally more pixels), for this rasterizer
   ("new") and for the previous one ("old") side by side, with the ratios
   1080p/480p (6.75x the pixels) and 4K/1080p (4x);
+* the cost of one frame of the film scene (``benchmarks/five_humans.lig``:
+  five Appendix A humans on a ground box, 732 triangles, as the thesis
+  look draws them at 640x480: the triangles ``frames.draw`` hands the
+  rasterizer), old and new (issue 22's goal: at most 1.0 ms of CPU);
 * the fixed cost of a frame: a tiny scene (one box, 12 triangles) at
   640x480, and the five figures at 64x48 (per-triangle work, almost no
   pixels), old and new;
@@ -25,7 +29,9 @@ Reported, side by side:
 "Old" is the rasterizer before its optimisation (issue 13): the file
 ``runtime/render/raster.py`` of commit ``PREVIOUS`` (before bands of rows,
 per-trapezoid tables and anti-aliasing), read with ``git show`` when the
-benchmark runs and loaded as a module from a temporary file.  Without git
+benchmark runs and loaded as a module from a temporary file;
+``--previous COMMIT`` takes it from another commit instead (e.g. the one
+before a change, to see the change's effect in one run).  Without git
 or without that history (an installed copy, a shallow clone) the output
 says so and the old figures are null.  (Until the rasterizer got an
 independent, deliberately slow cross-check reference, "old" was a frozen
@@ -33,14 +39,17 @@ copy of that same version under tests/; it no longer is.)
 
 Frame costs are CPU time of this process (``time.process_time``), best of
 several rounds with old and new interleaved: on a shared machine, wall time
-also counts other processes' turns.
+also counts other processes' turns.  The load average is printed first and
+last: other processes also compete for the caches and memory, which CPU
+time does feel (in the runs of issue 22 the same frames cost up to 10%
+more at a load of 2 than of 1 on this project's two-core machine).
 
 The last line printed is one JSON object with the figures.  Keys
 ``old_ms_<case>``, ``old_ratio_1080p_480p`` and ``old_ratio_4k_1080p`` are
 null when the old rasterizer is not available; ``old_source`` names where
 it came from (``"git <commit>:runtime/render/raster.py"``), or is null, and
-``old_same_image`` says whether it drew the 480p benchmark frame with the
-same bytes.
+``old_same_image`` and ``old_same_film`` say whether it drew the 480p
+benchmark frame and the film scene's frames with the same bytes.
 
 Usage: ``python benchmarks/raster.py [--quick]``.
 """
@@ -65,10 +74,14 @@ from concurrent.futures import ThreadPoolExecutor
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
+from _clock import load, load_text  # noqa: E402
 
 from liganimate.runtime.render.camera import Camera  # noqa: E402
 from liganimate.runtime.render.imagefiles import write_png  # noqa: E402
 from liganimate.runtime.render.raster import rasterize  # noqa: E402
+
+#: The film scene (issue 22): its frames are drawn by the rasterizer as ``liganimate run`` draws them.
+FILM_SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "five_humans.lig")
 
 #: The commit whose runtime/render/raster.py is the "old" rasterizer: the
 #: last one before the optimisations of issue 13.
@@ -280,8 +293,8 @@ def bench_png(frames: int, rounds: int, workers: int, mode: str) -> float:
             return _best_rate(run, frames, rounds)
 
 
-def previous_rasterizer():
-    """The old rasterizer's ``rasterize``, out of git history, or why it is not available.
+def previous_rasterizer(commit: str = PREVIOUS):
+    """The old rasterizer's ``rasterize`` (that of ``commit``), out of git history, or why it is not available.
 
     Returns
     -------
@@ -289,7 +302,7 @@ def previous_rasterizer():
         ``(rasterize, source)`` with ``source`` naming the commit and file,
         or ``(None, reason)``.
     """
-    where = f"{PREVIOUS}:runtime/render/raster.py"
+    where = f"{commit}:runtime/render/raster.py"
     try:
         shown = subprocess.run(
             ["git", "-C", _REPO, "show", where], capture_output=True, text=True, check=False, timeout=60
@@ -300,10 +313,10 @@ def previous_rasterizer():
         first = (shown.stderr.strip().splitlines() or ["no output"])[0]
         return None, f"git show {where} failed: {first}"
     with tempfile.TemporaryDirectory() as folder:
-        path = os.path.join(folder, f"raster_{PREVIOUS}.py")
+        path = os.path.join(folder, f"raster_{commit}.py")
         with open(path, "w", encoding="utf-8") as f:
             f.write(shown.stdout)
-        spec = importlib.util.spec_from_file_location(f"raster_{PREVIOUS}", path)
+        spec = importlib.util.spec_from_file_location(f"raster_{commit}", path)
         if spec is None or spec.loader is None:
             return None, f"{where} could not be loaded as a module"
         module = importlib.util.module_from_spec(spec)
@@ -317,25 +330,78 @@ def previous_rasterizer():
 RESOLUTIONS = {"480p": (640, 480), "1080p": (1920, 1080), "4K": (3840, 2160)}
 
 
+def film_frames(count: int = 20) -> list:
+    """The first ``count`` images of the film scene as the rasterizer is given them.
+
+    The scene (``FILM_SCENE``, made ``count`` ticks long) is compiled and
+    rendered in the thesis look at 640x480, one process, with the drawing
+    step replaced by a recorder; each image's draws (one camera) are joined
+    as ``frames.draw`` joins them.  Returns ``(triangles, grey levels, cull
+    flags, camera)`` per image.
+    """
+    from liganimate.compiler import load_program
+    from liganimate.runtime.render import frames as R
+
+    got: list = []
+    original = R.draw_images
+
+    def grab(size, draws_list, *options):  # aa, png, raw, look: whatever draw_images takes
+        got.extend(draws_list[: max(0, count - len(got))])
+        return [(None, None)] * len(draws_list)
+
+    with open(FILM_SCENE, encoding="utf-8") as f:
+        text = f.read().replace("LENGTH 1000", f"LENGTH {count}").replace("TO 999", f"TO {count - 1}")
+    R.draw_images = grab
+    try:
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "film.lig")
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(text)
+            program, _ = load_program(path)
+            program.check()
+            program.render(
+                os.path.join(folder, "frames"), checked=True, size=SIZE, quiet=True, workers=1, look="thesis"
+            )
+    finally:
+        R.draw_images = original
+    frames = []
+    for draws in got:
+        cameras = {camera for camera, _parts in draws}
+        assert len(cameras) == 1, cameras  # a still camera: one list of triangles an image
+        tris, grey, cull = R._joined([part for _camera, parts in draws for part in parts])
+        frames.append((tris, grey, cull, R._camera(cameras.pop(), SIZE)))
+    return frames
+
+
 def _frame_cost(draw, scenes, camera, frames: int, **kw) -> float:
-    """CPU milliseconds per frame of ``draw`` over ``frames`` frames of ``scenes``."""
+    """CPU milliseconds per frame of ``draw`` over ``frames`` frames of ``scenes``.
+
+    A scene is ``(triangles, shade)``, drawn by ``camera`` with every
+    triangle culled where it faces away, or ``(triangles, shade, cull,
+    camera)``.
+    """
     cull = np.ones(len(scenes[0][0]), dtype=bool)
     t0 = time.process_time()
     for i in range(frames):
-        tris, shade = scenes[i % len(scenes)]
-        draw(tris, shade, camera, cull=cull[: len(tris)], **kw)
+        scene = scenes[i % len(scenes)]
+        if len(scene) == 4:
+            draw(scene[0], scene[1], scene[3], cull=scene[2], **kw)
+        else:
+            draw(scene[0], scene[1], camera, cull=cull[: len(scene[0])], **kw)
     return (time.process_time() - t0) / frames * 1e3
 
 
-def bench_costs(frames: int, rounds: int, old=None) -> dict:
+def bench_costs(frames: int, rounds: int, old=None, film=None) -> dict:
     """Best CPU ms per frame: old and new at each resolution, the fixed costs, and aa.
 
     ``old`` is the previous rasterizer's ``rasterize``, or None to time only
-    this one.  Returns a dict keyed ``(implementation, case)``.
+    this one; ``film`` the film scene's frames (:func:`film_frames`).
+    Returns a dict keyed ``(implementation, case)``.
     """
     scenes = _scene_cache(20)
     tiny = [(tris[:12], shade[:12]) for tris, shade in scenes]
     cases = {name: (scenes, Camera(VIEW_POINT, VIEW_WIDTH, size), {}) for name, size in RESOLUTIONS.items()}
+    cases["film"] = (film or film_frames(), None, {})
     cases["tiny"] = (tiny, _camera(), {})
     cases["64x48"] = (scenes, Camera(VIEW_POINT, VIEW_WIDTH, (64, 48)), {})
     impls = {"new": rasterize} if old is None else {"old": old, "new": rasterize}
@@ -344,7 +410,7 @@ def bench_costs(frames: int, rounds: int, old=None) -> dict:
     cases["aa2"] = (scenes, _camera(), {"aa": 2})
     cases["aa4"] = (scenes, _camera(), {"aa": 4})
     # Frames per round: fewer where a frame costs more, at least 2.
-    weight = {"480p": 1, "1080p": 6, "4K": 24, "tiny": 0.1, "64x48": 0.2, "aa2": 4, "aa4": 16}
+    weight = {"480p": 1, "film": 1, "1080p": 6, "4K": 24, "tiny": 0.1, "64x48": 0.2, "aa2": 4, "aa4": 16}
     best = {job: float("inf") for job in jobs}
     for job in jobs:  # warm up (shared aranges, cameras)
         impl, case = job
@@ -360,8 +426,11 @@ def bench_costs(frames: int, rounds: int, old=None) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="a short run (under a minute)")
+    ap.add_argument("--previous", default=PREVIOUS, metavar="COMMIT", help=f"the old rasterizer's commit ({PREVIOUS})")
     args = ap.parse_args(argv)
     frames, rounds = (50, 5) if args.quick else (200, 15)
+    print(load_text())
+    load_start = load()[0]
 
     tris, _ = scene(0)
     img = rasterize(*scene(0), _camera())
@@ -389,18 +458,29 @@ def main(argv=None) -> int:
     print(f"rasterize + write_png, 2 processes: {png2p:8.1f} images/s")
     print(f"rasterize + write_png, 2 threads:   {png2t:8.1f} images/s")
 
-    old, source = previous_rasterizer()
-    same_image = None
+    film = film_frames()
+    ftris, fgrey, fcull, fcam = film[0]
+    fimg = rasterize(ftris, fgrey, fcam, cull=fcull)
+    print(
+        f"film scene ({os.path.basename(FILM_SCENE)}, thesis look): {len(ftris)} triangles, {SIZE[0]}x{SIZE[1]}, "
+        f"{(fimg != 255).sum()} pixels covered, {len(film)} images"
+    )
+    old, source = previous_rasterizer(args.previous)
+    same_image = same_film = None
     if old is None:
         print(f"previous rasterizer not available: {source}; timing this one only")
     else:
         cam, flags = _camera(), np.ones(len(tris), dtype=bool)
         same_image = bool(np.array_equal(old(*scene(0), cam, cull=flags), rasterize(*scene(0), cam, cull=flags)))
-        print(f"previous rasterizer: {source} (same 480p image: {'yes' if same_image else 'NO'})")
-    cost = bench_costs(frames, rounds, old)
+        same_film = all(np.array_equal(old(t, g, c, cull=f), rasterize(t, g, c, cull=f)) for t, g, f, c in film)
+        print(
+            f"previous rasterizer: {source} (same 480p image: {'yes' if same_image else 'NO'}; "
+            f"same film images: {'yes' if same_film else 'NO'})"
+        )
+    cost = bench_costs(frames, rounds, old, film)
     impls = ("new",) if old is None else ("old", "new")
     print("CPU ms per frame (best of rounds), " + ("previous rasterizer vs this one:" if old else "this rasterizer:"))
-    for case in ["480p", "1080p", "4K", "tiny", "64x48"]:
+    for case in ["480p", "film", "1080p", "4K", "tiny", "64x48"]:
         new = cost["new", case]
         if old is None:
             print(f"  {case:6s} new {new:8.3f}")
@@ -414,13 +494,14 @@ def main(argv=None) -> int:
     aa2, aa4 = cost["new", "aa2"] / cost["new", "480p"], cost["new", "aa4"] / cost["new", "480p"]
     print(f"  anti-aliasing at 480p: aa=2 costs {aa2:5.2f}x aa=1, aa=4 {aa4:5.2f}x")
     figures = {}
-    for case in ["480p", "1080p", "4K", "tiny", "64x48", "aa2", "aa4"]:
+    for case in ["480p", "film", "1080p", "4K", "tiny", "64x48", "aa2", "aa4"]:
         for impl in ("old", "new"):
             if (impl, case) in cost:
                 figures[f"{impl}_ms_{case}"] = round(cost[impl, case], 4)
             elif impl == "old" and case not in ("aa2", "aa4"):
                 figures[f"{impl}_ms_{case}"] = None
     ratios.setdefault("old", (None, None))
+    print(load_text())
     print(
         json.dumps(
             {
@@ -440,9 +521,12 @@ def main(argv=None) -> int:
                 "new_ratio_4k_1080p": _rounded(ratios["new"][1]),
                 "old_source": source if old else None,
                 "old_same_image": same_image,
+                "old_same_film": same_film,
                 "aa2_cost_x": round(aa2, 2),
                 "aa4_cost_x": round(aa4, 2),
                 "cores": os.cpu_count(),
+                "load_start": round(load_start, 2),
+                "load_end": round(load()[0], 2),
                 "quick": args.quick,
             }
         )

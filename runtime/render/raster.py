@@ -20,7 +20,11 @@ handful per frame).  The pipeline:
    relative) above the triangle's number.  One ``np.maximum.at`` then does
    the depth test *and* the tie rule: nearer wins, and at equal depth the
    higher triangle number wins.  The fragments whose key is still there
-   afterwards paint their triangle's grey level or colour.
+   afterwards paint their triangle's grey level or colour; in a new grey
+   image (``rasterize``) the tag is the triangle's number shifted left by 8
+   bits above its grey level (less the background's, modulo 256), so the
+   depth keys cast to bytes, plus the background, are the pixels, and no
+   fragment is looked at again.
 
 Coverage rule: a pixel belongs to a triangle when its centre lies inside it;
 a centre exactly on an edge belongs to the triangle to its right, or below it
@@ -42,7 +46,12 @@ Speed notes (measured with callgrind and CPU time; see
 where a gather (``np.take``, fancy indexing) costs 15-30, so per-span values
 reach fragments by repeating, never by gathering with a span index.  With a
 few hundred triangles a frame costs mostly numpy calls (about a microsecond
-each), so the per-triangle steps work on whole (k, N) blocks.  The benchmark
+each), so the per-triangle steps work on whole (k, N) blocks.  At 640x480
+the fragments' arrays and the depth keys outgrow the processor's cache,
+and a pass over memory that has left it costs two to three times one over
+memory still there: work is ordered so that an array is made just before
+it is used (the depth keys are zeroed just before the depth test).  The
+benchmark
 times this rasterizer beside its version before these optimisations (that
 of commit 2526992, read from git history).
 
@@ -143,7 +152,7 @@ def rasterize(triangles, shade, camera: Camera, background=255, cull=None, aa: i
     shade, bg = _same_kind(shade, bg)
     cam = camera.supersampled(aa)
     W, H = cam.size
-    img = np.full((H, W) + np.shape(bg), bg, dtype=np.uint8)
+    img = np.empty((H, W) + np.shape(bg), dtype=np.uint8)  # (filled by _draw)
     # Nothing drawn yet: the depth buffer need only span the pixels touched.
     _draw(None, img, tris, shade, cam, cull, 0, bg)
     return downsample(img, aa)
@@ -281,9 +290,10 @@ class Framebuffer:
 
 
 def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
-    """Draw triangles into ``img`` (its depth keys ``zbuf``, or None for a fresh image of ``background``).
+    """Draw triangles into ``img`` (its depth keys ``zbuf``, or None for a new image, of ``background``).
 
-    Returns the next draw's first triangle number.
+    A new image's pixels are all written here, the background where nothing
+    is drawn.  Returns the next draw's first triangle number.
     """
     n = len(tris)
     if first_index + n >= _MAX_TRIANGLES:
@@ -291,21 +301,29 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
     W, H = camera.size
     band_rows = None if W * H <= _ONE_BAND_PIXELS else max(1, _BAND_PIXELS // W)
     # A fresh image's depth keys are this draw's alone, so their tags may
-    # carry each triangle's grey level in their low byte, and "nothing drawn"
-    # may be the background's grey level (a key below any surface's): the
-    # depth keys then cast to bytes are the image (see _band).
+    # carry each triangle's grey level in their low byte, less the
+    # background's (modulo 256): the depth keys cast to bytes, plus the
+    # background's grey level, are then the image, EMPTY (0) giving the
+    # background (see _band).
     packed = zbuf is None and shade.ndim == 1 and np.ndim(background) == 0 and n <= _PACKED_TRIANGLES
-    empty = background if packed else EMPTY
-    spans = _spans(tris, cull, camera, first_index, band_rows, shade if packed else None) if n else None
+    grey = shade - np.uint8(background) if packed else None
+    spans = _spans(tris, cull, camera, first_index, band_rows, grey) if n else None
+    single = spans is not None and len(spans.bounds) == 2
+    if zbuf is None and not (single and packed):
+        img[...] = background
     if spans is None:
         return first_index + n
     flat_img = img.reshape((-1,) + img.shape[2:])
     flat_z = None if zbuf is None else zbuf.reshape(-1)
     bounds, tbounds = spans.bounds, spans.tbounds
-    if len(bounds) == 2:
+    if single:
         lo, hi = spans.origin, spans.origin + spans.size
-        zb = np.full(hi - lo, empty, dtype=np.int64) if flat_z is None else flat_z[lo:hi]
-        _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, packed)
+        if zbuf is None and packed:
+            # _band writes every pixel of rows lo..hi; the rest is background.
+            flat_img[:lo] = background
+            flat_img[hi:] = background
+        zb = None if flat_z is None else flat_z[lo:hi]  # (None: made by _band, when it needs it)
+        _band(zb, flat_img[lo:hi], spans, shade, first_index, flat_z is None, background if packed else None)
         return first_index + n
     starts = bounds[:-1]
     offset, count = spans.offset, spans.pixels
@@ -314,7 +332,7 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
     if flat_z is None:
         # One buffer for every band: clearing it while it is still in the
         # cache is cheaper than fresh zeroed pages from the kernel.
-        scratch = np.full(max(h - l for l, h in zip(los, his)), empty, dtype=np.int64)
+        scratch = np.zeros(max(h - l for l, h in zip(los, his)), dtype=np.int64)
     for i, (lo, hi) in enumerate(zip(los, his)):
         sl, tl = slice(bounds[i], bounds[i + 1]), slice(tbounds[i], tbounds[i + 1])
         if flat_z is not None:
@@ -322,11 +340,11 @@ def _draw(zbuf, img, tris, shade, camera, cull, first_index, background=None):
         else:
             zb = scratch[: hi - lo]
             if i:
-                zb.fill(empty)
+                zb.fill(EMPTY)
         band = _Spans(
             offset[sl] - lo, spans.wstart[sl], spans.step[sl], count[sl], spans.tag[tl], spans.nrows[tl], [], [], 0, 0
         )
-        _band(zb, flat_img[lo:hi], band, shade, first_index, flat_z is None, packed)
+        _band(zb, flat_img[lo:hi], band, shade, first_index, flat_z is None, background if packed else None)
     return first_index + n
 
 
@@ -353,16 +371,17 @@ class _Spans(NamedTuple):
 def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
     """Depth-test one band's spans into its depth keys and image (views of the band's pixel range).
 
-    ``fresh``: the depth keys were all EMPTY before this draw.  ``packed``
-    (only in a fresh draw): the tags are ``number << 8 | grey level``, and
-    the keys were all the background's grey level.
+    ``zb`` None stands for new depth keys, all EMPTY.  ``fresh``: the depth
+    keys were all EMPTY before this draw.  ``packed``
+    (only in a fresh draw): None, or the background's grey level ``b`` (an
+    int 0..255), the tags being ``number << 8 | (grey level - b) % 256``.
     """
     offset, wstart, step, count = spans.offset, spans.wstart, spans.step, spans.pixels
     # ends[k]: fragments up to the end of span k; ends0 has a 0 before them.
     ends0 = np.empty(len(count) + 1, dtype=np.int64)
     ends0[0] = 0
-    ends = np.cumsum(count, out=ends0[1:])
-    if ends[-1] == 0:
+    ends = np.add.accumulate(count, out=ends0[1:])
+    if ends[-1] == 0 and packed is None:
         return
     if ends[-1] <= _CHUNK:
         # A trapezoid's fragments are consecutive, so its tag is repeated
@@ -372,10 +391,13 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         frags = ends0.take(spans.nrows.cumsum())
         frags[1:] -= frags[:-1].copy()
         pix, key = _expand(offset, wstart, step, count, ends, spans.tag, frags)
+        if zb is None:
+            # Zeroed only now, so that it is still in the cache for the
+            # depth test rather than pushed out by the fragments' arrays.
+            zb = np.zeros(len(im), dtype=np.int64)
         np.maximum.at(zb, pix, key)
-        if packed:
-            # Each key's low byte is the grey level of the winner, or the background.
-            np.copyto(im, zb, casting="unsafe")
+        if packed is not None:
+            _unpack(im, zb, packed)
             return
         if fresh:
             # Every key in the buffer is this draw's: each fragment may
@@ -397,6 +419,8 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         return
     # Too many fragments for one go (deep overlap): depth-test chunk by
     # chunk, then find this draw's winners by scanning the band.
+    if zb is None:
+        zb = np.zeros(len(im), dtype=np.int64)
     tag = spans.tag.repeat(spans.nrows)  # each span's
     lo = 0
     for hi in np.searchsorted(ends, np.arange(_CHUNK, ends[-1], _CHUNK), side="right").tolist() + [len(count)]:
@@ -406,12 +430,19 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
             pix, key = _expand(offset[sl], wstart[sl], step[sl], cut, cut.cumsum(), tag[sl], cut)
             np.maximum.at(zb, pix, key)
             lo = hi
-    if packed:
-        np.copyto(im, zb, casting="unsafe")
+    if packed is not None:
+        _unpack(im, zb, packed)
         return
     num = zb & _INDEX_MASK
     sel = ((zb != EMPTY) & (num >= first_index)).nonzero()[0]
     im[sel] = shade.take(num.take(sel) - first_index, axis=0)
+
+
+def _unpack(im, zb, background: int) -> None:
+    """Pixels from a packed draw's depth keys: the low byte (the winner's grey level less the background's) plus the background's."""
+    np.copyto(im, zb, casting="unsafe")  # (a cast to bytes keeps the low byte)
+    if background:
+        im += np.uint8(background)
 
 
 # Shared read-only aranges, grown as needed (replaced, never modified, so
@@ -438,8 +469,6 @@ def _expand(offset, wstart, step, count, ends, tag, tag_count):
     n = int(ends[-1])
     iar, far = _aranges(n)
     starts = ends - count
-    pix = (offset - starts).repeat(count)
-    pix += iar[:n]
     # 1/z = wstart + (i - start) * step for fragment i.  Anchoring the
     # ramp at fragment 0 instead saves two passes; its extra rounding is
     # about 1e-16 * start * |step| (start < _CHUNK + W, and |step| at most
@@ -450,6 +479,9 @@ def _expand(offset, wstart, step, count, ends, tag, tag_count):
     key = w.view(np.int64)
     key &= _DEPTH_MASK
     key += tag.repeat(tag_count)
+    # (The pixel numbers last: the depth test reads them next.)
+    pix = (offset - starts).repeat(count)
+    pix += iar[:n]
     return pix, key
 
 
@@ -498,8 +530,8 @@ def _check(triangles, shade, cull):
     tris = np.asarray(triangles, dtype=np.float64)
     if tris.ndim != 3 or tris.shape[1:] != (3, 3):
         raise RenderError(f"Triangles must be an array of shape (N, 3, 3), not {tris.shape}.")
-    if not np.isfinite(tris).all():
-        raise RenderError("A triangle has a coordinate that is not a finite number.")
+    # (Whether every coordinate is finite is checked by _camera_triangles,
+    # on its component-major copy while that is still in the cache.)
     s = np.asarray(shade)
     if s.shape not in ((len(tris),), (len(tris), 3)):
         raise RenderError(
@@ -603,6 +635,8 @@ def _camera_triangles(tris, cull, camera: Camera):
     # more per element than the arithmetic.
     n = len(tris)
     v = np.ascontiguousarray(tris.reshape(n, 9).T).reshape(3, 3, n)
+    if not np.logical_and.reduce(np.isfinite(v), axis=None):
+        raise RenderError("A triangle has a coordinate that is not a finite number.")
     # Facing is decided in world space (camera space is left-handed): the
     # sign of ((v1 - v0) x (v2 - v0)) . (eye - v0), cross product
     # component k being a[k+1] b[k+2] - a[k+2] b[k+1].
@@ -656,7 +690,10 @@ def _pixel_vertices(cam: np.ndarray, camera: Camera) -> np.ndarray:
     less = np.empty((3, m), dtype=bool)
     np.less(xyw[1, 1:], xyw[1, :2], out=less[:2])
     np.less(xyw[1, 2], xyw[1, 0], out=less[2])
-    code = np.packbits(less, axis=0, bitorder="little")[0]
+    bits = less.view(np.uint8)
+    code = bits[2] << 2
+    code |= bits[1] << 1
+    code |= bits[0]
     where = (_SORTED * m).take(code, axis=1)  # (3 positions, m): flat index of the vertex there
     where += _aranges(m)[0][:m]
     return xyw.reshape(3, 3 * m).take(where.reshape(-1), axis=1).reshape(3, 3, m)
@@ -773,10 +810,10 @@ def _banded(table: np.ndarray, first_row: np.ndarray, nrows: np.ndarray, total: 
         ends = nrows.cumsum()
         bounds, tbounds = [0, total], [0, len(nrows)]
         # The rows drawn: one depth buffer covers them (and no more).
-        drawn = nrows > 0
+        drawn = nrows.nonzero()[0]  # (not empty: total > 0)
         rows = (
-            int(np.minimum.reduce(first_row, where=drawn, initial=H)),
-            int(np.maximum.reduce(first_row + nrows, where=drawn, initial=0)),
+            int(np.minimum.reduce(first_row.take(drawn))),
+            int(np.maximum.reduce((first_row + nrows).take(drawn))),
         )
     # Row 13: the trapezoid's first row centre minus the number of spans before it.
     first_row -= ends

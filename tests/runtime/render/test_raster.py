@@ -372,6 +372,12 @@ def test_empty_and_offscreen_input():
     assert (rasterize(far_left, [0, 0], CAM) == 255).all()
     sliver = np.array([[[0, 0, 0], [1, 1, 0], [2, 2, 0]]], float)  # zero area
     assert (rasterize(sliver, [0], CAM) == 255).all()
+    # Rows 16-31 crossed, between the centres of columns 9 and 10: spans of
+    # no pixels, so the rows they span (and the rest) show the background,
+    # in grey and in colour.
+    thin = np.array([[[-2.7375, 1, 0], [-2.7, 1, 0], [-2.72, -1, 0]]])
+    assert (rasterize(thin, [0], CAM, background=9) == 9).all()
+    assert (rasterize(thin, [[0, 0, 0]], CAM, background=(1, 2, 3)) == [1, 2, 3]).all()
 
 
 def test_input_errors():
@@ -386,6 +392,13 @@ def test_input_errors():
         rasterize(sq, [0, 0], CAM, background=300)
     with pytest.raises(RenderError):
         rasterize(sq * np.nan, [0, 0], CAM)
+    # Checked before culling, and in a framebuffer's draw too.
+    inf = sq.copy()
+    inf[1, 2, 0] = np.inf
+    with pytest.raises(RenderError, match="finite"):
+        rasterize(inf, [0, 0], CAM, cull=[True, True])
+    with pytest.raises(RenderError, match="finite"):
+        Framebuffer(CAM.size).draw(inf, [0, 0], CAM)
     with pytest.raises(RenderError):
         rasterize(sq, [0, 0], CAM, cull=[True])
     with pytest.raises(RenderError, match="size"):
