@@ -20,8 +20,9 @@ from .numbers import MIN_FRAME_GAP
 
 __all__ = ["TableProblem", "numbers_text", "pack", "parse_numbers", "read_rows", "unpack"]
 
-_BAR = re.compile(r"\|")
-_CELL = re.compile(r"\S+")
+# As text, compiled when a TABLE is first read (re keeps them): most programs have none.
+_BAR = r"\|"
+_CELL = r"\S+"
 
 
 class TableProblem(Exception):
@@ -34,7 +35,7 @@ class TableProblem(Exception):
 
 def numbers_text(rows: str) -> str:
     """The rows' numbers, blank-separated: the token without its bars."""
-    return _BAR.sub(" ", rows)
+    return re.sub(_BAR, " ", rows)
 
 
 def read_rows(rows: str, pos: Pos, columns: int) -> np.ndarray:
@@ -117,7 +118,7 @@ def _find_bad_cell(rows: str, pos: Pos, width: int) -> None:
         offset = pos.column - 1 if k == 0 else 0
         body = line.split("|", 1)[1] if "|" in line else line
         start = len(line) - len(body)
-        cells = list(_CELL.finditer(body))
+        cells = list(re.finditer(_CELL, body))
         for m in cells:
             try:
                 ok = np.isfinite(float(m.group()))

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
 
-from liganimate.lang import keyframe_table, messages
+from liganimate.lang import messages
 from liganimate.lang import numbers as N
 from liganimate.lang.ast import Pos
 from liganimate.lang.diagnostics import Diagnostic, LigDiagnostics
@@ -632,6 +632,8 @@ class Runtime(Arithmetic):
         """Each table column as ``(start, frames, values)``: its first row is the start, the others keyframes."""
         arrays: dict = {}
         for t in tables:
+            from liganimate.lang import keyframe_table  # here: only a TABLE needs it
+
             width = 1 + 3 * len(t.columns)
             data = keyframe_table.unpack(t.numbers)
             if data is None or data.size == 0 or data.size % width:

@@ -7,7 +7,7 @@ interpolation method), which the REACH rule also uses for its method.
 from __future__ import annotations
 
 from liganimate.lang import ast as A
-from liganimate.lang import keyframe_table, messages
+from liganimate.lang import messages
 from liganimate.lang.diagnostics import did_you_mean
 from liganimate.runtime.motion import interpolation
 
@@ -56,6 +56,8 @@ class MotionBlock(Rule):
                 if value is not None and last is not None and value < last:
                     c.st.out.error(k.frame, messages.keyframes_out_of_order(value, last))
                 last = value if value is not None else last
+        if s.tables:
+            from liganimate.lang import keyframe_table  # only a TABLE needs it (a cold check imports it otherwise)
         for t in s.tables:
             for column in t.columns:
                 _track_joint(c, s, column, seen)
@@ -78,6 +80,8 @@ class MotionBlock(Rule):
         for t in s.tables:
             # The rows travel as one string of numbers (lang/keyframe_table.py), read in bulk at run time.
             columns = "".join(track(lo, col) + ", " for col in t.columns)
+            from liganimate.lang import keyframe_table
+
             packed = keyframe_table.pack(t.rows)
             tables += f"_host.TableArgs(({columns}), {packed!r}, {lo.at(t)}), "
             lo.table_spans.append((t.rows_pos.start, t.rows_pos.start + len(t.rows)))
