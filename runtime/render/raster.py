@@ -372,9 +372,10 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
     """Depth-test one band's spans into its depth keys and image (views of the band's pixel range).
 
     ``zb`` None stands for new depth keys, all EMPTY.  ``fresh``: the depth
-    keys were all EMPTY before this draw.  ``packed``
-    (only in a fresh draw): None, or the background's grey level ``b`` (an
-    int 0..255), the tags being ``number << 8 | (grey level - b) % 256``.
+    keys were all EMPTY before this draw.  ``packed`` (only in a fresh
+    draw): None, or the background's grey level ``b`` (an int 0..255), the
+    tags being ``number << 8 | (grey level - b) % 256`` and every pixel of
+    ``im`` written from the keys.
     """
     offset, wstart, step, count = spans.offset, spans.wstart, spans.step, spans.pixels
     # ends[k]: fragments up to the end of span k; ends0 has a 0 before them.
