@@ -390,7 +390,7 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         # trapezoids than spans).
         frags = ends0.take(spans.nrows.cumsum())
         frags[1:] -= frags[:-1].copy()
-        pix, key = _expand(offset, wstart, step, count, ends, spans.tag, frags)
+        pix, key = _expand(offset, wstart, step, count, ends0, spans.tag, frags)
         if zb is None:
             # Zeroed only now, so that it is still in the cache for the
             # depth test rather than pushed out by the fragments' arrays.
@@ -427,7 +427,7 @@ def _band(zb, im, spans: _Spans, shade, first_index, fresh, packed):
         if hi > lo:
             sl = slice(lo, hi)
             cut = count[sl]
-            pix, key = _expand(offset[sl], wstart[sl], step[sl], cut, cut.cumsum(), tag[sl], cut)
+            pix, key = _expand(offset[sl], wstart[sl], step[sl], cut, ends0[lo : hi + 1] - ends0[lo], tag[sl], cut)
             np.maximum.at(zb, pix, key)
             lo = hi
     if packed is not None:
@@ -461,14 +461,16 @@ def _aranges(n: int):
     return iar, far
 
 
-def _expand(offset, wstart, step, count, ends, tag, tag_count):
+def _expand(offset, wstart, step, count, ends0, tag, tag_count):
     """Spans (P,) to fragments: pixel numbers (F,) and depth keys (F,).
 
-    ``ends`` is ``count.cumsum()``; the fragments' tags are ``tag.repeat(tag_count)``.
+    ``ends0`` (P + 1,) is 0 then ``count.cumsum()``: each span's first
+    fragment, and the number of fragments.  The fragments' tags are
+    ``tag.repeat(tag_count)``.
     """
-    n = int(ends[-1])
+    n = int(ends0[-1])
     iar, far = _aranges(n)
-    starts = ends - count
+    starts = ends0[:-1]
     # 1/z = wstart + (i - start) * step for fragment i.  Anchoring the
     # ramp at fragment 0 instead saves two passes; its extra rounding is
     # about 1e-16 * start * |step| (start < _CHUNK + W, and |step| at most

@@ -20,7 +20,8 @@ def fragments(tris, cull, cam):
     if spans is None:
         return np.zeros(0, np.int64)
     count = spans.pixels
-    pix = _expand(spans.offset, spans.wstart, spans.step, count, count.cumsum(), count, count)[0]
+    ends0 = np.concatenate(([0], count.cumsum()))
+    pix = _expand(spans.offset, spans.wstart, spans.step, count, ends0, count, count)[0]
     return pix + spans.origin
 
 
