@@ -218,6 +218,8 @@ def written_shape(cls: type, frozen: bool, eq: bool = True) -> tuple | None:
     base frozen otherwise): such a class is made by ``@dataclass``, which
     also raises its errors.
     """
+    if "__slots__" in cls.__dict__:
+        return None  # slots of its own: @dataclass(slots=True) refuses them, and plain @dataclass keeps them
     out: list = [_options(frozen, eq, hasattr(cls, "__post_init__"))]
     inherited: dict = {}
     for base in cls.__mro__[-1:0:-1]:  # as @dataclass collects them: the farthest base first
@@ -258,6 +260,8 @@ _PLAIN: Any = dataclasses.dataclass(init=False, repr=False, eq=False)(
 #: The kind of an ordinary field (dataclasses marks each field: ordinary, ClassVar or InitVar).
 _FIELD = dataclasses.fields(_PLAIN)[0]._field_type  # type: ignore[attr-defined]
 _PARAMS: dict = {}
+#: What @dataclass gives every class as ``__replace__`` (from Python 3.13; None before).
+_REPLACE = _PLAIN.__dict__.get("__replace__")
 
 
 def _params(frozen: bool, slots: bool, eq: bool) -> Any:
@@ -345,6 +349,8 @@ def _assembled(cls: Any, frozen: bool, slots: bool, eq: bool, maker, own: set) -
     if "__match_args__" not in cls.__dict__:
         cls.__match_args__ = tuple(fields)  # type: ignore[misc]
     methods = _methods(cls.__qualname__, fields.values(), maker, own)
+    if _REPLACE is not None and "__replace__" not in cls.__dict__:
+        methods["__replace__"] = _REPLACE  # copy.replace(), which @dataclass supports from Python 3.13
     if slots:
         body = {**cls.__dict__, **methods}
         inherited = {name for base in cls.__mro__[1:-1] for name in _slots_of(base)}

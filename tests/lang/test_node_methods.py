@@ -87,6 +87,7 @@ def test_methods_behave_as_dataclass_ones():
         if hasattr(cls, "__post_init__"):
             continue  # its own checks refuse made-up values: tested with the class (and below)
         assert ("__slots__" in cls.__dict__) == ("__slots__" in ref.__dict__), name
+        assert hasattr(cls, "__replace__") == hasattr(ref, "__replace__"), name  # copy.replace, Python 3.13
         names = [f.name for f in dataclasses.fields(cls)]
         values = [f"v{i}" for i in range(len(names))]
         mine, theirs = cls(*values), ref(*values)
@@ -219,8 +220,8 @@ def test_an_edited_class_is_made_by_dataclass(monkeypatch):
 
 
 def test_what_only_dataclass_handles_is_left_to_it():
-    # A ClassVar, a mutable default: not read from the class as written (None), so @dataclass makes (or
-    # refuses) such a class, never the written-out path.
+    # A ClassVar, a mutable default, slots of its own: not read from the class as written (None), so
+    # @dataclass makes (or refuses) such a class, never the written-out path.
     class Counted:
         count: ClassVar[int] = 0  # noqa: RUF012
         name: str
@@ -228,7 +229,11 @@ def test_what_only_dataclass_handles_is_left_to_it():
     class Listed:
         items: list = []  # noqa: RUF012
 
-    for cls in (Counted, Listed):
+    class Slotted:
+        __slots__ = ("name",)
+        name: str
+
+    for cls in (Counted, Listed, Slotted):
         assert N.written_shape(cls, False) is None, cls.__name__
 
     class Plain:
