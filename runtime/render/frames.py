@@ -173,7 +173,7 @@ class Renderer:
         self._framed: dict = {}  # (scene id, size) -> default framing view
         self.fps = options.fps
         self.quiet = options.quiet
-        self.workers = options.workers if options.workers is not None else min(os.cpu_count() or 1, 8)
+        self.workers = options.drawing_workers()
         self.pool = None
         self._worker_procs: list = []
         self.pending: list = []

@@ -129,7 +129,9 @@ class RenderOptions:
         (``ultrafast`` to ``veryslow``) for the MP4.
     workers : int or None
         Processes rasterizing in parallel (default: the machine's cores, at
-        most 8); 1 draws everything in this process.
+        most 8, less one for a movie's encoder in the thesis look; see
+        :meth:`drawing_workers`);
+        1 draws everything in this process.
     scheduler : str or None
         The address of a Dask scheduler to draw the frames on (``tcp://host:8786``).
     quiet : bool
@@ -158,10 +160,34 @@ class RenderOptions:
         """The movies asked for, with their paths, in the order of :data:`MOVIES`."""
         return [(m, path) for m in MOVIES if (path := getattr(self, m.name)) is not None]
 
+    def drawing_workers(self) -> int:
+        """The processes that draw: ``workers`` if given, else one a core (at most 8), less one for a movie's encoder.
+
+        A movie's encoder (x264 in its own process, or the GIF writer's
+        thread) keeps a core busy beside the drawing. Where a frame draws in
+        less time than it is encoded (the thesis look: about 1.1 against 1.9
+        ms at 640x480), the encoder sets the pace, and a core of its own
+        beats a second drawing process that must send its images back: on
+        two cores the five-humanoid film to MP4 took 3.5 ms of CPU and 1.9 ms
+        of wall time a frame drawn in this process, against 4.3 and 2.5 ms
+        with two drawing workers. The modern look draws a frame in about 6
+        ms, so every core draws (4.5 ms of wall time a frame with two
+        workers against 6.0 with one); see docs/semantics-render.md.
+        """
+        if self.workers is not None:
+            return self.workers
+        getaffinity = getattr(os, "sched_getaffinity", None)  # the cores this process may use (Linux)
+        cores = len(getaffinity(0)) if getaffinity is not None else (os.cpu_count() or 1)
+        encoder = 1 if self.movies() and self.look in _ENCODER_BOUND_LOOKS else 0
+        return max(1, min(cores, 8) - encoder)
+
     def files(self) -> tuple[str, ...]:
         """Every output file asked for (movies, then the pose record): what the checks and the lock guard."""
         return tuple(path for _, path in self.movies()) + ((self.poses,) if self.poses is not None else ())
 
+
+#: The looks whose frames draw faster than x264 encodes them (see :meth:`RenderOptions.drawing_workers`).
+_ENCODER_BOUND_LOOKS = frozenset({"thesis"})
 
 _FIELDS = tuple(f.name for f in dataclasses.fields(RenderOptions))
 #: How the command line spells each option in messages.

@@ -165,3 +165,26 @@ def test_a_read_only_file_system_is_reported_as_such_not_as_a_permission(tmp_pat
     monkeypatch.setattr(outputs.os, "statvfs", real_statvfs)
     with pytest.raises(RenderError, match="permission denied"):
         O.checked(O.RenderOptions(out=str(tmp_path / "out")), O.CLI_NAMES)
+
+
+@pytest.mark.parametrize(
+    ("cores", "options", "workers"),
+    [
+        (2, {"look": "thesis"}, 2),  # PNG frames: every core draws
+        (2, {"look": "thesis", "mp4": "film.mp4"}, 1),  # the encoder gets a core of its own
+        (2, {"look": "thesis", "gif": "film.gif", "out": "frames"}, 1),
+        (2, {"look": "modern", "mp4": "film.mp4"}, 2),  # drawing sets the pace: every core draws
+        (2, {"mp4": "film.mp4"}, 2),  # the modern look is the default
+        (1, {"look": "thesis", "mp4": "film.mp4"}, 1),  # never none
+        (16, {}, 8),  # at most 8
+        (16, {"look": "thesis", "mp4": "film.mp4"}, 7),
+        (2, {"look": "thesis", "mp4": "film.mp4", "workers": 2}, 2),  # as asked
+    ],
+)
+def test_a_movie_s_encoder_keeps_a_core_of_the_drawing_workers(monkeypatch, cores, options, workers):
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(cores)), raising=False)
+    monkeypatch.setattr(os, "cpu_count", lambda: 64)  # the affinity counts where there is one
+    assert O.RenderOptions(**options).drawing_workers() == workers
+    monkeypatch.delattr(os, "sched_getaffinity")  # as on Windows and macOS
+    monkeypatch.setattr(os, "cpu_count", lambda: cores)
+    assert O.RenderOptions(**options).drawing_workers() == workers
