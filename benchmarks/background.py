@@ -34,50 +34,17 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import tempfile
 
 from _clock import Cost, best_of, load_text, measure
+from film import captured_draws, scene_program
 
-from liganimate.compiler import load_program
 from liganimate.runtime.render import frames as R
 from liganimate.runtime.render import look as L
 from liganimate.runtime.render import raster
 
-HERE = os.path.dirname(os.path.abspath(__file__))
 SIZE = (640, 480)
-
-
-def program_of(folder: str, ticks: int):
-    """The five humans, ``ticks`` long, compiled."""
-    with open(os.path.join(HERE, "five_humans.lig"), encoding="utf-8") as f:
-        text = f.read()
-    assert "LENGTH 1000" in text and text.count("TO 999") == 5
-    path = os.path.join(folder, "five.lig")
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text.replace("LENGTH 1000", f"LENGTH {ticks}").replace("TO 999", f"TO {ticks - 1}"))
-    program, _ = load_program(path)
-    program.check()
-    return program
-
-
-def captured(program, look: str) -> list:
-    """Every image's draws, as the renderer hands them to ``draw`` (drawn nowhere)."""
-    got: list = []
-    original = R.draw_images
-
-    def grab(size, draws_list, *options):
-        got.extend(draws_list)
-        return [(None, None)] * len(draws_list)
-
-    R.draw_images = grab
-    try:
-        with tempfile.TemporaryDirectory() as out:
-            program.render(out, checked=True, size=SIZE, quiet=True, workers=1, look=look)
-    finally:
-        R.draw_images = original
-    return got
 
 
 def best(fns: dict, count: int, rounds: int) -> dict:
@@ -128,7 +95,7 @@ def buffers(look: str):
 
 
 def measure_look(program, look: str, count: int, rounds: int) -> dict:
-    draws = captured(program, look)[:count]
+    draws = captured_draws(program, count, look)
     bare = [[(image[0][0], [])] + image[1:] for image in draws]
     assert all(len(image) == 2 and image[0][0] == image[1][0] for image in draws)  # one still camera
     copy, nbytes = buffers(look)
@@ -168,7 +135,7 @@ def main(argv=None) -> int:
     )
     out: dict = {"images": count, "size": f"{SIZE[0]}x{SIZE[1]}"}
     with tempfile.TemporaryDirectory() as folder:
-        program = program_of(folder, count)
+        program = scene_program(folder, count)
         for look in ("thesis", "modern"):
             m = measure_look(program, look, count, rounds)
             out[look] = m

@@ -143,8 +143,11 @@ def split(program, ticks: int, folder: str) -> dict:
     }
 
 
-def captured_draws(program, count: int) -> list:
-    """The draw lists of the first ``count`` images (drawn here, one process, nothing written)."""
+def captured_draws(program, count: int, look: str = LOOK) -> list:
+    """The draw lists of the first ``count`` images in ``look`` (drawn here, one process, nothing written).
+
+    benchmarks/background.py and raster.py take the scene's draws from here too.
+    """
     got: list = []
     original = R.draw_images
 
@@ -155,7 +158,7 @@ def captured_draws(program, count: int) -> list:
     R.draw_images = grab
     try:
         with tempfile.TemporaryDirectory() as out:
-            program.render(out, checked=True, size=SIZE, quiet=True, workers=1, look=LOOK)
+            program.render(out, checked=True, size=SIZE, quiet=True, workers=1, look=look)
     finally:
         R.draw_images = original
     return got

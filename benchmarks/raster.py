@@ -357,31 +357,12 @@ def film_frames(count: int = 20) -> list:
     as ``frames.draw`` joins them.  Returns ``(triangles, grey levels, cull
     flags, camera)`` per image.
     """
-    from liganimate.compiler import load_program
+    from film import captured_draws, scene_program
+
     from liganimate.runtime.render import frames as R
 
-    got: list = []
-    original = R.draw_images
-
-    def grab(size, draws_list, *options):  # aa, png, raw, look: whatever draw_images takes
-        got.extend(draws_list[: max(0, count - len(got))])
-        return [(None, None)] * len(draws_list)
-
-    with open(FILM_SCENE, encoding="utf-8") as f:
-        text = f.read().replace("LENGTH 1000", f"LENGTH {count}").replace("TO 999", f"TO {count - 1}")
-    R.draw_images = grab
-    try:
-        with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "film.lig")
-            with open(path, "w", encoding="utf-8") as f:
-                f.write(text)
-            program, _ = load_program(path)
-            program.check()
-            program.render(
-                os.path.join(folder, "frames"), checked=True, size=SIZE, quiet=True, workers=1, look="thesis"
-            )
-    finally:
-        R.draw_images = original
+    with tempfile.TemporaryDirectory() as folder:
+        got = captured_draws(scene_program(folder, count), count, "thesis")
     frames = []
     for draws in got:
         cameras = {camera for camera, _parts in draws}
